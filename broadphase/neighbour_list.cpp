@@ -1,0 +1,132 @@
+#include "broadphase/neighbour_list.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "framework/errors.hpp"
+
+namespace gem {
+
+// The rebuild fires a hair before d_1st + d_2nd reaches the skin, so that rounding in the distances
+// of the build and of this check can never let a pair on the very edge of the list slip out.
+constexpr Real kTrigger = Real(1) - Real(1e-6);
+
+bool NeighbourList::needsRebuild(const World& world) const {
+  if (!m_valid) return true;
+  const int n = world.size();
+  if (n != static_cast<int>(m_x0.size())) return true;
+  const Real* x = world.x.data();
+  const Real* y = world.y.data();
+  const Real* angle = world.angle.data();
+  const Real* radius = world.radius.data();
+  const std::int64_t* id = world.id.data();
+  Real first = 0, second = 0;
+  for (int i = 0; i < n; ++i) {
+    // A reorder or an in-place replacement without invalidate() would make the list point at the
+    // wrong bodies: the ids guard against it for the price of one load per body.
+    if (id[i] != m_id0[i]) return true;
+    const Real dx = x[i] - m_x0[i], dy = y[i] - m_y0[i];
+    // The farthest a point at distance R from the centroid moves under a turn of da is the chord
+    // 2 R |sin(da / 2)| <= R |da wrapped to [-pi, pi]|: an angle that was wrapped by the motion code
+    // (a jump of 2 pi) then counts as no turn, as it should. The wrap is rare, so it is branched.
+    Real da = std::fabs(angle[i] - m_angle0[i]);
+    if (da > kPi) da = std::fabs(std::remainder(da, Real(2) * kPi));
+    const Real d = std::sqrt(dx * dx + dy * dy) + radius[i] * da;
+    if (d > second) {
+      if (d > first) {
+        second = first;
+        first = d;
+      } else {
+        second = d;
+      }
+    }
+  }
+  return first + second > kTrigger * m_skin;
+}
+
+void NeighbourList::begin() { m_raw.clear(); }
+
+// Two stable counting sorts (by b, then by a): an LSD radix sort with digits the slot numbers,
+// O(bodies + pairs), where std::sort of the pairs would cost a log factor at every rebuild.
+void NeighbourList::sortRaw(int bodyCount) {
+  const size_t m = m_raw.size();
+  m_scratch.resize(m);
+  m_pairs.resize(m);
+  auto pass = [&](const std::vector<ListedPair>& in, std::vector<ListedPair>& out, auto key) {
+    m_count.assign(static_cast<size_t>(bodyCount) + 1, 0);
+    for (const ListedPair& p : in) ++m_count[key(p) + 1];
+    for (int k = 0; k < bodyCount; ++k) m_count[k + 1] += m_count[k];
+    for (const ListedPair& p : in) out[m_count[key(p)]++] = p;
+  };
+  pass(m_raw, m_scratch, [](const ListedPair& p) { return p.b; });
+  pass(m_scratch, m_pairs, [](const ListedPair& p) { return p.a; });
+}
+
+void NeighbourList::finish(const World& world) {
+  const int n = world.size();
+  bool sorted = true;
+  for (size_t k = 1; k < m_raw.size() && sorted; ++k)
+    sorted = m_raw[k - 1].a < m_raw[k].a || (m_raw[k - 1].a == m_raw[k].a && m_raw[k - 1].b < m_raw[k].b);
+  if (sorted)
+    m_pairs.swap(m_raw);
+  else
+    sortRaw(n);
+  // Drop wall-wall pairs and duplicates, and fix each pair's reach for the per-step filter.
+  size_t out = 0;
+  for (size_t k = 0; k < m_pairs.size(); ++k) {
+    ListedPair p = m_pairs[k];
+    if (world.kind[p.a] == BodyKind::Wall && world.kind[p.b] == BodyKind::Wall) continue;
+    if (out > 0 && m_pairs[out - 1].a == p.a && m_pairs[out - 1].b == p.b) continue;
+    const Real reach = world.radius[p.a] + world.radius[p.b];
+    p.reach2 = reach * reach;
+    m_pairs[out++] = p;
+  }
+  m_pairs.resize(out);
+  m_x0.assign(world.x.begin(), world.x.end());
+  m_y0.assign(world.y.begin(), world.y.end());
+  m_angle0.assign(world.angle.begin(), world.angle.end());
+  m_id0.assign(world.id.begin(), world.id.end());
+  m_valid = true;
+  ++m_rebuilds;
+}
+
+void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePair>& out) const {
+  out.clear();
+  const Real* x = world.x.data();
+  const Real* y = world.y.data();
+  for (const ListedPair& p : m_pairs) {
+    const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
+    if (dx * dx + dy * dy <= p.reach2) out.push_back({p.a, p.b});
+  }
+}
+
+void KeptListBroadphase::findCandidates(const World& world, std::vector<CandidatePair>& pairs) {
+  if (m_list.needsRebuild(world)) {
+    m_list.begin();
+    build(world, m_list);
+    m_list.finish(world);
+  }
+  filter(world, pairs);
+}
+
+BroadphaseSettings checkedSettings(const BroadphaseSettings& settings) {
+  auto check = [](Real value, const char* key) {
+    if (!std::isfinite(value) || value < 0)
+      throw InputError(std::string("broadphase ") + key + " must be a finite length >= 0 m, got " + std::to_string(value));
+  };
+  check(settings.skin, "skin");
+  check(settings.fixedRadius, "fixed_radius");
+  check(settings.cellSize, "cell_size");
+  return settings;
+}
+
+Real largestFloeRadius(const World& world) {
+  Real floe = 0, movable = 0;
+  for (int i = 0; i < world.size(); ++i) {
+    if (world.kind[i] == BodyKind::Floe && world.radius[i] > floe) floe = world.radius[i];
+    if (world.kind[i] != BodyKind::Wall && world.radius[i] > movable) movable = world.radius[i];
+  }
+  return floe > 0 ? floe : movable;
+}
+
+}  // namespace gem

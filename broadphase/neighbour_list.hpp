@@ -1,0 +1,139 @@
+// The machinery every kept-list broadphase shares (MODEL.md 9, thesis 5.1 and 5.4): a flat list of
+// pairs built with a skin, the never-miss rebuild rule, and the per-step filter that turns the kept
+// list into this step's candidates.
+//
+// Why a skin makes a kept list safe: a strategy lists every pair whose centroids were within
+// R_a + R_b + skin at the build. Two bodies can only touch while their bounding circles overlap,
+// |c_a - c_b| <= R_a + R_b, and since the build the centroid distance has changed by at most
+// d_a + d_b, d the bound on how far any point of a body has moved. So while d_a + d_b <= skin for
+// every pair, every touching pair is still listed. We check this with the two largest bounds:
+// d_1st + d_2nd >= d_a + d_b for any two bodies. That is MODEL.md's "rebuild before any body has moved
+// more than half the skin" made a little tighter: when only the vessel moves through resting ice,
+// the vessel alone may use the whole skin (half as many rebuilds), and the proof is the same.
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "broadphase/broadphase.hpp"
+
+namespace gem {
+
+// A listed pair: the two slots and the square of R_a + R_b, fixed between builds (a body keeps its
+// shape while it keeps its id), so the per-step filter streams one array and gathers only x, y.
+struct ListedPair {
+  int a, b;
+  Real reach2;
+};
+
+class NeighbourList {
+ public:
+  explicit NeighbourList(Real skin) : m_skin(skin) {}
+
+  Real skin() const { return m_skin; }
+  // Never built, invalidated, body count or identities changed, or some pair may have closed in by
+  // more than the skin since the build. One pass over the bodies, no allocation.
+  bool needsRebuild(const World& world) const;
+  void invalidate() { m_valid = false; }
+  long rebuilds() const { return m_rebuilds; }
+
+  // Building: begin, add each pair once (a != b, either order), finish. finish() drops wall-wall
+  // pairs (two immovable bodies never interact), sorts by (a, b) when the pairs did not come in
+  // order, and records the reference state of every body.
+  void begin();
+  void add(int a, int b) { m_raw.push_back({a < b ? a : b, a < b ? b : a, 0}); }
+  void finish(const World& world);
+
+  // This step's candidates: the listed pairs whose bounding circles overlap now, in list order
+  // (sorted). Clears out first.
+  void filterByCircles(const World& world, std::vector<CandidatePair>& out) const;
+  const std::vector<ListedPair>& pairs() const { return m_pairs; }
+
+ private:
+  void sortRaw(int bodyCount);
+
+  Real m_skin;
+  bool m_valid = false;
+  long m_rebuilds = 0;
+  std::vector<ListedPair> m_raw, m_pairs, m_scratch;
+  std::vector<int> m_count;
+  // Reference state at the last build, by slot.
+  std::vector<Real> m_x0, m_y0, m_angle0;
+  std::vector<std::int64_t> m_id0;
+};
+
+// Base of the kept-list strategies: rebuild when the rule asks, then filter. A strategy says only
+// how it builds (and, for triangulation_mesh, how it filters).
+class KeptListBroadphase : public Broadphase {
+ public:
+  explicit KeptListBroadphase(Real skin) : m_list(skin) {}
+  void findCandidates(const World& world, std::vector<CandidatePair>& pairs) override;
+  void invalidate() override { m_list.invalidate(); }
+  long rebuilds() const override { return m_list.rebuilds(); }
+
+ protected:
+  // Adds every pair the strategy lists between m_list.begin() and m_list.finish(), which the base calls.
+  virtual void build(const World& world, NeighbourList& list) = 0;
+  virtual void filter(const World& world, std::vector<CandidatePair>& pairs) { m_list.filterByCircles(world, pairs); }
+  NeighbourList m_list;
+};
+
+// The settings after a check: negative or non-finite lengths are an InputError naming the key.
+BroadphaseSettings checkedSettings(const BroadphaseSettings& settings);
+
+// The largest bounding radius among floes, else among all movable bodies, else 0: the size scale
+// of fixed_radius and uniform_grid. Walls (long, immovable) and the vessel would make it useless.
+Real largestFloeRadius(const World& world);
+
+// Sweep and prune along x: lists every pair (no wall-wall) whose x extents [x - h, x + h] overlap and
+// for which accept(i, j, d2) holds, d2 the squared centroid distance. h[i] must be at least half of
+// the largest distance at which accept can hold for body i, so the sweep never skips such a pair.
+// order is the sweep order kept between builds: bodies move little, so it is nearly sorted and an
+// insertion sort puts it right in about O(n).
+template <class Accept>
+void sweepAndPrune(const World& world, const std::vector<Real>& h, std::vector<int>& order, std::vector<Real>& lo,
+                   NeighbourList& list, Accept accept);
+
+// ----------------------------------------------------------------------------------------------
+template <class Accept>
+void sweepAndPrune(const World& world, const std::vector<Real>& h, std::vector<int>& order, std::vector<Real>& lo,
+                   NeighbourList& list, Accept accept) {
+  const int n = world.size();
+  lo.resize(n);
+  for (int i = 0; i < n; ++i) lo[i] = world.x[i] - h[i];
+  bool fresh = static_cast<int>(order.size()) != n;
+  if (fresh) {
+    order.resize(n);
+    for (int i = 0; i < n; ++i) order[i] = i;
+  }
+  // Insertion sort by lo: O(n + inversions), and inversions are few when bodies moved by about a
+  // skin. After a reorder of the world the old order means nothing: past a work budget, sort afresh.
+  long moves = 0;
+  const long budget = 16L * n + 1024;
+  for (int k = 1; k < n && moves <= budget; ++k) {
+    const int v = order[k];
+    const Real key = lo[v];
+    int m = k - 1;
+    while (m >= 0 && lo[order[m]] > key) {
+      order[m + 1] = order[m];
+      --m;
+      ++moves;
+    }
+    order[m + 1] = v;
+  }
+  if (moves > budget) std::sort(order.begin(), order.end(), [&](int p, int q) { return lo[p] < lo[q]; });
+  for (int k = 0; k < n; ++k) {
+    const int i = order[k];
+    const Real hiI = world.x[i] + h[i];
+    const bool wallI = world.kind[i] == BodyKind::Wall;
+    for (int m = k + 1; m < n; ++m) {
+      const int j = order[m];
+      if (lo[j] > hiI) break;
+      if (wallI && world.kind[j] == BodyKind::Wall) continue;
+      const Real dx = world.x[i] - world.x[j], dy = world.y[i] - world.y[j];
+      if (accept(i, j, dx * dx + dy * dy)) list.add(i, j);
+    }
+  }
+}
+
+}  // namespace gem

@@ -1,0 +1,175 @@
+// triangulation_mesh: thesis 5.5.2 and MODEL.md 9. Each polygon is ear-clipped once, in its body
+// frame, into triangles; two bodies are candidates when any triangle of one overlaps any triangle
+// of the other. The pairs worth testing come from a variable_radius list (same skin, same rebuild
+// rule); each step, a listed pair whose bounding circles overlap has its triangles placed in the
+// world and tested, so what comes out is close to the narrowphase's own answer.
+//
+// Triangles are cached by body id (ids are never reused and a body keeps its shape while it keeps
+// its id), so a floe is clipped once in its life, not at every rebuild; bodies that break are new
+// ids and get clipped when they first appear. The cache drops ids that are gone now and then.
+//
+// Per step: world vertices of a body are computed at most once (lazily, only for bodies in a
+// circle-overlapping pair), and a triangle is tested only when its box meets the other body's box.
+// The overlap test is conservative within eps = kEpsRel x (size + distance from the origin), so
+// rounding in the placement can never drop a pair whose polygons touch.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+
+#include "broadphase/neighbour_list.hpp"
+#include "framework/registry.hpp"
+#include "geometry/triangulate.hpp"
+
+namespace gem {
+namespace {
+
+constexpr int kMaxTriangles = kMaxVertices - 2;
+#if defined(GEM_REAL_FLOAT)
+constexpr Real kEpsRel = Real(1e-5);
+#else
+constexpr Real kEpsRel = Real(1e-9);
+#endif
+
+struct Box {
+  Real lox, loy, hix, hiy;
+};
+
+inline bool boxesMeet(const Box& p, const Box& q, Real eps) {
+  return p.lox <= q.hix + eps && q.lox <= p.hix + eps && p.loy <= q.hiy + eps && q.loy <= p.hiy + eps;
+}
+
+inline Box boxOf(const Vec2* v, int n) {
+  Box b{v[0].x, v[0].y, v[0].x, v[0].y};
+  for (int k = 1; k < n; ++k) {
+    b.lox = std::min(b.lox, v[k].x), b.hix = std::max(b.hix, v[k].x);
+    b.loy = std::min(b.loy, v[k].y), b.hiy = std::max(b.hiy, v[k].y);
+  }
+  return b;
+}
+
+struct TriangleSet {
+  int count;
+  int tri[kMaxTriangles][3];
+};
+
+class TriangulationMesh final : public KeptListBroadphase {
+ public:
+  explicit TriangulationMesh(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin) {}
+  std::string name() const override { return "triangulation_mesh"; }
+
+ protected:
+  void build(const World& world, NeighbourList& list) override {
+    const int n = world.size();
+    const Real skin = list.skin();
+    const Real* radius = world.radius.data();
+    m_half.resize(n);
+    for (int i = 0; i < n; ++i) m_half[i] = radius[i] + skin / 2;
+    sweepAndPrune(world, m_half, m_order, m_lo, list, [&](int i, int j, Real d2) {
+      const Real reach = radius[i] + radius[j] + skin;
+      return d2 <= reach * reach;
+    });
+    refreshTriangles(world);
+  }
+
+  void filter(const World& world, std::vector<CandidatePair>& pairs) override {
+    pairs.clear();
+    if (++m_epoch == 0) {  // the stamp wrapped: forget every stamp once
+      std::fill(m_stamp.begin(), m_stamp.end(), 0u);
+      m_epoch = 1;
+    }
+    const Real* x = world.x.data();
+    const Real* y = world.y.data();
+    for (const ListedPair& p : m_list.pairs()) {
+      const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
+      if (dx * dx + dy * dy > p.reach2) continue;
+      place(world, p.a);
+      place(world, p.b);
+      const Real eps = kEpsRel * (std::sqrt(p.reach2) + std::fabs(x[p.a]) + std::fabs(y[p.a]));
+      if (!boxesMeet(m_box[p.a], m_box[p.b], eps)) continue;
+      if (trianglesMeet(p.a, p.b, eps)) pairs.push_back({p.a, p.b});
+    }
+  }
+
+ private:
+  // Per-slot triangles (CSR over slots) from the cache by id; clips the bodies seen for the first time.
+  void refreshTriangles(const World& world) {
+    const int n = world.size();
+    m_triStart.resize(n + 1);
+    m_vertStart.resize(n + 1);
+    m_tri.clear();
+    m_triStart[0] = m_vertStart[0] = 0;
+    for (int i = 0; i < n; ++i) {
+      auto it = m_cache.find(world.id[i]);
+      if (it == m_cache.end()) {
+        TriangleSet t{};
+        t.count = earClip(world.local(i), world.vertexCount[i], t.tri);
+        it = m_cache.emplace(world.id[i], t).first;
+      }
+      const TriangleSet& t = it->second;
+      for (int k = 0; k < t.count; ++k) m_tri.insert(m_tri.end(), t.tri[k], t.tri[k] + 3);
+      m_triStart[i + 1] = m_triStart[i] + t.count;
+      m_vertStart[i + 1] = m_vertStart[i] + world.vertexCount[i];
+    }
+    // Forget the ids that are gone once the cache holds many of them.
+    if (m_cache.size() > static_cast<size_t>(2 * n) + 64) {
+      std::unordered_map<std::int64_t, TriangleSet> kept;
+      for (int i = 0; i < n; ++i) kept.emplace(world.id[i], m_cache.at(world.id[i]));
+      m_cache.swap(kept);
+    }
+    m_world.resize(static_cast<size_t>(m_vertStart[n]));
+    m_box.resize(n);
+    m_stamp.assign(n, 0u);
+    m_epoch = 0;
+  }
+
+  // World vertices and box of body i, once per step.
+  void place(const World& world, int i) {
+    if (m_stamp[i] == m_epoch) return;
+    m_stamp[i] = m_epoch;
+    Vec2* v = &m_world[m_vertStart[i]];
+    const int n = world.vertexCount[i];
+    toWorld(world.local(i), n, world.position(i), world.angle[i], v);
+    m_box[i] = boxOf(v, n);
+  }
+
+  // Any triangle of a meets any triangle of b? Only the triangles whose boxes meet the other body's
+  // box take part; the first overlapping pair ends the search.
+  bool trianglesMeet(int a, int b, Real eps) {
+    auto gather = [&](int body, const Box& other, Vec2 (*out)[3]) {
+      int count = 0;
+      const Vec2* v = &m_world[m_vertStart[body]];
+      for (int t = m_triStart[body]; t < m_triStart[body + 1]; ++t) {
+        const int* k = &m_tri[static_cast<size_t>(t) * 3];
+        Vec2 tri[3] = {v[k[0]], v[k[1]], v[k[2]]};
+        if (!boxesMeet(boxOf(tri, 3), other, eps)) continue;
+        std::copy(tri, tri + 3, out[count++]);
+      }
+      return count;
+    };
+    Vec2 ta[kMaxTriangles][3], tb[kMaxTriangles][3];
+    const int na = gather(a, m_box[b], ta);
+    if (na == 0) return false;
+    const int nb = gather(b, m_box[a], tb);
+    for (int i = 0; i < na; ++i)
+      for (int j = 0; j < nb; ++j)
+        if (trianglesOverlap(ta[i], tb[j], eps)) return true;
+    return false;
+  }
+
+  std::vector<Real> m_half, m_lo;
+  std::vector<int> m_order;
+  std::unordered_map<std::int64_t, TriangleSet> m_cache;
+  std::vector<int> m_triStart, m_vertStart, m_tri;  // m_tri: 3 vertex indices per triangle
+  std::vector<Vec2> m_world;
+  std::vector<Box> m_box;
+  std::vector<std::uint32_t> m_stamp;
+  std::uint32_t m_epoch = 0;
+};
+
+}  // namespace
+
+GEM_REGISTER_BROADPHASE(TriangulationMesh, "triangulation_mesh",
+                        "variable_radius list, then any overlapping pair of ear-clipped triangles (thesis 5.5.2)");
+
+}  // namespace gem

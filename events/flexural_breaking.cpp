@@ -1,0 +1,86 @@
+#include "events/flexural_breaking.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "framework/table_reader.hpp"
+#include "framework/world.hpp"
+#include "geometry/split.hpp"
+
+namespace gem {
+
+// Drops the vertex with the smallest turn until the polygon has at most `limit` vertices: a cut adds
+// one vertex, and a floe may have at most kMaxFloeVertices.
+static void limitVertices(std::vector<Vec2>& v, int limit) {
+  while (static_cast<int>(v.size()) > limit) {
+    const int n = static_cast<int>(v.size());
+    int flattest = 0;
+    Real smallest = INFINITY;
+    for (int i = 0; i < n; ++i) {
+      const Vec2 a = v[(i + n - 1) % n], b = v[i], c = v[(i + 1) % n];
+      const Real turn = std::fabs(cross(b - a, c - b));
+      if (turn < smallest) smallest = turn, flattest = i;
+    }
+    v.erase(v.begin() + flattest);
+  }
+}
+
+void FlexuralBreaking::apply(const Params& p, TopologyData& data) {
+  if (data.breakCount == 0) return;
+  World& world = *data.world;
+  std::unordered_map<std::int64_t, int> slotOf;
+  for (int i = 0; i < world.size(); ++i) slotOf[world.id[i]] = i;
+
+  // One break per floe and step, the first request in the deterministic contact order.
+  std::vector<char> remove(world.size(), 0), done(world.size(), 0);
+  std::vector<BodySpec> pieces;
+  for (int r = 0; r < data.breakCount; ++r) {
+    const BreakRequest& request = data.breaks[r];
+    auto it = slotOf.find(request.floeId);
+    if (it == slotOf.end() || done[it->second]) continue;
+    const int i = it->second;
+    done[i] = 1;
+    Vec2 polygon[kMaxVertices];
+    const int n = world.worldVertices(i, polygon);
+    Vec2 left[kMaxClipVertices], right[kMaxClipVertices];
+    int nLeft = 0, nRight = 0;
+    const Vec2 linePoint = request.point + request.cuspLength * request.normal;
+    splitByLine(polygon, n, linePoint, perpLeft(request.normal), left, &nLeft, right, &nRight);
+    if (nLeft < 3 || nRight < 3) continue;  // the cut misses the floe
+
+    remove[i] = 1;
+    ++data.floesBroken;
+    const Vec2 centroid = world.position(i), velocity = world.velocity(i);
+    for (auto [v, count] : {std::pair<const Vec2*, int>{left, nLeft}, {right, nRight}}) {
+      BodySpec piece;
+      piece.kind = BodyKind::Floe;
+      piece.vertices.assign(v, v + count);
+      limitVertices(piece.vertices, kMaxFloeVertices);
+      const Real area = signedArea(piece.vertices.data(), static_cast<int>(piece.vertices.size()));
+      if (area < p.minArea) {
+        data.rubbleMass += kRhoIce * area * world.thickness[i];
+        continue;
+      }
+      const Vec2 pieceCentroid = areaCentroid(piece.vertices.data(), static_cast<int>(piece.vertices.size()));
+      piece.thickness = world.thickness[i];
+      piece.velocity = velocity + crossZ(world.omega[i], pieceCentroid - centroid);
+      piece.angularVelocity = world.omega[i];
+      piece.origin = "break";
+      pieces.push_back(std::move(piece));
+    }
+  }
+  if (data.floesBroken == 0) return;
+  world.removeBodies(remove);
+  for (const BodySpec& piece : pieces) world.addBody(piece);
+  data.changed = true;
+}
+
+static FlexuralBreaking::Params parseFlexuralBreaking(EventConfig& config) {
+  FlexuralBreaking::Params p{};
+  p.minArea = config.params.getNonNegative("min_area", 1);
+  return p;
+}
+
+GEM_REGISTER_TOPOLOGY_EVENT(FlexuralBreaking, "flexural_breaking", "splits a floe whose edge failed in bending at the cusp length; small pieces leave as rubble (A.100-A.104)", true, parseFlexuralBreaking);
+
+}  // namespace gem

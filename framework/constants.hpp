@@ -1,0 +1,11 @@
+// Physical constants shared by host and device code (MODEL.md 1, 4, 7). Values that a researcher
+// may want to change are event parameters instead; these are the defaults they start from.
+#pragma once
+#include "geometry/config.hpp"
+
+namespace gem {
+constexpr Real kRhoIce = 900;     // kg/m^3
+constexpr Real kRhoWater = 1025;  // kg/m^3
+constexpr Real kRhoAir = Real(1.3);  // kg/m^3
+constexpr Real kGravity = Real(9.81);  // m/s^2
+}  // namespace gem

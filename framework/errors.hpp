@@ -1,0 +1,25 @@
+// Errors that reach the user. InputError is bad input (exit status 2): it names the file, the
+// line and column or the key, and what was expected. Anything else is an internal failure (1).
+#pragma once
+#include <stdexcept>
+#include <string>
+
+namespace gem {
+
+class InputError : public std::runtime_error {
+ public:
+  explicit InputError(const std::string& message) : std::runtime_error(message) {}
+  // "FILE:LINE:COL: message" (line/column 0 are left out).
+  InputError(const std::string& file, int line, int column, const std::string& message)
+      : std::runtime_error(format(file, line, column, message)) {}
+
+ private:
+  static std::string format(const std::string& file, int line, int column, const std::string& message) {
+    std::string where = file;
+    if (line > 0) where += ":" + std::to_string(line);
+    if (line > 0 && column > 0) where += ":" + std::to_string(column);
+    return where.empty() ? message : where + ": " + message;
+  }
+};
+
+}  // namespace gem

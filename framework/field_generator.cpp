@@ -1,0 +1,906 @@
+// Pack-ice field generation. The random field is a tessellation, not random sequential placement
+// (which jams near 50 % and cannot give the thesis 69 % field):
+//   1. draw the floe areas a_i from the size distribution (stratified, so that a field of a few
+//      hundred floes already has the requested mean and standard deviation);
+//   2. give each floe a share t_i = a_i / c of the domain (c the concentration) and seed it as a
+//      disk of area phi t_i by random sequential placement, largest first (phi = 0.45 is far below
+//      jamming, so it never stalls);
+//   3. take the power (Laguerre) diagram of the disks, weights r_i^2: each cell contains its disk,
+//      and a few Jacobi steps on the weights move the cell areas towards t_i;
+//   4. each cell, inset by minGap / 2, its vertex count brought into [minSides, maxSides], is the
+//      container of its floe: the floe is the container shrunk about its centroid to a_i, then
+//      rotated and shifted at random as far as it stays inside, so low concentrations do not look
+//      like a mosaic. Neighbouring containers are minGap apart, so the floes are too.
+// Every step is O(N) over a uniform grid (the sort of step 2 is O(N log N)). The generator
+// computes in double whatever gem::Real is: a float build generates the same field, rounded once.
+#include "framework/field_generator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "framework/errors.hpp"
+
+namespace gem {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925;
+
+struct P2 {
+  double x, y;
+};
+inline P2 operator+(P2 a, P2 b) { return {a.x + b.x, a.y + b.y}; }
+inline P2 operator-(P2 a, P2 b) { return {a.x - b.x, a.y - b.y}; }
+inline P2 operator*(double s, P2 a) { return {s * a.x, s * a.y}; }
+inline double dot(P2 a, P2 b) { return a.x * b.x + a.y * b.y; }
+inline double cross(P2 a, P2 b) { return a.x * b.y - a.y * b.x; }
+inline double length(P2 a) { return std::sqrt(dot(a, a)); }
+inline P2 rotated(P2 a, double c, double s) { return {c * a.x - s * a.y, s * a.x + c * a.y}; }
+
+// ---------------------------------------------------------------------------------------------
+// Random numbers. std::mt19937_64's output is fixed by the standard; the standard distributions
+// are not, so the few we need are built here from its raw bits.
+class Random {
+ public:
+  explicit Random(std::uint64_t seed) : m_engine(seed) {}
+  double uniform() { return static_cast<double>(m_engine() >> 11) * 0x1.0p-53; }  // [0, 1)
+  double uniform(double a, double b) { return a + (b - a) * uniform(); }
+  std::uint64_t below(std::uint64_t n) {  // [0, n), unbiased by rejection
+    const std::uint64_t limit = std::numeric_limits<std::uint64_t>::max() -
+                                std::numeric_limits<std::uint64_t>::max() % n;
+    std::uint64_t r;
+    do r = m_engine(); while (r >= limit);
+    return r % n;
+  }
+  template <class T>
+  void shuffle(std::vector<T>& v) {  // Fisher-Yates
+    for (size_t i = v.size(); i > 1; --i) std::swap(v[i - 1], v[below(i)]);
+  }
+
+ private:
+  std::mt19937_64 m_engine;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The size distribution: lognormal in s = sqrt(area), truncated to [lo, hi].
+double normalCdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
+
+// Inverse of normalCdf: Acklam's rational approximation, polished by one Halley step (|error|
+// about 1e-15).
+double normalQuantile(double p) {
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+                             1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                             6.680131188771972e+01, -1.328068155288572e+01};
+  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                             -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                             3.754408661907416e+00};
+  p = std::clamp(p, 1e-300, 1 - 1e-16);
+  double x;
+  if (p < 0.02425 || p > 1 - 0.02425) {
+    const double q = std::sqrt(-2 * std::log(p < 0.5 ? p : 1 - p));
+    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
+    if (p > 0.5) x = -x;
+  } else {
+    const double q = p - 0.5, r = q * q;
+    x = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
+  }
+  const double e = normalCdf(x) - p;
+  const double u = e * std::sqrt(kTwoPi) * std::exp(0.5 * x * x);
+  return x - u / (1 + 0.5 * x * u);
+}
+
+// Probability mass of the standard normal between z1 < z2, from the nearer tail so that ranges
+// far out in one tail keep their precision.
+double normalMass(double z1, double z2) {
+  return z1 >= 0 ? normalCdf(-z1) - normalCdf(-z2) : normalCdf(z2) - normalCdf(z1);
+}
+
+struct SizeDistribution {
+  double mu = 0, sigma = 0, lo = 0, hi = 0;
+
+  // Raw moment E[s^k] of the truncated distribution (closed form for the lognormal).
+  double moment(int k) const {
+    if (sigma <= 0) return std::pow(std::clamp(std::exp(mu), lo, hi), k);
+    const double za = (std::log(lo) - mu) / sigma, zb = (std::log(hi) - mu) / sigma;
+    const double mass = normalMass(za, zb);
+    if (!(mass > 1e-300)) return std::pow(za > 0 ? lo : hi, k);  // all of it beyond one bound
+    return std::exp(k * mu + 0.5 * k * k * sigma * sigma) * normalMass(za - k * sigma, zb - k * sigma) / mass;
+  }
+  // The size at cumulative probability u of the truncated distribution.
+  double quantile(double u) const {
+    if (sigma <= 0) return std::clamp(std::exp(mu), lo, hi);
+    const double za = (std::log(lo) - mu) / sigma, zb = (std::log(hi) - mu) / sigma;
+    double z;
+    if (za >= 0) {  // the whole range in the upper tail: work with upper-tail probabilities
+      const double qa = normalCdf(-za), qb = normalCdf(-zb);
+      if (!(qa - qb > 1e-300)) return lo;
+      z = -normalQuantile(qa - u * (qa - qb));
+    } else {
+      const double pa = normalCdf(za), pb = normalCdf(zb);
+      if (!(pb - pa > 1e-300)) return hi;
+      z = normalQuantile(pa + u * (pb - pa));
+    }
+    return std::clamp(std::exp(mu + sigma * z), lo, hi);
+  }
+  double mean() const { return moment(1); }
+  double sd() const { return std::sqrt(std::max(0.0, moment(2) - moment(1) * moment(1))); }
+};
+
+// Lognormal parameters whose truncation to [lo, hi] has the requested mean and sd: start from the
+// untruncated match and correct (truncation at 2 and 20 m shifts the thesis moments by a few %).
+SizeDistribution fitSizeDistribution(double mean, double sd, double lo, double hi) {
+  SizeDistribution dist{std::log(mean), 0, lo, hi};
+  if (sd <= 0 || lo == hi) return dist;
+  const double cv = sd / mean;
+  dist.sigma = std::sqrt(std::log(1 + cv * cv));
+  dist.mu = std::log(mean) - 0.5 * dist.sigma * dist.sigma;
+  for (int it = 0; it < 200; ++it) {
+    const double m = dist.mean(), s = dist.sd();
+    if (std::fabs(m / mean - 1) < 1e-12 && std::fabs(s / sd - 1) < 1e-12) break;
+    dist.mu += std::log(mean / m);
+    // A cv beyond what the range allows cannot be met; the cap stops sigma from running away.
+    if (s > 0) dist.sigma = std::min(10.0, dist.sigma * std::clamp(cv / (s / m), 0.5, 2.0));
+  }
+  return dist;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Input checks: messages name the scenario key; the scenario loader adds the file.
+template <class... Args>
+[[noreturn]] void fail(const Args&... parts) {
+  std::ostringstream out;
+  (out << ... << parts);
+  throw InputError(out.str());
+}
+
+void checkDomain(const Domain& d) {
+  if (!(std::isfinite(d.x0) && std::isfinite(d.x1) && d.x1 > d.x0))
+    fail("domain.x: expected [x0, x1] with x0 < x1, got [", d.x0, ", ", d.x1, "]");
+  if (!(std::isfinite(d.y0) && std::isfinite(d.y1) && d.y1 > d.y0))
+    fail("domain.y: expected [y0, y1] with y0 < y1, got [", d.y0, ", ", d.y1, "]");
+}
+
+void checkCommon(Real concentration, Real thickness, Real minGap, bool thicknessUsed) {
+  if (!(concentration > 0 && concentration < Real(0.9)))
+    fail("field.concentration: expected a fraction in (0, 0.9), got ", concentration);
+  if (thicknessUsed && !(thickness > 0 && std::isfinite(thickness)))
+    fail("field.thickness: expected a positive thickness in m, got ", thickness);
+  if (!(minGap >= 0 && std::isfinite(minGap))) fail("field.min_gap: expected >= 0 m, got ", minGap);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Small convex polygons: fixed capacity, each edge labelled with the site that made it (-1: the
+// domain boundary), so that a power cell knows its neighbours.
+constexpr int kPolyCapacity = 64;
+
+struct Poly {
+  int n = 0;
+  P2 v[kPolyCapacity];
+  int label[kPolyCapacity];
+  void push(P2 p, int l) {
+    if (n == kPolyCapacity) throw std::logic_error("field generator: polygon capacity exceeded");
+    v[n] = p;
+    label[n++] = l;
+  }
+};
+
+double area(const Poly& q) {
+  double twice = 0;
+  for (int k = 0; k < q.n; ++k) twice += cross(q.v[k], q.v[(k + 1) % q.n]);
+  return 0.5 * twice;
+}
+
+P2 centroid(const Poly& q) {  // relative to vertex 0, as areaCentroid in geometry/polygon.hpp
+  const P2 o = q.v[0];
+  double twice = 0, cx = 0, cy = 0;
+  for (int k = 0; k < q.n; ++k) {
+    const P2 a = q.v[k] - o, b = q.v[(k + 1) % q.n] - o;
+    const double ak = cross(a, b);
+    twice += ak;
+    cx += (a.x + b.x) * ak;
+    cy += (a.y + b.y) * ak;
+  }
+  return twice > 0 ? P2{o.x + cx / (3 * twice), o.y + cy / (3 * twice)} : o;
+}
+
+// Sutherland-Hodgman against one half-plane dot(a, x) <= b. A vertex carries the label of the
+// edge that starts at it; the cut edge gets `label`.
+void clip(const Poly& in, P2 a, double b, int label, Poly& out) {
+  out.n = 0;
+  for (int k = 0; k < in.n; ++k) {
+    const P2 cur = in.v[k], nxt = in.v[(k + 1) % in.n];
+    const double dc = dot(a, cur) - b, dn = dot(a, nxt) - b;
+    if (dc <= 0) out.push(cur, in.label[k]);
+    if ((dc <= 0) != (dn <= 0)) {
+      const P2 x = cur + (dc / (dc - dn)) * (nxt - cur);
+      out.push(x, dc <= 0 ? label : in.label[k]);
+    }
+  }
+  if (out.n < 3) out.n = 0;
+}
+
+// The points of q at least delta from its boundary: q clipped by each edge moved inwards.
+void inset(const Poly& q, double delta, Poly& out) {
+  Poly work = q, tmp;
+  for (int k = 0; k < q.n && work.n > 0; ++k) {
+    const P2 e = q.v[(k + 1) % q.n] - q.v[k];
+    const double l = length(e);
+    if (!(l > 0)) continue;
+    const P2 inward{-e.y / l, e.x / l};
+    clip(work, -1.0 * inward, -(delta + dot(inward, q.v[k])), q.label[k], tmp);
+    work = tmp;
+  }
+  out = work;
+}
+
+// Removes vertices that would make the polygon fail a strict convexity test after rounding to
+// float: edges shorter than minEdge and turns with sine below kMinTurnSine. Removing a vertex of a
+// convex polygon cuts a corner, so the result stays inside the original.
+constexpr double kMinTurnSine = 1e-3;
+
+void cleanup(Poly& q, double minEdge) {
+  bool changed = true;
+  while (changed && q.n >= 3) {
+    changed = false;
+    for (int k = 0; k < q.n && q.n >= 3; ++k) {
+      const P2 prev = q.v[(k + q.n - 1) % q.n], cur = q.v[k], nxt = q.v[(k + 1) % q.n];
+      const P2 e0 = cur - prev, e1 = nxt - cur;
+      const double l0 = length(e0), l1 = length(e1);
+      if (l1 < minEdge || cross(e0, e1) <= kMinTurnSine * l0 * l1) {
+        std::copy(q.v + k + 1, q.v + q.n, q.v + k);
+        std::copy(q.label + k + 1, q.label + q.n, q.label + k);
+        --q.n;
+        changed = true;
+      }
+    }
+  }
+  if (q.n < 3) q.n = 0;
+}
+
+// Brings the vertex count into [minSides, maxSides]: above, cut the corner of least area; below,
+// chamfer the sharpest corner (new vertices a fifth of the way along its edges). Both keep the
+// polygon convex and inside the original.
+void fitVertexCount(Poly& q, int minSides, int maxSides) {
+  while (q.n > maxSides) {
+    int best = 0;
+    double bestArea = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < q.n; ++k) {
+      const double a = cross(q.v[k] - q.v[(k + q.n - 1) % q.n], q.v[(k + 1) % q.n] - q.v[k]);
+      if (a < bestArea) bestArea = a, best = k;
+    }
+    std::copy(q.v + best + 1, q.v + q.n, q.v + best);
+    std::copy(q.label + best + 1, q.label + q.n, q.label + best);
+    --q.n;
+  }
+  while (q.n > 0 && q.n < minSides) {
+    int best = 0;
+    double bestCos = -2;
+    for (int k = 0; k < q.n; ++k) {
+      const P2 a = q.v[(k + q.n - 1) % q.n] - q.v[k], b = q.v[(k + 1) % q.n] - q.v[k];
+      const double c = dot(a, b) / (length(a) * length(b));
+      if (c > bestCos) bestCos = c, best = k;
+    }
+    const P2 cur = q.v[best], prev = q.v[(best + q.n - 1) % q.n], nxt = q.v[(best + 1) % q.n];
+    std::copy_backward(q.v + best + 1, q.v + q.n, q.v + q.n + 1);
+    std::copy_backward(q.label + best + 1, q.label + q.n, q.label + q.n + 1);
+    ++q.n;
+    q.v[best] = cur + 0.2 * (prev - cur);
+    q.v[best + 1] = cur + 0.2 * (nxt - cur);
+    q.label[best + 1] = q.label[best];
+  }
+}
+
+bool containsAll(const Poly& outer, const P2* pts, int n) {
+  for (int k = 0; k < outer.n; ++k) {
+    const P2 a = outer.v[k], e = outer.v[(k + 1) % outer.n] - a;
+    for (int i = 0; i < n; ++i)
+      if (cross(e, pts[i] - a) < 0) return false;
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Uniform grid over the domain: the cell size h is at least the largest disk diameter, so every
+// disk overlapping a given one has its centre in the 3 x 3 block around it.
+struct Grid {
+  double x0 = 0, y0 = 0, h = 1;
+  int nx = 1, ny = 1;
+  Grid(const Domain& d, double cell, size_t count) {
+    x0 = d.x0, y0 = d.y0;
+    const double w = d.x1 - d.x0, hgt = d.y1 - d.y0;
+    // No more cells than a few per site, whatever the ratio of domain to floe size.
+    const double minCell = std::sqrt(w * hgt / (4.0 * static_cast<double>(std::max<size_t>(count, 1))));
+    h = std::max(cell, minCell);
+    nx = std::max(1, static_cast<int>(std::ceil(w / h)));
+    ny = std::max(1, static_cast<int>(std::ceil(hgt / h)));
+  }
+  int cx(double x) const { return std::clamp(static_cast<int>((x - x0) / h), 0, nx - 1); }
+  int cy(double y) const { return std::clamp(static_cast<int>((y - y0) / h), 0, ny - 1); }
+  int cell(P2 p) const { return cy(p.y) * nx + cx(p.x); }
+};
+
+// A container needs room for its floe after corner cuts (vertex count): its estimated area
+// (cell area - perimeter * inset) times this must reach the floe's area.
+constexpr double kRoomFraction = 0.92;
+constexpr int kMaxNewtonSteps = 30;
+
+// Random sequential placement of disks, in the given (descending) order. A disk that finds no
+// place in kAttempts tries is shrunk by 10 % and tried again; at a packing fraction of 0.45 that
+// is rare.
+std::vector<P2> placeDisks(std::vector<double>& radius, const Domain& d, const Grid& grid, Random& rng) {
+  constexpr int kAttempts = 64;
+  const size_t n = radius.size();
+  std::vector<P2> centre(n);
+  std::vector<int> head(static_cast<size_t>(grid.nx) * grid.ny, -1), next(n, -1);
+  for (size_t i = 0; i < n; ++i) {
+    for (int attempt = 0;; ++attempt) {
+      if (attempt > 0 && attempt % kAttempts == 0) radius[i] *= 0.9;
+      const double r = radius[i];
+      const double ax = std::min(d.x0 + r, 0.5 * (d.x0 + d.x1)), bx = std::max(d.x1 - r, ax);
+      const double ay = std::min(d.y0 + r, 0.5 * (d.y0 + d.y1)), by = std::max(d.y1 - r, ay);
+      const P2 p{rng.uniform(ax, bx), rng.uniform(ay, by)};
+      const int gx = grid.cx(p.x), gy = grid.cy(p.y);
+      bool free = true;
+      for (int y = std::max(0, gy - 1); y <= std::min(grid.ny - 1, gy + 1) && free; ++y)
+        for (int x = std::max(0, gx - 1); x <= std::min(grid.nx - 1, gx + 1) && free; ++x)
+          for (int j = head[static_cast<size_t>(y) * grid.nx + x]; j >= 0; j = next[j]) {
+            const P2 dp = centre[j] - p;
+            const double rr = radius[j] + r;
+            if (dot(dp, dp) < rr * rr) {
+              free = false;
+              break;
+            }
+          }
+      if (!free) continue;
+      centre[i] = p;
+      const size_t c = static_cast<size_t>(grid.cell(p));
+      next[i] = head[c];
+      head[c] = static_cast<int>(i);
+      break;
+    }
+  }
+  return centre;
+}
+
+// The power diagram of weighted sites, clipped to the domain, one cell at a time: the domain
+// rectangle cut by the power bisector of every site that can reach it, nearest first.
+class PowerDiagram {
+ public:
+  PowerDiagram(const std::vector<P2>& site, const Domain& d, const Grid& grid)
+      : m_site(site), m_domain(d), m_grid(grid) {
+    // Sites bucketed by grid cell (counting sort: deterministic order within a cell).
+    m_start.assign(static_cast<size_t>(grid.nx) * grid.ny + 1, 0);
+    for (const P2& p : site) ++m_start[static_cast<size_t>(grid.cell(p)) + 1];
+    std::partial_sum(m_start.begin(), m_start.end(), m_start.begin());
+    m_items.resize(site.size());
+    std::vector<int> fill(m_start.begin(), m_start.end() - 1);
+    for (size_t i = 0; i < site.size(); ++i) m_items[static_cast<size_t>(fill[static_cast<size_t>(grid.cell(site[i]))]++)] = static_cast<int>(i);
+  }
+
+  // Cell of site i in coordinates relative to the site. A site j cuts the cell only where its
+  // power |x - p_j|^2 - w_j is below |x - p_i|^2 - w_i; with R the cell's largest vertex distance
+  // that needs |p_j - p_i| < R + sqrt(R^2 - w_i + wMax), which bounds the rings searched.
+  void cell(int i, const std::vector<double>& w, double wMax, Poly& out) {
+    const P2 p = m_site[static_cast<size_t>(i)];
+    Poly& cur = out;
+    cur.n = 0;
+    cur.push(P2{m_domain.x0, m_domain.y0} - p, -1);
+    cur.push(P2{m_domain.x1, m_domain.y0} - p, -1);
+    cur.push(P2{m_domain.x1, m_domain.y1} - p, -1);
+    cur.push(P2{m_domain.x0, m_domain.y1} - p, -1);
+    const int gx = m_grid.cx(p.x), gy = m_grid.cy(p.y);
+    const int maxRing = std::max(m_grid.nx, m_grid.ny);
+    for (int ring = 1; ring <= maxRing; ++ring) {
+      m_candidates.clear();
+      for (int y = gy - ring; y <= gy + ring; ++y) {
+        if (y < 0 || y >= m_grid.ny) continue;
+        const bool edgeRow = y == gy - ring || y == gy + ring;
+        for (int x = gx - ring; x <= gx + ring; x += (edgeRow || ring == 1) ? 1 : 2 * ring) {
+          if (x < 0 || x >= m_grid.nx) continue;
+          const size_t c = static_cast<size_t>(y) * m_grid.nx + x;
+          for (int k = m_start[c]; k < m_start[c + 1]; ++k) {
+            const int j = m_items[static_cast<size_t>(k)];
+            if (j == i) continue;
+            const P2 dp = m_site[static_cast<size_t>(j)] - p;
+            m_candidates.push_back({dot(dp, dp), j});
+          }
+        }
+      }
+      std::sort(m_candidates.begin(), m_candidates.end());
+      double r2 = maxDistance2(cur);
+      for (const auto& [d2, j] : m_candidates) {
+        const P2 dp = m_site[static_cast<size_t>(j)] - p;
+        const double rhs = 0.5 * (d2 - w[static_cast<size_t>(j)] + w[static_cast<size_t>(i)]);
+        if (std::sqrt(d2 * r2) <= rhs) continue;  // every vertex, hence the cell, is on i's side
+        bool cuts = false;
+        for (int k = 0; k < cur.n && !cuts; ++k) cuts = dot(dp, cur.v[k]) > rhs;
+        if (!cuts) continue;
+        clip(cur, dp, rhs, j, m_tmp);
+        cur = m_tmp;
+        if (cur.n == 0) return;
+        r2 = maxDistance2(cur);
+      }
+      const double reach = std::sqrt(r2) + std::sqrt(std::max(0.0, r2 - w[static_cast<size_t>(i)] + wMax));
+      if (reach <= ring * m_grid.h) return;
+    }
+  }
+
+ private:
+  static double maxDistance2(const Poly& q) {
+    double r2 = 0;
+    for (int k = 0; k < q.n; ++k) r2 = std::max(r2, dot(q.v[k], q.v[k]));
+    return r2;
+  }
+
+  const std::vector<P2>& m_site;
+  Domain m_domain;
+  const Grid& m_grid;
+  std::vector<int> m_start, m_items;
+  std::vector<std::pair<double, int>> m_candidates;
+  Poly m_tmp;
+};
+
+// Every cell's area and perimeter, and its couplings to its neighbours: moving w_i by dw moves
+// the bisector with site j by dw / (2 |p_i - p_j|), so d(area_i)/d(w_j) = -l_ij / (2 |p_i - p_j|)
+// for an edge of length l_ij, and d(area_i)/d(w_i) is minus their sum: a graph Laplacian.
+struct CellSet {
+  std::vector<double> area, perimeter;
+  std::vector<int> start, neighbour;
+  std::vector<double> coupling;
+};
+
+void measureAll(PowerDiagram& diagram, const std::vector<double>& w, const std::vector<P2>& site, CellSet& out) {
+  const size_t n = site.size();
+  const double wMax = *std::max_element(w.begin(), w.end());
+  out.area.assign(n, 0);
+  out.perimeter.assign(n, 0);
+  out.start.assign(n + 1, 0);
+  out.neighbour.clear();
+  out.coupling.clear();
+  Poly q;
+  for (size_t i = 0; i < n; ++i) {
+    diagram.cell(static_cast<int>(i), w, wMax, q);
+    if (q.n > 0) out.area[i] = area(q);
+    for (int k = 0; k < q.n; ++k) {
+      const double l = length(q.v[(k + 1) % q.n] - q.v[k]);
+      out.perimeter[i] += l;
+      const int j = q.label[k];
+      if (j < 0 || !(l > 0)) continue;
+      out.neighbour.push_back(j);
+      out.coupling.push_back(l / (2 * length(site[static_cast<size_t>(j)] - site[i])));
+    }
+    out.start[i + 1] = static_cast<int>(out.neighbour.size());
+  }
+}
+
+// Solves L x = g for the weight step (L x)_i = sum_j c_ij (x_i - x_j): conjugate gradients with
+// the diagonal as preconditioner. L is singular (a common shift of all weights changes nothing),
+// so g is made mean-free; an inexact solve (residual / 10) is all a damped Newton step needs.
+std::vector<double> solveLaplacian(const CellSet& cs, std::vector<double> g) {
+  const size_t n = g.size();
+  const double mean = std::accumulate(g.begin(), g.end(), 0.0) / static_cast<double>(n);
+  for (double& v : g) v -= mean;
+  std::vector<double> diag(n, 0), x(n, 0), r = g, z(n), p(n), lp(n);
+  for (size_t i = 0; i < n; ++i)
+    for (int k = cs.start[i]; k < cs.start[i + 1]; ++k) diag[i] += cs.coupling[static_cast<size_t>(k)];
+  auto precondition = [&](const std::vector<double>& in, std::vector<double>& out) {
+    for (size_t i = 0; i < n; ++i) out[i] = diag[i] > 0 ? in[i] / diag[i] : 0;
+  };
+  auto dotN = [&](const std::vector<double>& a, const std::vector<double>& b) {
+    double s = 0;
+    for (size_t i = 0; i < n; ++i) s += a[i] * b[i];
+    return s;
+  };
+  precondition(r, z);
+  p = z;
+  double rz = dotN(r, z);
+  const double stop = 1e-2 * dotN(g, g);
+  for (int it = 0; it < 200 && dotN(r, r) > stop; ++it) {
+    for (size_t i = 0; i < n; ++i) {
+      double s = 0;
+      for (int k = cs.start[i]; k < cs.start[i + 1]; ++k)
+        s += cs.coupling[static_cast<size_t>(k)] * (p[i] - p[static_cast<size_t>(cs.neighbour[static_cast<size_t>(k)])]);
+      lp[i] = s;
+    }
+    const double pLp = dotN(p, lp);
+    if (!(pLp > 0)) break;
+    const double alpha = rz / pLp;
+    for (size_t i = 0; i < n; ++i) x[i] += alpha * p[i], r[i] -= alpha * lp[i];
+    precondition(r, z);
+    const double rzNext = dotN(r, z);
+    for (size_t i = 0; i < n; ++i) p[i] = z[i] + (rzNext / rz) * p[i];
+    rz = rzNext;
+  }
+  return x;
+}
+
+// Floe areas that cover exactly target: a_i scaled by one common factor f, but never above the
+// room cap_i of its container. f = 1 unless some container is too small.
+std::vector<double> fitAreas(const std::vector<double>& a, const std::vector<double>& cap, double target) {
+  auto total = [&](double f) {
+    double s = 0;
+    for (size_t i = 0; i < a.size(); ++i) s += std::min(f * a[i], cap[i]);
+    return s;
+  };
+  double lo = 1, hi = 1;
+  if (total(1) < target) {
+    if (std::accumulate(cap.begin(), cap.end(), 0.0) < target * (1 - 1e-9)) return {};
+    while (total(hi) < target) hi *= 2;
+    for (int it = 0; it < 100; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (total(mid) < target ? lo : hi) = mid;
+    }
+  }
+  std::vector<double> out(a.size());
+  for (size_t i = 0; i < a.size(); ++i) out[i] = std::min(hi * a[i], cap[i]);
+  return out;
+}
+
+// Each floe goes to one group, the groups' areas matching their coverages: random order, each
+// floe to a group drawn with probability proportional to what the group still lacks (so every
+// group spreads over the whole domain), the last tenth largest first to the neediest group (so
+// the error ends near the size of a small floe).
+std::vector<int> assignGroups(const std::vector<double>& floeArea, const std::vector<ThicknessGroup>& groups,
+                              double domainArea, Random& rng) {
+  const size_t n = floeArea.size();
+  std::vector<double> lack(groups.size());
+  for (size_t g = 0; g < groups.size(); ++g) lack[g] = groups[g].coverage * domainArea;
+  std::vector<int> order(n), group(n, 0);
+  std::iota(order.begin(), order.end(), 0);
+  rng.shuffle(order);
+  const size_t randomPart = n - n / 10;
+  std::sort(order.begin() + static_cast<std::ptrdiff_t>(randomPart), order.end(), [&](int a, int b) {
+    return floeArea[static_cast<size_t>(a)] != floeArea[static_cast<size_t>(b)]
+               ? floeArea[static_cast<size_t>(a)] > floeArea[static_cast<size_t>(b)] : a < b;
+  });
+  for (size_t k = 0; k < n; ++k) {
+    const size_t i = static_cast<size_t>(order[k]);
+    size_t g = 0;
+    if (k < randomPart) {
+      double sum = 0;
+      for (double l : lack) sum += std::max(l, 0.0);
+      double pick = rng.uniform() * sum;
+      g = groups.size() - 1;
+      for (size_t c = 0; c < groups.size(); ++c) {
+        if (lack[c] <= 0) continue;
+        g = c;
+        if ((pick -= lack[c]) < 0) break;
+      }
+    } else {
+      g = static_cast<size_t>(std::max_element(lack.begin(), lack.end()) - lack.begin());
+    }
+    group[i] = static_cast<int>(g);
+    lack[g] -= floeArea[i];
+  }
+  return group;
+}
+
+BodySpec makeFloe(const P2* v, int n, Real thickness) {
+  BodySpec b;
+  b.kind = BodyKind::Floe;
+  b.vertices.reserve(static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) b.vertices.push_back(Vec2{static_cast<Real>(v[k].x), static_cast<Real>(v[k].y)});
+  b.thickness = thickness;
+  b.origin = "field";
+  return b;
+}
+
+// Along x, then y: ids then grow along the vessel's track.
+void sortAlongX(std::vector<BodySpec>& floes) {
+  std::vector<std::pair<std::pair<Real, Real>, size_t>> key(floes.size());
+  for (size_t i = 0; i < floes.size(); ++i) {
+    const Vec2 c = areaCentroid(floes[i].vertices.data(), static_cast<int>(floes[i].vertices.size()));
+    key[i] = {{c.x, c.y}, i};
+  }
+  std::sort(key.begin(), key.end());
+  std::vector<BodySpec> sorted;
+  sorted.reserve(floes.size());
+  for (const auto& k : key) sorted.push_back(std::move(floes[k.second]));
+  floes.swap(sorted);
+}
+
+}  // namespace
+
+std::vector<BodySpec> generateRandomConvexField(const RandomFieldSpec& spec) {
+  checkDomain(spec.domain);
+  checkCommon(spec.concentration, spec.thickness, spec.minGap, spec.groups.empty());
+  if (spec.count < 0) fail("field.count: expected a floe count >= 0 (0: from the size distribution), got ", spec.count);
+  if (!(spec.sizeMin > 0 && std::isfinite(spec.sizeMin)))
+    fail("field.size_min: expected a positive size in m, got ", spec.sizeMin);
+  if (!(spec.sizeMax >= spec.sizeMin && std::isfinite(spec.sizeMax)))
+    fail("field.size_max: expected >= field.size_min = ", spec.sizeMin, " m, got ", spec.sizeMax);
+  if (!(spec.sizeMean >= spec.sizeMin && spec.sizeMean <= spec.sizeMax))
+    fail("field.size_mean: expected within [field.size_min, field.size_max] = [", spec.sizeMin, ", ",
+         spec.sizeMax, "] m, got ", spec.sizeMean);
+  if (!(spec.sizeSd >= 0 && std::isfinite(spec.sizeSd))) fail("field.size_sd: expected >= 0 m, got ", spec.sizeSd);
+  if (spec.minSides < 3 || spec.minSides > kMaxFloeVertices)
+    fail("field.min_sides: expected 3 to ", kMaxFloeVertices, ", got ", spec.minSides);
+  if (spec.maxSides < spec.minSides || spec.maxSides > kMaxFloeVertices)
+    fail("field.max_sides: expected field.min_sides = ", spec.minSides, " to ", kMaxFloeVertices, ", got ",
+         spec.maxSides);
+  double coverageSum = 0;
+  for (size_t g = 0; g < spec.groups.size(); ++g) {
+    if (!(spec.groups[g].coverage > 0)) fail("field.groups[", g, "].coverage: expected > 0, got ", spec.groups[g].coverage);
+    if (!(spec.groups[g].thickness > 0 && std::isfinite(spec.groups[g].thickness)))
+      fail("field.groups[", g, "].thickness: expected a positive thickness in m, got ", spec.groups[g].thickness);
+    coverageSum += spec.groups[g].coverage;
+  }
+  if (!spec.groups.empty() && std::fabs(coverageSum - spec.concentration) > 1e-6)
+    fail("field.groups: the coverages sum to ", coverageSum, " but field.concentration is ", spec.concentration);
+
+  const Domain& d = spec.domain;
+  const double domainArea = (double(d.x1) - d.x0) * (double(d.y1) - d.y0);
+  const double c = spec.concentration, iceArea = c * domainArea;
+  const double lo = spec.sizeMin, hi = spec.sizeMax;
+
+  // 1. Floe areas: stratified quantiles of the fitted distribution, largest first.
+  SizeDistribution dist = fitSizeDistribution(spec.sizeMean, spec.sizeSd, lo, hi);
+  size_t n = static_cast<size_t>(spec.count);
+  if (n == 0) n = static_cast<size_t>(std::max(1.0, std::round(iceArea / dist.moment(2))));
+  if (iceArea <= n * lo * lo * (1 + 1e-9) || (iceArea >= n * hi * hi * (1 - 1e-9) && lo < hi) ||
+      (lo == hi && std::fabs(iceArea / (n * lo * lo) - 1) > 0.01))
+    fail("field.concentration: ", c, " of the domain (", iceArea, " m^2) cannot be covered by ", n,
+         " floes of size (sqrt of area) within [field.size_min, field.size_max] = [", lo, ", ", hi, "] m");
+  if (spec.count > 0 && dist.sigma > 0) {
+    // Shift log-size by a common amount (a common size factor before truncation) until the
+    // expected total area is the ice area.
+    const double mu0 = dist.mu;
+    auto expected = [&](double shift) {
+      dist.mu = mu0 + shift;
+      return n * dist.moment(2);
+    };
+    double a = -1, b = 1;
+    while (expected(a) > iceArea) a *= 2;
+    while (expected(b) < iceArea) b *= 2;
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (a + b);
+      (expected(mid) < iceArea ? a : b) = mid;
+    }
+    dist.mu = mu0 + 0.5 * (a + b);
+  } else if (spec.count > 0) {
+    dist.mu = std::log(std::clamp(std::sqrt(iceArea / n), lo, hi));
+  }
+  Random rng(spec.seed);
+  std::vector<double> target(n);  // a_i, m^2
+  for (size_t k = 0; k < n; ++k) {
+    const double u = (static_cast<double>(n - 1 - k) + rng.uniform()) / static_cast<double>(n);
+    const double s = dist.quantile(u);
+    target[k] = s * s;
+  }
+  const double sampled = std::accumulate(target.begin(), target.end(), 0.0);
+  for (double& a : target) a *= iceArea / sampled;  // a fraction of a percent: the exact total
+
+  // 2. Seed disks, each a fixed fraction of its floe's share of the domain.
+  constexpr double kDiskFraction = 0.45;
+  std::vector<double> share(n), radius(n);
+  for (size_t i = 0; i < n; ++i) {
+    share[i] = target[i] / c;
+    radius[i] = std::sqrt(kDiskFraction * share[i] / kPi);
+  }
+  const Grid grid(d, 2 * radius[0], n);
+  const std::vector<P2> site = placeDisks(radius, d, grid, rng);
+
+  // 3. Power diagram; its weights by damped Newton steps (Kitagawa, Merigot and Thibert 2019:
+  // the cell areas as a function of the weights are the gradient of a concave function, and a
+  // step halved until no cell shrinks below half its area or target converges from any start
+  // with non-empty cells), until every cell has room for its floe.
+  const double insetBy = 0.5 * spec.minGap * (1 + 1e-6) + 1e-9;
+  std::vector<double> w(n);
+  for (size_t i = 0; i < n; ++i) w[i] = radius[i] * radius[i];
+  PowerDiagram diagram(site, d, grid);
+  CellSet cells, trial;
+  measureAll(diagram, w, site, cells);
+  auto misfits = [&](const CellSet& cs) {
+    size_t count = 0;
+    for (size_t i = 0; i < n; ++i) count += target[i] > kRoomFraction * (cs.area[i] - cs.perimeter[i] * insetBy);
+    return count;
+  };
+  auto residual = [&](const CellSet& cs) {
+    double r = 0;
+    for (size_t i = 0; i < n; ++i) r += (share[i] - cs.area[i]) * (share[i] - cs.area[i]);
+    return std::sqrt(r);
+  };
+  std::vector<double> gradient(n), direction, wTrial(n);
+  for (int iteration = 0; iteration < kMaxNewtonSteps && misfits(cells) > 0; ++iteration) {
+    for (size_t i = 0; i < n; ++i) gradient[i] = share[i] - cells.area[i];
+    direction = solveLaplacian(cells, gradient);
+    const double before = residual(cells);
+    bool accepted = false;
+    for (double alpha = 1; alpha > 1e-3 && !accepted; alpha *= 0.5) {
+      for (size_t i = 0; i < n; ++i) wTrial[i] = w[i] + alpha * direction[i];
+      measureAll(diagram, wTrial, site, trial);
+      accepted = residual(trial) <= (1 - 0.5 * alpha) * before;
+      for (size_t i = 0; i < n && accepted; ++i)
+        accepted = trial.area[i] >= 0.5 * std::min(cells.area[i], share[i]);
+    }
+    if (std::getenv("GEM_FIELD_DEBUG")) {
+      double e2 = 0, emin = 1e9, emax = 0;
+      for (size_t i = 0; i < n; ++i) { double r = trial.area[i] / share[i]; e2 += (r - 1) * (r - 1); emin = std::min(emin, r); emax = std::max(emax, r); }
+      fprintf(stderr, "iter %d accepted %d misfits %zu rms %.3f min %.3f max %.3f\n", iteration, accepted, misfits(trial), std::sqrt(e2 / n), emin, emax);
+    }
+    if (!accepted) break;  // cannot happen in exact arithmetic; the containers below cope
+    w.swap(wTrial);
+    std::swap(cells, trial);
+  }
+
+  // 4. Containers, floe areas, floes.
+  const double wMax = *std::max_element(w.begin(), w.end());
+  std::vector<P2> containerVertex;
+  std::vector<int> containerStart(n + 1, 0);
+  std::vector<double> room(n);
+  Poly cell;
+  containerVertex.reserve(n * static_cast<size_t>(spec.maxSides));
+  Poly shrunk;
+  for (size_t i = 0; i < n; ++i) {
+    diagram.cell(static_cast<int>(i), w, wMax, cell);
+    inset(cell, insetBy, shrunk);
+    cleanup(shrunk, 1e-4 * std::sqrt(target[i]));
+    fitVertexCount(shrunk, spec.minSides, spec.maxSides);
+    room[i] = shrunk.n > 0 ? area(shrunk) : 0;
+    for (int k = 0; k < shrunk.n; ++k) containerVertex.push_back(site[i] + shrunk.v[k]);
+    containerStart[i + 1] = static_cast<int>(containerVertex.size());
+  }
+  const std::vector<double> floeArea = fitAreas(target, room, iceArea);
+  if (floeArea.empty() || *std::min_element(floeArea.begin(), floeArea.end()) <= 0)
+    fail("field.concentration: ", c, " with field.count = ", n,
+         " floes could not be reached in this domain; lower the concentration or field.min_gap");
+
+  std::vector<int> group;
+  if (!spec.groups.empty()) group = assignGroups(floeArea, spec.groups, domainArea, rng);
+
+  std::vector<BodySpec> floes;
+  floes.reserve(n);
+  Poly container;
+  P2 floe[kPolyCapacity], moved[kPolyCapacity];
+  for (size_t i = 0; i < n; ++i) {
+    container.n = 0;
+    for (int k = containerStart[i]; k < containerStart[i + 1]; ++k) container.push(containerVertex[static_cast<size_t>(k)], -1);
+    const P2 centre = centroid(container);
+    const double scale = std::sqrt(floeArea[i] / room[i]);
+    for (int k = 0; k < container.n; ++k) floe[k] = centre + scale * (container.v[k] - centre);
+    // Random turn and shift within the container, smaller at each try; kept only if it fits.
+    if (scale < 0.98) {
+      const double reach = (1 - scale) * std::sqrt(room[i]);
+      for (int attempt = 0; attempt < 8; ++attempt) {
+        const double amplitude = 1 - attempt / 8.0;
+        const double turn = amplitude * rng.uniform(-0.5, 0.5) * kTwoPi;
+        const P2 shift{amplitude * reach * rng.uniform(-0.5, 0.5), amplitude * reach * rng.uniform(-0.5, 0.5)};
+        const double ct = std::cos(turn), st = std::sin(turn);
+        for (int k = 0; k < container.n; ++k) moved[k] = centre + shift + rotated(floe[k] - centre, ct, st);
+        if (containsAll(container, moved, container.n)) {
+          std::copy(moved, moved + container.n, floe);
+          break;
+        }
+      }
+    }
+    const Real thickness = group.empty() ? spec.thickness : spec.groups[static_cast<size_t>(group[i])].thickness;
+    floes.push_back(makeFloe(floe, container.n, thickness));
+  }
+  sortAlongX(floes);
+  return floes;
+}
+
+
+namespace {
+
+// Distance lower bound between two convex polygons: the widest gap along an edge normal of either
+// (exact when the nearest features include an edge, as for neighbouring hexagons).
+double separation(const P2* p, int n, const P2* q, int m) {
+  double best = -std::numeric_limits<double>::infinity();
+  for (int pass = 0; pass < 2; ++pass) {
+    const P2* a = pass == 0 ? p : q;
+    const P2* b = pass == 0 ? q : p;
+    const int na = pass == 0 ? n : m, nb = pass == 0 ? m : n;
+    for (int k = 0; k < na; ++k) {
+      const P2 e = a[(k + 1) % na] - a[k];
+      const P2 out = (1 / length(e)) * P2{e.y, -e.x};  // outward for counter-clockwise a
+      double maxA = -std::numeric_limits<double>::infinity(), minB = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < na; ++i) maxA = std::max(maxA, dot(out, a[i]));
+      for (int i = 0; i < nb; ++i) minB = std::min(minB, dot(out, b[i]));
+      best = std::max(best, minB - maxA);
+    }
+  }
+  return best;
+}
+
+struct HexLayout {
+  int nx, ny;
+  double concentrationError, distortion;
+};
+
+}  // namespace
+
+std::vector<BodySpec> generateHexagonField(const HexagonFieldSpec& spec) {
+  checkDomain(spec.domain);
+  checkCommon(spec.concentration, spec.thickness, spec.minGap, true);
+  if (!(spec.size > 0 && std::isfinite(spec.size))) fail("field.size: expected a positive size in m, got ", spec.size);
+  if (!(spec.rotationJitterDeg >= 0 && spec.rotationJitterDeg <= 30))
+    fail("field.rotation_jitter_deg: expected 0 to 30 degrees, got ", spec.rotationJitterDeg);
+
+  const Domain& d = spec.domain;
+  const double width = double(d.x1) - d.x0, height = double(d.y1) - d.y0, domainArea = width * height;
+  const double hexArea = double(spec.size) * spec.size;
+  const double circumradius = std::sqrt(2 * hexArea / (3 * std::sqrt(3.0)));
+  const double ideal = spec.concentration * domainArea / hexArea;
+  // Rows along x, odd rows shifted by half a cell; hexagons with a vertex up, so that at 100 %
+  // cover the lattice is dx = sqrt(3) a, dy = 1.5 a. Each hexagon sits in the middle of a
+  // W / (nx + 1/2) by H / ny cell, so the concentration is N A_hex / A_domain whatever the
+  // spacing, and the gap to the domain edge is half the gap between neighbours.
+  const double regularAspect = std::sqrt(3.0) / 1.5;
+  std::vector<HexLayout> layouts;
+  for (int ny = 1; height / ny >= circumradius; ++ny) {
+    const int around = static_cast<int>(std::round(ideal / ny));
+    for (int nx = std::max(1, around - 2); nx <= around + 2; ++nx) {
+      const double error = std::fabs(double(nx) * ny * hexArea / domainArea - spec.concentration);
+      if (error > 0.01) continue;
+      const double dx = width / (nx + (ny > 1 ? 0.5 : 0.0)), dy = height / ny;
+      layouts.push_back({nx, ny, error, std::fabs(std::log(dx / dy / regularAspect))});
+    }
+  }
+  // Within half the tolerance, the most regular lattice; then the closest concentration.
+  std::sort(layouts.begin(), layouts.end(), [](const HexLayout& a, const HexLayout& b) {
+    const bool aClose = a.concentrationError <= 0.005, bClose = b.concentrationError <= 0.005;
+    if (aClose != bClose) return aClose;
+    if (a.distortion != b.distortion) return a.distortion < b.distortion;
+    if (a.concentrationError != b.concentrationError) return a.concentrationError < b.concentrationError;
+    return a.ny < b.ny;
+  });
+
+  const double margin = 0.5 * spec.minGap;
+  for (const HexLayout& layout : layouts) {
+    const int nx = layout.nx, ny = layout.ny;
+    const double offset = ny > 1 ? 0.5 : 0.0;
+    const double dx = width / (nx + offset), dy = height / ny;
+    Random rng(spec.seed);
+    std::vector<P2> v(static_cast<size_t>(nx) * ny * 6);
+    bool inside = true;
+    for (int r = 0; r < ny; ++r)
+      for (int i = 0; i < nx; ++i) {
+        const P2 centre{d.x0 + dx * (i + 0.5 + offset * (r % 2)), d.y0 + dy * (r + 0.5)};
+        const double turn = rng.uniform(-1, 1) * spec.rotationJitterDeg * kPi / 180;
+        P2* hex = &v[(static_cast<size_t>(r) * nx + i) * 6];
+        for (int k = 0; k < 6; ++k) {
+          const double angle = kPi / 6 + k * kPi / 3 + turn;
+          hex[k] = centre + circumradius * P2{std::cos(angle), std::sin(angle)};
+          inside = inside && hex[k].x >= d.x0 + margin && hex[k].x <= d.x1 - margin &&
+                   hex[k].y >= d.y0 + margin && hex[k].y <= d.y1 - margin;
+        }
+      }
+    if (!inside) continue;
+    // Rotated neighbours must still keep the gap: the next in the row, the two touching it in
+    // the next row, and the one two rows up.
+    auto at = [&](int r, int i) { return &v[(static_cast<size_t>(r) * nx + i) * 6]; };
+    auto apart = [&](int r, int i, int r2, int i2) {
+      if (r2 >= ny || i2 < 0 || i2 >= nx) return true;
+      return separation(at(r, i), 6, at(r2, i2), 6) >= spec.minGap;
+    };
+    bool separated = true;
+    for (int r = 0; r < ny && separated; ++r)
+      for (int i = 0; i < nx && separated; ++i) {
+        const int left = r % 2 == 0 ? i - 1 : i;  // the lower of the two neighbours in the next row
+        separated = apart(r, i, r, i + 1) && apart(r, i, r + 1, left) && apart(r, i, r + 1, left + 1) &&
+                    apart(r, i, r + 2, i);
+      }
+    if (!separated) continue;
+    std::vector<BodySpec> floes;
+    floes.reserve(static_cast<size_t>(nx) * ny);
+    for (size_t h = 0; h < static_cast<size_t>(nx) * ny; ++h) floes.push_back(makeFloe(&v[h * 6], 6, spec.thickness));
+    sortAlongX(floes);
+    return floes;
+  }
+  fail("field.concentration: ", spec.concentration, " cannot be reached within 0.01 by hexagons of field.size = ",
+       spec.size, " m in this domain, at least field.min_gap = ", spec.minGap, " m apart");
+}
+
+}  // namespace gem

@@ -1,0 +1,146 @@
+// The gem command (SCENARIO.md "Command line"): run, check, info, bench.
+// Exit status: 0 success; 2 bad input (with file, line and column or key); 1 any other failure.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "framework/bench.hpp"
+#include "framework/errors.hpp"
+#include "framework/registry.hpp"
+#include "framework/runner.hpp"
+#include "framework/scenario.hpp"
+#include "framework/simulation.hpp"
+
+namespace fs = std::filesystem;
+using namespace gem;
+
+namespace {
+
+struct RunArguments {
+  std::string scenario, out, backend, broadphase;
+  double duration = 0;
+  long steps = 0;
+  std::vector<std::string> set;
+  bool quiet = false;
+};
+
+Scenario load(const RunArguments& a) {
+  std::vector<std::string> overrides = a.set;
+  if (!a.backend.empty()) overrides.push_back("simulation.backend=\"" + a.backend + "\"");
+  if (!a.broadphase.empty()) overrides.push_back("simulation.broadphase=\"" + a.broadphase + "\"");
+  Scenario s = loadScenario(a.scenario, overrides);
+  if (a.duration > 0) {
+    s.duration = static_cast<Real>(a.duration);
+    s.steps = std::lround(a.duration / s.dt);
+  }
+  if (a.steps > 0) {
+    s.steps = a.steps;
+    s.duration = static_cast<Real>(a.steps) * s.dt;
+  }
+  if (!a.out.empty()) s.output.dir = fs::absolute(a.out);
+  return s;
+}
+
+int commandRun(const RunArguments& a) {
+  const Scenario s = load(a);
+  RunOptions options;
+  options.quiet = a.quiet;
+  options.progress = isatty(fileno(stderr));
+  if (!a.quiet)
+    std::printf("gem run %s: %ld steps of %.3g s, backend %s, broadphase %s\n", a.scenario.c_str(), s.steps,
+                static_cast<double>(s.dt), resolveBackend(s.backend).c_str(), s.broadphase.c_str());
+  const RunSummary r = runScenario(s, options);
+  if (!a.quiet) {
+    std::printf("  floes          %d at start, %d at end (%ld broken, %.4g kg rubble)\n", r.floesInitial, r.floesFinal,
+                r.floesBroken, r.rubbleMass);
+    std::printf("  impacts        %ld ship-ice impacts", r.impacts);
+    if (r.impactForce.count) std::printf(", force mean %.3g kN, max %.3g kN", r.impactForce.mean / 1e3, r.impactForce.max / 1e3);
+    std::printf("\n");
+    if (r.shipSpeed.count)
+      std::printf("  ship speed     mean %.3f m/s (min %.3f, max %.3f); mean net thrust %.1f kN\n", r.shipSpeed.mean,
+                  r.shipSpeed.min, r.shipSpeed.max, r.netThrust.mean / 1e3);
+    std::printf("  wall time      %.3f s for %.1f s simulated: %.0fx real time (%.0f steps/s)\n", r.wallTime, r.simTime,
+                r.simTime / std::max(r.wallTime, 1e-9), r.steps / std::max(r.wallTime, 1e-9));
+    std::printf("  outputs        %s/ (summary.json, timeseries.csv, impacts.csv, state.csv, frames.pvd, frames.ice)\n",
+                r.outputDir.c_str());
+  }
+  return 0;
+}
+
+int commandCheck(const RunArguments& a) {
+  const Scenario s = load(a);
+  resolveBackend(s.backend);
+  Simulation sim(s);  // builds the field, checks every body and overlap, parses every event
+  std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(),
+              sim.world().size(), sim.world().count(BodyKind::Floe), s.vessel.present ? ", a vessel" : "", s.steps,
+              s.broadphase.c_str(), sim.events().size());
+  return 0;
+}
+
+int commandInfo() {
+  std::printf("GEM %s (GPU Event Mechanics)\n", GEM_VERSION);
+  std::printf("build: real type %s, CUDA backend: not built (CPU only)\n", sizeof(Real) == 8 ? "double" : "float");
+  std::printf("devices: cpu\n\nevents (phase, default, origin):\n");
+  for (const EventEntry* e : Registry::global().events())
+    std::printf("  %-18s %-9s %-4s %-9s %s\n", e->name.c_str(), eventPhaseName(e->phase), e->enabledByDefault ? "on" : "off",
+                e->origin.c_str(), e->description.c_str());
+  std::printf("\nbroadphases (origin):\n");
+  for (const BroadphaseEntry* b : Registry::global().broadphases())
+    std::printf("  %-18s %-9s %s\n", b->name.c_str(), b->origin.c_str(), b->description.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"GEM: GPU Event Mechanics, ships in 2D pack ice"};
+  app.require_subcommand(1);
+  RunArguments args;
+  auto addRunOptions = [&](CLI::App* c) {
+    c->add_option("scenario", args.scenario, "scenario file (TOML)")->required();
+    c->add_option("--backend", args.backend, "auto, cpu or cuda");
+    c->add_option("--broadphase", args.broadphase, "broadphase strategy by name (see gem info)");
+    auto* duration = c->add_option("--duration", args.duration, "simulated time, s");
+    c->add_option("--steps", args.steps, "number of steps")->excludes(duration);
+    c->add_option("--set", args.set, "override a scenario key: --set simulation.dt=0.05")->take_all();
+  };
+  CLI::App* run = app.add_subcommand("run", "run a scenario and write its outputs");
+  addRunOptions(run);
+  run->add_option("--out", args.out, "run folder (default: output.dir of the scenario, else runs/NAME)");
+  run->add_flag("--quiet", args.quiet, "no progress line and no summary");
+  CLI::App* check = app.add_subcommand("check", "load and validate a scenario without running it");
+  addRunOptions(check);
+  app.add_subcommand("info", "version, build, devices, registered events and broadphases");
+  BenchOptions bench;
+  CLI::App* benchCommand = app.add_subcommand("bench", "time the CPU backend per step on the thesis fields");
+  benchCommand->add_option("--steps", bench.steps, "steps timed per case");
+  benchCommand->add_option("--csv", bench.csv, "also write the table as CSV");
+  benchCommand->add_option("--cases", bench.cases, "which cases: 456, 824, 10000 (default all)");
+  benchCommand->add_option("--broadphase", bench.broadphases, "broadphases to time (default variable_radius)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  try {
+    if (*run) return commandRun(args);
+    if (*check) return commandCheck(args);
+    if (*benchCommand) return runBench(bench);
+    return commandInfo();
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "gem: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gem: failed: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,202 @@
+// One registry of events and broadphases by name: built-ins register themselves at load time
+// with the macros below; plugins will use the very same macros (DESIGN.md "Plugins").
+#pragma once
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "broadphase/broadphase.hpp"
+#include "framework/event_api.hpp"
+
+namespace gem {
+
+class TableReader;
+struct Scenario;
+struct World;
+
+enum class EventPhase { Pair, Solo, Motion, Topology };
+const char* eventPhaseName(EventPhase phase);
+
+// What the scheduler hands a pair event each step: every body's view (by slot) and the contacts.
+struct PairPhaseData {
+  const PairBody* bodies;
+  const int* contactA;  // slot of body a of contact k
+  const int* contactB;
+  const PairContact* contacts;
+  PairSlot* slots;
+  int count;
+  StepContext ctx;
+  RecordSink sink;
+};
+
+struct SoloPhaseData {
+  const SoloBody* bodies;
+  VelocityChange* changes;
+  int count;
+  StepContext ctx;
+};
+
+struct MotionPhaseData {
+  MotionBody* bodies;
+  int count;
+  StepContext ctx;
+};
+
+// Topology events run on the host after motion (MODEL.md 8, phase 6).
+struct TopologyData {
+  struct World* world;
+  const BreakRequest* breaks;
+  int breakCount;
+  Real time;
+  // Outputs: what the event did, for the summary and the broadphase.
+  double rubbleMass = 0;   // kg removed as rubble this step
+  int floesBroken = 0;
+  bool changed = false;    // bodies were added or removed
+};
+
+class EventInstance {
+ public:
+  virtual ~EventInstance() = default;
+  virtual void runPairs(const PairPhaseData&) {}
+  virtual void runSolo(const SoloPhaseData&) {}
+  virtual void runMotion(const MotionPhaseData&) {}
+  virtual void runTopology(TopologyData&) {}
+};
+
+// What an event's factory gets: its parameter table (strict) and the whole scenario
+// (propulsion and autopilot read the vessel from it).
+struct EventConfig {
+  TableReader& params;
+  const Scenario& scenario;
+};
+
+struct EventEntry {
+  std::string name, description, origin;
+  EventPhase phase;
+  bool enabledByDefault;
+  std::function<std::unique_ptr<EventInstance>(EventConfig&)> makeCpu;
+};
+
+struct BroadphaseEntry {
+  std::string name, description, origin;
+  std::function<std::unique_ptr<Broadphase>(const BroadphaseSettings&)> make;
+};
+
+class Registry {
+ public:
+  static Registry& global();
+  void addEvent(EventEntry entry);
+  void addBroadphase(BroadphaseEntry entry);
+  // Throw InputError listing the valid names when `name` is unknown.
+  const EventEntry& event(const std::string& name) const;
+  const BroadphaseEntry& broadphase(const std::string& name) const;
+  const EventEntry* findEvent(const std::string& name) const;
+  // In registration order of phase, then name.
+  std::vector<const EventEntry*> events() const;
+  std::vector<const BroadphaseEntry*> broadphases() const;
+  std::vector<std::string> eventNames() const;
+  std::vector<std::string> broadphaseNames() const;
+
+ private:
+  std::map<std::string, EventEntry> m_events;
+  std::map<std::string, BroadphaseEntry> m_broadphases;
+};
+
+// The CPU drivers: the only loops over bodies and contacts (DESIGN.md "Folders").
+template <class Event>
+class CpuPairDriver final : public EventInstance {
+ public:
+  using Params = typename Event::Params;
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  explicit CpuPairDriver(const Params& p) : m_params(p) {}
+  void runPairs(const PairPhaseData& d) override {
+    for (int k = 0; k < d.count; ++k)
+      Event::apply(m_params, d.bodies[d.contactA[k]], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], d.ctx, d.sink);
+  }
+
+ private:
+  Params m_params;
+};
+
+template <class Event>
+class CpuSoloDriver final : public EventInstance {
+ public:
+  using Params = typename Event::Params;
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  explicit CpuSoloDriver(const Params& p) : m_params(p) {}
+  void runSolo(const SoloPhaseData& d) override {
+    for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.changes[i], d.ctx);
+  }
+
+ private:
+  Params m_params;
+};
+
+template <class Event>
+class CpuMotionDriver final : public EventInstance {
+ public:
+  using Params = typename Event::Params;
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  explicit CpuMotionDriver(const Params& p) : m_params(p) {}
+  void runMotion(const MotionPhaseData& d) override {
+    for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.ctx);
+  }
+
+ private:
+  Params m_params;
+};
+
+// Topology events work on the host World directly.
+template <class Event>
+class TopologyDriver final : public EventInstance {
+ public:
+  using Params = typename Event::Params;
+  explicit TopologyDriver(const Params& p) : m_params(p) {}
+  void runTopology(TopologyData& d) override { Event::apply(m_params, d); }
+
+ private:
+  Params m_params;
+};
+
+struct RegisterEvent {
+  explicit RegisterEvent(EventEntry e) { Registry::global().addEvent(std::move(e)); }
+};
+struct RegisterBroadphase {
+  explicit RegisterBroadphase(BroadphaseEntry e) { Registry::global().addBroadphase(std::move(e)); }
+};
+
+#ifndef GEM_ORIGIN
+#define GEM_ORIGIN "built-in"
+#endif
+
+#define GEM_CONCAT_INNER(a, b) a##b
+#define GEM_CONCAT(a, b) GEM_CONCAT_INNER(a, b)
+
+// Registers an event: EVENT is the evaluator struct, PARSE a function EventConfig& -> EVENT::Params.
+#define GEM_REGISTER_EVENT(DRIVER, PHASE, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)                        \
+  static const ::gem::RegisterEvent GEM_CONCAT(gem_register_event_, __LINE__){::gem::EventEntry{           \
+      NAME, DESCRIPTION, GEM_ORIGIN, PHASE, ENABLED,                                                        \
+      [](::gem::EventConfig& config) -> std::unique_ptr<::gem::EventInstance> {                            \
+        return std::make_unique<DRIVER<EVENT>>(PARSE(config));                                             \
+      }}}
+#define GEM_REGISTER_PAIR_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
+  GEM_REGISTER_EVENT(::gem::CpuPairDriver, ::gem::EventPhase::Pair, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
+#define GEM_REGISTER_SOLO_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
+  GEM_REGISTER_EVENT(::gem::CpuSoloDriver, ::gem::EventPhase::Solo, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
+#define GEM_REGISTER_MOTION_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
+  GEM_REGISTER_EVENT(::gem::CpuMotionDriver, ::gem::EventPhase::Motion, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
+#define GEM_REGISTER_TOPOLOGY_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
+  GEM_REGISTER_EVENT(::gem::TopologyDriver, ::gem::EventPhase::Topology, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
+
+// Registers a broadphase class constructible from BroadphaseSettings.
+#define GEM_REGISTER_BROADPHASE(CLASS, NAME, DESCRIPTION)                                                  \
+  static const ::gem::RegisterBroadphase GEM_CONCAT(gem_register_broadphase_, __LINE__){                   \
+      ::gem::BroadphaseEntry{NAME, DESCRIPTION, GEM_ORIGIN,                                                \
+                             [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::Broadphase> { \
+                               return std::make_unique<CLASS>(s);                                          \
+                             }}}
+
+}  // namespace gem

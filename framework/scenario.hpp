@@ -1,0 +1,94 @@
+// A scenario: everything one run needs, read from a TOML file (SCENARIO.md) with --set overrides.
+// Loading validates every key, type and range; errors are InputError with file:line:column.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "broadphase/broadphase.hpp"
+#include "framework/field_generator.hpp"
+#include "framework/world.hpp"
+
+namespace gem {
+
+struct VesselSpec {
+  bool present = false;
+  Real length = 100, beam = 20;  // m
+  Real mass = Real(7.2e6);       // kg (thesis 6.2.1.1.2: 7200 t)
+  Real draft = 6;                // m: the vessel's "thickness" for the elastic contact's h = min(h1, h2)
+  Vec2 position{-60, 0};         // centroid at start, m
+  Real headingDeg = 0;
+  int dof = 1;
+  Real bollardThrust = Real(370e3);  // N
+  Real openWaterSpeed = Real(4.9);   // m/s
+  Real speed = Real(4.9);            // initial speed, m/s (defaults to the open-water speed)
+  std::vector<Vec2> hull;            // waterline, body frame (x forward, y to port), any origin
+  std::vector<Real> frameAnglesDeg;  // one per hull edge (edge i joins vertex i and i+1)
+};
+
+struct OutputSpec {
+  std::filesystem::path dir;  // absolute
+  int frameEvery = 10;        // steps between frames; 0 = no frames
+  int timeseriesEvery = 1;    // steps between time-series rows
+  std::vector<std::string> formats{"vtk", "ice"};
+};
+
+struct PluginSpec {
+  std::filesystem::path path;
+  bool override = false;
+};
+
+struct Scenario {
+  std::filesystem::path file;  // the scenario file (absolute)
+  std::string fileName;        // as given, for messages
+  toml::table root;            // the parsed document, overrides applied
+
+  // [simulation]
+  Real dt = Real(0.1);
+  Real duration = 600;
+  long steps = 0;  // total steps (from duration / dt, or simulation.steps)
+  std::string backend = "auto";
+  std::string broadphase = "variable_radius";
+  BroadphaseSettings broadphaseSettings;
+  std::uint64_t seed = 1;
+  bool mortonSort = true;  // re-sort bodies along a space-filling curve at each list rebuild
+
+  // [domain]
+  bool hasDomain = false;
+  Domain domain{0, 500, -100, 100};
+  bool walls = false;
+  Real wallThickness = 5;  // m: the wall polygons' width outside the domain
+
+  // [field] and [[floes]]
+  std::string fieldKind = "none";  // none | random_convex | hexagons | file
+  RandomFieldSpec randomField;
+  HexagonFieldSpec hexagonField;
+  std::filesystem::path fieldFile;
+  std::vector<BodySpec> floes;  // explicit [[floes]]
+
+  VesselSpec vessel;
+
+  // [events.NAME]: enabled flag and the table of parameters (null when absent).
+  struct EventSetting {
+    bool enabled;
+    const toml::table* table;
+  };
+  std::map<std::string, EventSetting> events;
+
+  std::vector<PluginSpec> plugins;
+  OutputSpec output;
+};
+
+// Reads and validates a scenario. overrides are "dotted.key=VALUE" (VALUE in TOML syntax; a bare
+// word is taken as a string). outDir, when not empty, replaces output.dir.
+Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
+
+// The default hull: 100 m x 20 m with a sloped bow (see vessel.cpp for the numbers).
+void defaultHull(Real length, Real beam, std::vector<Vec2>& vertices, std::vector<Real>& frameAnglesDeg);
+
+}  // namespace gem

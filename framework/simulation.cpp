@@ -1,0 +1,322 @@
+#include "framework/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "framework/errors.hpp"
+#include "framework/ice_file.hpp"
+#include "framework/table_reader.hpp"
+#include "framework/vessel.hpp"
+#include "geometry/contact.hpp"
+
+namespace gem {
+
+void validateBodySpec(BodySpec& spec, int maxVertices) {
+  const int n = static_cast<int>(spec.vertices.size());
+  if (n < 3 || n > maxVertices)
+    throw InputError(fmt::format("{}: a {} needs 3 to {} vertices, got {}", spec.origin, bodyKindName(spec.kind), maxVertices, n));
+  for (const Vec2& v : spec.vertices)
+    if (!std::isfinite(v.x) || !std::isfinite(v.y))
+      throw InputError(fmt::format("{}: vertex coordinates must be finite numbers", spec.origin));
+  if (!std::isfinite(spec.velocity.x) || !std::isfinite(spec.velocity.y) || !std::isfinite(spec.angularVelocity))
+    throw InputError(fmt::format("{}: velocity must be finite", spec.origin));
+  if (!(spec.thickness > 0) || !std::isfinite(spec.thickness))
+    throw InputError(fmt::format("{}: thickness must be a positive number, got {}", spec.origin, spec.thickness));
+  if (signedArea(spec.vertices.data(), n) < 0) reverseOrder(spec.vertices.data(), n);  // MODEL.md 1
+  if (!isStrictlyConvexCCW(spec.vertices.data(), n, Real(1e-9)))
+    throw InputError(fmt::format("{}: the polygon is not convex (or is self-intersecting or has repeated or collinear vertices)", spec.origin));
+}
+
+// Static walls along the long sides of the domain (SCENARIO.md [domain] walls): the channel. They
+// reach past both ends so that a vessel starting before the field is already between them.
+static void addWalls(const Scenario& s, std::vector<BodySpec>& bodies) {
+  const Real margin = std::max<Real>(2 * s.vessel.length, 50);
+  const Real x0 = s.domain.x0 - margin, x1 = s.domain.x1 + margin;
+  const Real t = s.wallThickness;
+  for (int side = 0; side < 2; ++side) {
+    const Real inner = side == 0 ? s.domain.y0 : s.domain.y1;
+    const Real outer = side == 0 ? inner - t : inner + t;
+    BodySpec wall;
+    wall.kind = BodyKind::Wall;
+    wall.thickness = 10;
+    wall.origin = side == 0 ? "domain wall (y0)" : "domain wall (y1)";
+    wall.vertices = {{x0, std::min(inner, outer)}, {x1, std::min(inner, outer)}, {x1, std::max(inner, outer)}, {x0, std::max(inner, outer)}};
+    bodies.push_back(wall);
+  }
+}
+
+World buildWorld(const Scenario& s) {
+  std::vector<BodySpec> bodies;
+  if (s.walls) addWalls(s, bodies);
+  if (s.fieldKind == "random_convex") {
+    auto field = generateRandomConvexField(s.randomField);
+    bodies.insert(bodies.end(), field.begin(), field.end());
+  } else if (s.fieldKind == "hexagons") {
+    auto field = generateHexagonField(s.hexagonField);
+    bodies.insert(bodies.end(), field.begin(), field.end());
+  } else if (s.fieldKind == "file") {
+    auto field = readIceInitialBodies(s.fieldFile);
+    bodies.insert(bodies.end(), field.begin(), field.end());
+  }
+  bodies.insert(bodies.end(), s.floes.begin(), s.floes.end());
+
+  World world;
+  std::vector<std::string> origins;
+  for (BodySpec& spec : bodies) {
+    if (spec.kind == BodyKind::Vessel) continue;  // a vessel comes from [vessel]
+    validateBodySpec(spec, spec.kind == BodyKind::Floe ? kMaxFloeVertices : kMaxVertices);
+    world.addBody(spec);
+    origins.push_back(spec.origin);
+  }
+  if (s.vessel.present) {
+    HullGeometry hull = hullGeometry(s.vessel);
+    BodySpec check;
+    check.kind = BodyKind::Vessel;
+    check.origin = "vessel hull";
+    check.vertices = hull.vertices;
+    check.thickness = s.vessel.draft;
+    validateBodySpec(check, kMaxVertices);
+    addVessel(world, s.vessel);
+    origins.push_back("vessel");
+  }
+
+  // Bodies never start in contact (MODEL.md 1): any conservative broadphase + the exact contact.
+  auto broadphase = Registry::global().broadphase("variable_radius").make(BroadphaseSettings{0, 0, 0});
+  std::vector<CandidatePair> pairs;
+  broadphase->findCandidates(world, pairs);
+  Vec2 p[kMaxVertices], q[kMaxVertices];
+  for (const CandidatePair& pair : pairs) {
+    if (world.invMass[pair.a] == 0 && world.invMass[pair.b] == 0) continue;
+    const int n = world.worldVertices(pair.a, p), m = world.worldVertices(pair.b, q);
+    const Contact c = computeContact(p, n, world.position(pair.a), q, m, world.position(pair.b));
+    if (c.touching)
+      throw InputError(fmt::format("bodies overlap at the start: {} (id {}) and {} (id {}), overlap area {:.4g} m^2",
+                                   origins[pair.a], world.id[pair.a], origins[pair.b], world.id[pair.b], c.area));
+  }
+  return world;
+}
+
+Simulation::Simulation(const Scenario& scenario) : Simulation(scenario, buildWorld(scenario)) {}
+
+Simulation::Simulation(const Scenario& scenario, World world) : m_scenario(scenario), m_world(std::move(world)) {
+  setUp();
+}
+
+void Simulation::setUp() {
+  m_broadphase = Registry::global().broadphase(m_scenario.broadphase).make(m_scenario.broadphaseSettings);
+  for (const EventEntry* entry : Registry::global().events()) {
+    auto it = m_scenario.events.find(entry->name);
+    const toml::table* table = it == m_scenario.events.end() ? nullptr : it->second.table;
+    const bool enabled = it == m_scenario.events.end() ? entry->enabledByDefault : it->second.enabled;
+    TableReader reader(table, "events." + entry->name, m_scenario.fileName);
+    reader.accept("enabled");
+    EventConfig config{reader, m_scenario};
+    auto instance = entry->makeCpu(config);  // parsed even when off, so its table is still checked
+    reader.finish();
+    if (enabled) m_events.push_back({entry->name, entry->phase, std::move(instance)});
+  }
+  for (int i = 0; i < m_world.size(); ++i)
+    if (m_world.kind[i] == BodyKind::Vessel) m_vesselId = m_world.id[i];
+  if (m_scenario.mortonSort) reorderAlongCurve();
+}
+
+int Simulation::vesselSlot() const {
+  if (m_vesselId < 0) return -1;
+  for (int i = 0; i < m_world.size(); ++i)
+    if (m_world.id[i] == m_vesselId) return i;
+  return -1;
+}
+
+static int dofOf(const World& w, int i, int vesselDof) {
+  switch (w.kind[i]) {
+    case BodyKind::Wall: return 0;
+    case BodyKind::Vessel: return vesselDof;
+    default: return 3;
+  }
+}
+
+// Re-sorts the bodies along a Morton (Z-order) curve so that neighbours sit near each other in
+// memory (DESIGN.md "Speed habits"). Every strategy sees the same order, so results stay identical.
+void Simulation::reorderAlongCurve() {
+  const int n = m_world.size();
+  if (n < 2) return;
+  Real x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  for (int i = 0; i < n; ++i) {
+    x0 = std::min(x0, m_world.x[i]); x1 = std::max(x1, m_world.x[i]);
+    y0 = std::min(y0, m_world.y[i]); y1 = std::max(y1, m_world.y[i]);
+  }
+  const Real scale = 65535 / std::max<Real>({x1 - x0, y1 - y0, Real(1e-9)});
+  auto spread = [](std::uint32_t v) {
+    v &= 0xffff;
+    v = (v | (v << 8)) & 0x00ff00ff;
+    v = (v | (v << 4)) & 0x0f0f0f0f;
+    v = (v | (v << 2)) & 0x33333333;
+    v = (v | (v << 1)) & 0x55555555;
+    return v;
+  };
+  std::vector<std::pair<std::uint32_t, int>> keys(n);
+  for (int i = 0; i < n; ++i) {
+    auto gx = static_cast<std::uint32_t>((m_world.x[i] - x0) * scale), gy = static_cast<std::uint32_t>((m_world.y[i] - y0) * scale);
+    keys[i] = {spread(gx) | (spread(gy) << 1), i};
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<int> order(n);
+  for (int k = 0; k < n; ++k) order[k] = keys[k].second;
+  m_world.permute(order);
+  m_broadphase->invalidate();
+}
+
+void Simulation::narrowphase() {
+  const int n = m_world.size();
+  m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
+  for (int i = 0; i < n; ++i) m_world.worldVertices(i, &m_worldVertices[static_cast<size_t>(i) * kMaxVertices]);
+
+  m_contactA.clear();
+  m_contactB.clear();
+  m_contacts.clear();
+  m_currentContacts.clear();
+  for (const CandidatePair& pair : m_pairs) {
+    const int a = pair.a, b = pair.b;
+    if (m_world.invMass[a] == 0 && m_world.invMass[b] == 0) continue;
+    const Real dx = m_world.x[a] - m_world.x[b], dy = m_world.y[a] - m_world.y[b];
+    const Real reach = m_world.radius[a] + m_world.radius[b];
+    if (dx * dx + dy * dy > reach * reach) continue;
+    const Contact c = computeContact(&m_worldVertices[static_cast<size_t>(a) * kMaxVertices], m_world.vertexCount[a],
+                                     m_world.position(a), &m_worldVertices[static_cast<size_t>(b) * kMaxVertices],
+                                     m_world.vertexCount[b], m_world.position(b));
+    if (!c.touching) continue;
+    const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
+    const bool onset = !std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
+    m_contactA.push_back(a);
+    m_contactB.push_back(b);
+    m_contacts.push_back(PairContact{c, onset});
+    m_currentContacts.push_back(key);
+  }
+  std::sort(m_currentContacts.begin(), m_currentContacts.end());
+  m_previousContacts.swap(m_currentContacts);
+}
+
+void Simulation::step() {
+  const StepContext ctx{m_scenario.dt, m_time, m_step};
+  const int n = m_world.size();
+  const int vesselDof = m_scenario.vessel.dof;
+
+  // 1-2. Candidates, then contacts.
+  m_broadphase->findCandidates(m_world, m_pairs);
+  narrowphase();
+
+  // 3. Two-body events write into each contact's slot.
+  m_pairBodies.resize(n);
+  for (int i = 0; i < n; ++i) {
+    PairBody& b = m_pairBodies[i];
+    b.kind = m_world.kind[i];
+    b.dof = dofOf(m_world, i, vesselDof);
+    b.id = m_world.id[i];
+    b.position = m_world.position(i);
+    b.angle = m_world.angle[i];
+    b.velocity = m_world.velocity(i);
+    b.omega = m_world.omega[i];
+    b.mass = m_world.mass[i];
+    b.invMass = m_world.invMass[i];
+    b.invInertia = m_world.invInertia[i];
+    b.gyration2 = m_world.gyration2[i];
+    b.gyrationX2 = m_world.gyrationX2[i];
+    b.gyrationY2 = m_world.gyrationY2[i];
+    b.principalAngle = m_world.angle[i] + m_world.principalAngle[i];
+    b.area = m_world.area[i];
+    b.thickness = m_world.thickness[i];
+    b.vertices = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
+    b.vertexCount = m_world.vertexCount[i];
+  }
+  const int contacts = static_cast<int>(m_contacts.size());
+  m_slots.assign(contacts, PairSlot{{0, 0}});
+  // Each contact yields at most one impact and one break: the buffers can never overflow.
+  m_impacts.resize(contacts);
+  m_breaks.resize(contacts);
+  int impactCount = 0, breakCount = 0;
+  const RecordSink sink{m_impacts.data(), contacts, &impactCount, m_breaks.data(), contacts, &breakCount};
+  const PairPhaseData pairData{m_pairBodies.data(), m_contactA.data(), m_contactB.data(), m_contacts.data(),
+                               m_slots.data(), contacts, ctx, sink};
+  for (auto& e : m_events)
+    if (e.phase == EventPhase::Pair) e.instance->runPairs(pairData);
+  m_impacts.resize(impactCount);
+  m_breaks.resize(breakCount);
+
+  // 4. Solo events, from the state at the start of the step.
+  m_soloBodies.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const PairBody& p = m_pairBodies[i];
+    m_soloBodies[i] = SoloBody{p.kind, p.dof, p.position, p.angle, p.velocity, p.omega, p.mass, p.area, p.thickness};
+  }
+  m_changes.assign(n, VelocityChange{{0, 0}, 0});
+  const SoloPhaseData soloData{m_soloBodies.data(), m_changes.data(), n, ctx};
+  for (auto& e : m_events)
+    if (e.phase == EventPhase::Solo) e.instance->runSolo(soloData);
+
+  // 5. Velocities from 3 and 4, then positions.
+  gatherAndMove();
+
+  // 6. Topology: breaks, rubble, new floes.
+  TopologyData topology{&m_world, m_breaks.data(), static_cast<int>(m_breaks.size()), m_time};
+  for (auto& e : m_events)
+    if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
+  m_rubbleMass += topology.rubbleMass;
+  m_floesBroken += topology.floesBroken;
+  if (topology.changed) m_broadphase->invalidate();
+
+  ++m_step;
+  m_time = static_cast<Real>(m_step) * m_scenario.dt;
+  if (m_scenario.mortonSort && m_step % 200 == 0) reorderAlongCurve();
+}
+
+void Simulation::gatherAndMove() {
+  const int n = m_world.size();
+  // Impulses: every body sums its contacts in contact order (sorted by slot pair), so the sum
+  // is the same whatever broadphase found the pairs, and no atomics are needed.
+  std::vector<VelocityChange>& total = m_changes;  // already holds the solo events' part
+  const int vessel = m_vesselId >= 0 ? vesselSlot() : -1;
+  Vec2 vesselImpulse{0, 0};
+  for (size_t k = 0; k < m_contacts.size(); ++k) {
+    const Vec2 j = m_slots[k].impulse;
+    if (j.x == 0 && j.y == 0) continue;
+    const Vec2 c = m_contacts[k].geometry.point;
+    for (int side = 0; side < 2; ++side) {
+      const int i = side == 0 ? m_contactA[k] : m_contactB[k];
+      const Vec2 ji = side == 0 ? -j : j;
+      const PairBody& b = m_pairBodies[i];
+      if (i == vessel) vesselImpulse += ji;
+      if (b.dof == 0) continue;
+      if (b.dof == 1) {
+        const Vec2 heading{std::cos(b.angle), std::sin(b.angle)};
+        total[i].dv += (b.invMass * dot(ji, heading)) * heading;
+        continue;
+      }
+      total[i].dv += b.invMass * ji;
+      total[i].domega += b.invInertia * cross(c - b.position, ji);
+    }
+  }
+  m_vesselIceForce = (Real(1) / m_scenario.dt) * vesselImpulse;
+
+  m_motionBodies.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const PairBody& p = m_pairBodies[i];
+    m_motionBodies[i] = MotionBody{p.kind, p.dof, p.position, p.angle, p.velocity + total[i].dv, p.omega + total[i].domega};
+  }
+  const StepContext ctx{m_scenario.dt, m_time, m_step};
+  const MotionPhaseData motion{m_motionBodies.data(), n, ctx};
+  for (auto& e : m_events)
+    if (e.phase == EventPhase::Motion) e.instance->runMotion(motion);
+  for (int i = 0; i < n; ++i) {
+    const MotionBody& b = m_motionBodies[i];
+    m_world.x[i] = b.position.x;
+    m_world.y[i] = b.position.y;
+    m_world.angle[i] = b.angle;
+    m_world.vx[i] = b.velocity.x;
+    m_world.vy[i] = b.velocity.y;
+    m_world.omega[i] = b.omega;
+  }
+}
+
+}  // namespace gem

@@ -1,0 +1,59 @@
+// Strict reading of one TOML table (a scenario section or an event's parameters): every key read
+// is checked for type and range, and finish() rejects any key nobody asked for, listing the valid
+// ones, so a typo can never be silently ignored (SCENARIO.md). Errors name file:line:column.
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "geometry/vec2.hpp"
+
+namespace gem {
+
+class TableReader {
+ public:
+  // table may be null (section absent): every get returns its default. path is the dotted name
+  // of the table ("events.drag") used in messages; file is the scenario file.
+  TableReader(const toml::table* table, std::string path, std::string file);
+
+  bool has(const std::string& key) const;
+  Real getReal(const std::string& key, Real fallback);
+  Real getPositive(const std::string& key, Real fallback);     // > 0, finite
+  Real getNonNegative(const std::string& key, Real fallback);  // >= 0, finite
+  std::optional<Real> findReal(const std::string& key);
+  std::int64_t getInt(const std::string& key, std::int64_t fallback, std::int64_t min, std::int64_t max);
+  bool getBool(const std::string& key, bool fallback);
+  std::string getString(const std::string& key, const std::string& fallback);
+  // A string that must be one of `choices`.
+  std::string getChoice(const std::string& key, const std::string& fallback, const std::vector<std::string>& choices);
+  std::optional<Vec2> findVec2(const std::string& key);
+  // [[x, y], ...]
+  std::optional<std::vector<Vec2>> findPoints(const std::string& key);
+  std::optional<std::vector<Real>> findReals(const std::string& key);
+  const toml::table* findTable(const std::string& key);
+  const toml::array* findArray(const std::string& key);
+  // Marks a key as known without reading it (read elsewhere).
+  void accept(const std::string& key);
+  // Throws InputError for the first key that was never read.
+  void finish() const;
+
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const;
+  [[noreturn]] void failAt(const toml::node& node, const std::string& message) const;
+  const std::string& file() const { return m_file; }
+  const std::string& path() const { return m_path; }
+  std::string keyPath(const std::string& key) const { return m_path.empty() ? key : m_path + "." + key; }
+
+ private:
+  const toml::node* node(const std::string& key);
+  Real toReal(const toml::node& n, const std::string& key) const;
+
+  const toml::table* m_table;
+  std::string m_path, m_file;
+  std::set<std::string> m_known;
+};
+
+}  // namespace gem

@@ -1,0 +1,104 @@
+#include "framework/world.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace gem {
+
+const char* bodyKindName(BodyKind kind) {
+  switch (kind) {
+    case BodyKind::Floe: return "floe";
+    case BodyKind::Vessel: return "vessel";
+    case BodyKind::Wall: return "wall";
+  }
+  return "unknown";
+}
+
+int World::addBody(const BodySpec& spec) {
+  const int n = static_cast<int>(spec.vertices.size());
+  if (n < 3 || n > kMaxVertices) throw std::invalid_argument("World::addBody: vertex count out of range");
+  MassProperties mp = massProperties(spec.vertices.data(), n);
+
+  const int slot = size();
+  id.push_back(spec.id >= 0 ? spec.id : nextId);
+  nextId = std::max(nextId, id.back() + 1);
+  kind.push_back(spec.kind);
+  vertexCount.push_back(n);
+  localVertices.resize(localVertices.size() + kMaxVertices, Vec2{0, 0});
+  for (int k = 0; k < n; ++k) local(slot)[k] = spec.vertices[k] - mp.centroid;
+  x.push_back(mp.centroid.x);
+  y.push_back(mp.centroid.y);
+  angle.push_back(0);
+  vx.push_back(spec.velocity.x);
+  vy.push_back(spec.velocity.y);
+  omega.push_back(spec.angularVelocity);
+  area.push_back(mp.area);
+  thickness.push_back(spec.thickness);
+  const Real m = kRhoIce * mp.area * spec.thickness;  // MODEL.md 1; the vessel's mass is set by its owner
+  mass.push_back(m);
+  const bool immovable = spec.kind == BodyKind::Wall;
+  invMass.push_back(immovable ? Real(0) : Real(1) / m);
+  gyration2.push_back(mp.izz / mp.area);
+  gyrationX2.push_back(mp.ixx / mp.area);
+  gyrationY2.push_back(mp.iyy / mp.area);
+  invInertia.push_back(immovable ? Real(0) : Real(1) / (m * gyration2.back()));
+  principalAngle.push_back(mp.principalAngle);
+  radius.push_back(boundingRadius(local(slot), n));
+  return slot;
+}
+
+template <class T>
+static void keepIf(std::vector<T>& v, const std::vector<char>& remove, size_t stride = 1) {
+  size_t out = 0;
+  for (size_t i = 0; i < remove.size(); ++i) {
+    if (remove[i]) continue;
+    for (size_t k = 0; k < stride; ++k) v[out * stride + k] = v[i * stride + k];
+    ++out;
+  }
+  v.resize(out * stride);
+}
+
+void World::removeBodies(const std::vector<char>& remove) {
+  keepIf(id, remove); keepIf(kind, remove); keepIf(vertexCount, remove);
+  keepIf(localVertices, remove, kMaxVertices);
+  keepIf(x, remove); keepIf(y, remove); keepIf(angle, remove);
+  keepIf(vx, remove); keepIf(vy, remove); keepIf(omega, remove);
+  keepIf(area, remove); keepIf(thickness, remove); keepIf(mass, remove);
+  keepIf(invMass, remove); keepIf(invInertia, remove);
+  keepIf(gyration2, remove); keepIf(gyrationX2, remove); keepIf(gyrationY2, remove);
+  keepIf(principalAngle, remove); keepIf(radius, remove);
+}
+
+template <class T>
+static void applyOrder(std::vector<T>& v, const std::vector<int>& order, size_t stride = 1) {
+  std::vector<T> out(v.size());
+  for (size_t k = 0; k < order.size(); ++k)
+    for (size_t s = 0; s < stride; ++s) out[k * stride + s] = v[static_cast<size_t>(order[k]) * stride + s];
+  v.swap(out);
+}
+
+void World::permute(const std::vector<int>& order) {
+  applyOrder(id, order); applyOrder(kind, order); applyOrder(vertexCount, order);
+  applyOrder(localVertices, order, kMaxVertices);
+  applyOrder(x, order); applyOrder(y, order); applyOrder(angle, order);
+  applyOrder(vx, order); applyOrder(vy, order); applyOrder(omega, order);
+  applyOrder(area, order); applyOrder(thickness, order); applyOrder(mass, order);
+  applyOrder(invMass, order); applyOrder(invInertia, order);
+  applyOrder(gyration2, order); applyOrder(gyrationX2, order); applyOrder(gyrationY2, order);
+  applyOrder(principalAngle, order); applyOrder(radius, order);
+}
+
+double World::floeMass() const {
+  double total = 0;
+  for (int i = 0; i < size(); ++i)
+    if (kind[i] == BodyKind::Floe) total += mass[i];
+  return total;
+}
+
+int World::count(BodyKind k) const {
+  int c = 0;
+  for (BodyKind b : kind) c += (b == k);
+  return c;
+}
+
+}  // namespace gem

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs what GEM needs from Debian's packages (only what is missing) and configures + builds it.
+# Usage: scripts/setup.sh [BUILD_DIR]   (default: build)
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_dir="${1:-$here/build}"
+
+packages=(cmake ninja-build g++ pkg-config libeigen3-dev libboost-dev libboost-filesystem-dev
+          libtomlplusplus-dev libfmt-dev libcgal-dev libgmp-dev libmpfr-dev libgtest-dev libgmock-dev
+          libcli11-dev libpugixml-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "gem setup: installing ${missing[*]}"
+  sudo_cmd=""; [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo_cmd apt-get update -qq
+  $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+cuda_args=()
+if [ -x /usr/local/cuda/bin/nvcc ] && [ "${GEM_CUDA:-auto}" != "off" ]; then
+  cuda_args=(-DCMAKE_CUDA_COMPILER=/usr/local/cuda/bin/nvcc)
+fi
+cmake -S "$here" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${cuda_args[@]}" >/dev/null
+cmake --build "$build_dir" --parallel "$(nproc)"

@@ -1,0 +1,393 @@
+// Broadphase strategies (MODEL.md 9): every strategy, reached through the registry by name, must
+// propose a superset of the truly overlapping pairs (exact separating axes, written here), sorted,
+// unique, a < b, never two walls; keep doing so while bodies move (the rebuild rule), rebuild only
+// when the rule asks, and after invalidate(). Filtered by exact overlap, all agree with all_pairs.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "broadphase/broadphase.hpp"
+#include "framework/errors.hpp"
+#include "framework/registry.hpp"
+#include "framework/world.hpp"
+
+namespace gem {
+namespace {
+
+const std::vector<std::string> kStrategies = {"all_pairs", "fixed_radius", "variable_radius", "uniform_grid",
+                                              "triangulation_mesh"};
+// Strategies whose per-step output is exactly "bounding circles overlap" (the same set as all_pairs).
+const std::vector<std::string> kCircleStrategies = {"fixed_radius", "variable_radius", "uniform_grid"};
+
+std::unique_ptr<Broadphase> make(const std::string& name, BroadphaseSettings s = {}) {
+  return Registry::global().broadphase(name).make(s);
+}
+
+// ------------------------------------------------------------------------------------ worlds
+BodySpec spec(BodyKind kind, std::vector<Vec2> vertices) {
+  BodySpec s;
+  s.kind = kind;
+  s.vertices = std::move(vertices);
+  return s;
+}
+
+std::vector<Vec2> regularPolygon(Vec2 c, Real r, int n, Real rot) {
+  std::vector<Vec2> v;
+  for (int k = 0; k < n; ++k) {
+    Real a = rot + 2 * kPi * k / n;
+    v.push_back({c.x + r * std::cos(a), c.y + r * std::sin(a)});
+  }
+  return v;
+}
+
+std::vector<Vec2> rectangle(Vec2 c, Real w, Real h, Real rot) {
+  std::vector<Vec2> v;
+  const Real hx[4] = {-w / 2, w / 2, w / 2, -w / 2}, hy[4] = {-h / 2, -h / 2, h / 2, h / 2};
+  for (int k = 0; k < 4; ++k) v.push_back(c + rotate(Vec2{hx[k], hy[k]}, rot));
+  return v;
+}
+
+// Random rectangles and hexagons (some overlapping) in a square of side `side`, a vessel, and
+// `walls` long thin walls: the channel sides and diagonals across the field.
+World randomWorld(unsigned seed, int floes, Real side, int walls = 3) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<Real> u(0, 1);
+  World w;
+  for (int k = 0; k < walls; ++k) {
+    Vec2 c{side / 2, k == 0 ? Real(-3) : k == 1 ? side + 3 : side * u(rng)};
+    Real rot = k < 2 ? Real(0) : kPi * u(rng);
+    w.addBody(spec(BodyKind::Wall, rectangle(c, side * Real(1.2), 2, rot)));
+  }
+  w.addBody(spec(BodyKind::Vessel, {{side / 2 - 20, side / 2 - 4}, {side / 2 + 15, side / 2 - 4}, {side / 2 + 22, side / 2},
+                                {side / 2 + 15, side / 2 + 4}, {side / 2 - 20, side / 2 + 4}}));
+  for (int k = 0; k < floes; ++k) {
+    Vec2 c{side * u(rng), side * u(rng)};
+    Real size = 1 + 7 * u(rng) * u(rng);
+    if (u(rng) < 0.5)
+      w.addBody(spec(BodyKind::Floe, rectangle(c, size * (0.5 + u(rng)), size * (0.3 + u(rng)), 2 * kPi * u(rng))));
+    else
+      w.addBody(spec(BodyKind::Floe, regularPolygon(c, size / 2, 3 + static_cast<int>(u(rng) * 7), 2 * kPi * u(rng))));
+  }
+  return w;
+}
+
+// ------------------------------------------------------------------------------------ truth
+// Exact separating-axis test of two convex polygons, closed sets: touching counts as overlapping.
+bool polygonsOverlap(const Vec2* p, int n, const Vec2* q, int m) {
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int i = 0; i < n; ++i) {
+      Vec2 axis = perpLeft(p[(i + 1) % n] - p[i]);
+      Real pmin = dot(axis, p[0]), pmax = pmin, qmin = dot(axis, q[0]), qmax = qmin;
+      for (int k = 1; k < n; ++k) pmin = std::min(pmin, dot(axis, p[k])), pmax = std::max(pmax, dot(axis, p[k]));
+      for (int k = 1; k < m; ++k) qmin = std::min(qmin, dot(axis, q[k])), qmax = std::max(qmax, dot(axis, q[k]));
+      if (pmax < qmin || qmax < pmin) return false;
+    }
+    std::swap(p, q);
+    std::swap(n, m);
+  }
+  return true;
+}
+
+using PairSet = std::vector<std::pair<int, int>>;
+
+bool overlapping(const World& w, int a, int b) {
+  Vec2 pa[kMaxVertices], pb[kMaxVertices];
+  const int na = w.worldVertices(a, pa), nb = w.worldVertices(b, pb);
+  return polygonsOverlap(pa, na, pb, nb);
+}
+
+PairSet truthPairs(const World& w) {
+  PairSet out;
+  for (int a = 0; a < w.size(); ++a)
+    for (int b = a + 1; b < w.size(); ++b) {
+      if (w.kind[a] == BodyKind::Wall && w.kind[b] == BodyKind::Wall) continue;
+      Real dx = w.x[a] - w.x[b], dy = w.y[a] - w.y[b], r = w.radius[a] + w.radius[b];
+      if (dx * dx + dy * dy > r * r * (1 + 1e-9)) continue;
+      if (overlapping(w, a, b)) out.push_back({a, b});
+    }
+  return out;
+}
+
+PairSet toSet(const std::vector<CandidatePair>& pairs) {
+  PairSet out;
+  for (auto p : pairs) out.push_back({p.a, p.b});
+  return out;
+}
+
+PairSet exactOnly(const World& w, const PairSet& pairs) {
+  PairSet out;
+  for (auto p : pairs)
+    if (overlapping(w, p.first, p.second)) out.push_back(p);
+  return out;
+}
+
+// Sorted strictly (so unique), a < b, in range, no wall-wall pair, and a superset of truth.
+void checkCandidates(const World& w, const PairSet& got, const PairSet& truth, const std::string& what) {
+  for (size_t k = 0; k < got.size(); ++k) {
+    auto [a, b] = got[k];
+    ASSERT_TRUE(0 <= a && a < b && b < w.size()) << what << ": bad pair " << a << "," << b;
+    ASSERT_FALSE(w.kind[a] == BodyKind::Wall && w.kind[b] == BodyKind::Wall) << what << ": wall-wall pair";
+    if (k > 0) {
+      ASSERT_LT(got[k - 1], got[k]) << what << ": not sorted or not unique at " << k;
+    }
+  }
+  for (auto p : truth)
+    ASSERT_TRUE(std::binary_search(got.begin(), got.end(), p))
+        << what << ": missed overlapping pair " << p.first << "," << p.second;
+}
+
+// One query of every strategy on w: candidate checks, and agreement with all_pairs.
+void checkAll(const World& w, std::vector<std::unique_ptr<Broadphase>>& strategies, const std::string& what) {
+  const PairSet truth = truthPairs(w);
+  std::vector<CandidatePair> pairs;
+  PairSet reference;
+  for (auto& s : strategies) {
+    s->findCandidates(w, pairs);
+    const PairSet got = toSet(pairs);
+    checkCandidates(w, got, truth, what + " " + s->name());
+    if (s->name() == "all_pairs") reference = got;
+    ASSERT_EQ(exactOnly(w, got), truth) << what << " " << s->name();
+    if (std::find(kCircleStrategies.begin(), kCircleStrategies.end(), s->name()) != kCircleStrategies.end()) {
+      ASSERT_EQ(got, reference) << what << " " << s->name() << ": circle-overlap set differs from all_pairs";
+    }
+  }
+}
+
+std::vector<std::unique_ptr<Broadphase>> makeAll(BroadphaseSettings s = {}) {
+  std::vector<std::unique_ptr<Broadphase>> out;
+  for (const auto& name : kStrategies) out.push_back(make(name, s));
+  return out;
+}
+
+// Moves every movable body by a random step of length up to `step` and turns it by up to `turn`.
+void jiggle(World& w, std::mt19937& rng, Real step, Real turn) {
+  std::uniform_real_distribution<Real> u(-1, 1);
+  for (int i = 0; i < w.size(); ++i) {
+    if (w.kind[i] == BodyKind::Wall) continue;
+    Real s = step * std::fabs(u(rng)), dir = kPi * u(rng);
+    w.x[i] += s * std::cos(dir);
+    w.y[i] += s * std::sin(dir);
+    w.angle[i] += turn * u(rng);
+  }
+}
+
+// ------------------------------------------------------------------------------------ tests
+TEST(Broadphase, RegistryHasEveryStrategy) {
+  for (const auto& name : kStrategies) {
+    auto s = make(name);
+    ASSERT_NE(s, nullptr);
+    EXPECT_EQ(s->name(), name);
+  }
+}
+
+TEST(Broadphase, SmallExactCases) {
+  // Two unit squares side by side: apart, touching along an edge, overlapping.
+  for (Real gap : {Real(0.5), Real(0), Real(-0.25)}) {
+    World w;
+    w.addBody(spec(BodyKind::Floe, rectangle({0, 0}, 1, 1, 0)));
+    w.addBody(spec(BodyKind::Floe, rectangle({1 + gap, 0}, 1, 1, 0)));
+    auto all = makeAll();
+    checkAll(w, all, "squares gap " + std::to_string(gap));
+    std::vector<CandidatePair> pairs;
+    all.back()->findCandidates(w, pairs);  // triangulation_mesh
+    EXPECT_EQ(pairs.size(), gap <= 0 ? 1u : 0u) << gap;
+  }
+  // Two squares 0.2 m apart side by side, one shifted up: their bounding circles overlap, the
+  // polygons do not. The circle strategies propose the pair; the triangle mesh drops it.
+  World w;
+  w.addBody(spec(BodyKind::Floe, rectangle({0, 0}, 2, 2, 0)));
+  w.addBody(spec(BodyKind::Floe, rectangle({2.2, 1.5}, 2, 2, 0)));
+  std::vector<CandidatePair> pairs;
+  make("variable_radius")->findCandidates(w, pairs);
+  EXPECT_EQ(pairs.size(), 1u);
+  make("triangulation_mesh")->findCandidates(w, pairs);
+  EXPECT_EQ(pairs.size(), 0u);
+  // Two walls crossing are never a pair.
+  World walls;
+  walls.addBody(spec(BodyKind::Wall, rectangle({0, 0}, 100, 2, 0)));
+  walls.addBody(spec(BodyKind::Wall, rectangle({0, 0}, 100, 2, kPi / 2)));
+  for (const auto& name : kStrategies) {
+    make(name)->findCandidates(walls, pairs);
+    EXPECT_TRUE(pairs.empty()) << name;
+  }
+}
+
+TEST(Broadphase, RandomWorldsSupersetOfTruth) {
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    World w = randomWorld(seed, 250, 150, 2 + seed % 3);
+    auto all = makeAll();
+    checkAll(w, all, "seed " + std::to_string(seed));
+  }
+}
+
+TEST(Broadphase, EmptyAndSingleBody) {
+  World w;
+  std::vector<CandidatePair> pairs{{0, 1}};
+  for (const auto& name : kStrategies) {
+    auto s = make(name);
+    s->findCandidates(w, pairs);
+    EXPECT_TRUE(pairs.empty()) << name;
+    w.addBody(spec(BodyKind::Floe, rectangle({0, 0}, 1, 1, 0)));
+    s->findCandidates(w, pairs);
+    EXPECT_TRUE(pairs.empty()) << name;
+    w = World{};
+  }
+}
+
+// The rebuild rule under motion: per step below and above skin / 2, translation and rotation.
+TEST(Broadphase, MovingBodiesNeverMissed) {
+  World w = randomWorld(42, 200, 120);
+  std::mt19937 rng(7);
+  BroadphaseSettings s;
+  s.skin = 2;
+  auto all = makeAll(s);
+  for (int step = 0; step < 160; ++step) {
+    // Mostly small steps; every 40th phase, steps beyond skin / 2 (a rebuild at every step).
+    const bool big = (step / 20) % 4 == 3;
+    jiggle(w, rng, big ? Real(1.5) : Real(0.15), big ? Real(0.3) : Real(0.02));
+    checkAll(w, all, "step " + std::to_string(step));
+    if (HasFatalFailure()) return;
+  }
+  for (auto& b : all)
+    if (b->name() != "all_pairs") {
+      EXPECT_LT(b->rebuilds(), 100) << b->name();
+    }
+}
+
+TEST(Broadphase, RebuildOnlyWhenNeeded) {
+  BroadphaseSettings s;
+  s.skin = 2;
+  std::vector<CandidatePair> pairs;
+  for (const auto& name : kStrategies) {
+    if (name == "all_pairs") continue;
+    // No motion: one build, ever.
+    World w = randomWorld(3, 100, 80);
+    auto b = make(name, s);
+    for (int k = 0; k < 20; ++k) b->findCandidates(w, pairs);
+    EXPECT_EQ(b->rebuilds(), 1) << name;
+
+    // One floe alone moving 0.3 m a step: d_1st + d_2nd = 0.3 k passes the 2 m skin at k = 7.
+    const int f = w.size() - 1;
+    for (int k = 1; k <= 6; ++k) {
+      w.x[f] += Real(0.3);
+      b->findCandidates(w, pairs);
+    }
+    EXPECT_EQ(b->rebuilds(), 1) << name;
+    w.x[f] += Real(0.3);
+    b->findCandidates(w, pairs);
+    EXPECT_EQ(b->rebuilds(), 2) << name;
+
+    // Every movable body moving 0.3 m a step: 0.6 k > 2 at k = 4.
+    for (int k = 1; k <= 4; ++k) {
+      for (int i = 0; i < w.size(); ++i)
+        if (w.kind[i] != BodyKind::Wall) w.y[i] += Real(0.3);
+      b->findCandidates(w, pairs);
+      EXPECT_EQ(b->rebuilds(), k < 4 ? 2 : 3) << name << " k " << k;
+    }
+
+    // Turning counts R |d angle|: 1.5 m of rim travel on the vessel is within the skin, 2.5 m is not.
+    const int v = static_cast<int>(std::find(w.kind.begin(), w.kind.end(), BodyKind::Vessel) - w.kind.begin());
+    const Real r = w.radius[v];
+    w.angle[v] += Real(1.5) / r;
+    b->findCandidates(w, pairs);
+    EXPECT_EQ(b->rebuilds(), 3) << name;
+    w.angle[v] += Real(1.0) / r;
+    b->findCandidates(w, pairs);
+    EXPECT_EQ(b->rebuilds(), 4) << name;
+
+    // An angle wrapped by a whole turn (as motion code may do) is no turn at all.
+    for (int i = 0; i < w.size(); ++i) w.angle[i] += 2 * kPi;
+    b->findCandidates(w, pairs);
+    EXPECT_EQ(b->rebuilds(), 4) << name;
+
+    // invalidate() rebuilds at once, motion or not.
+    b->invalidate();
+    b->findCandidates(w, pairs);
+    EXPECT_EQ(b->rebuilds(), 5) << name;
+  }
+}
+
+TEST(Broadphase, InvalidateAfterTopologyChanges) {
+  World w = randomWorld(11, 200, 120);
+  auto all = makeAll();
+  checkAll(w, all, "before");
+  // Remove every third floe (the count changes), then add new floes (new ids).
+  std::vector<char> remove(w.size(), 0);
+  for (int i = 0; i < w.size(); i += 3)
+    if (w.kind[i] == BodyKind::Floe) remove[i] = 1;
+  w.removeBodies(remove);
+  for (auto& b : all) b->invalidate();
+  checkAll(w, all, "after removal");
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<Real> u(0, 120);
+  for (int k = 0; k < 30; ++k) w.addBody(spec(BodyKind::Floe, regularPolygon({u(rng), u(rng)}, 3, 5, u(rng))));
+  for (auto& b : all) b->invalidate();
+  checkAll(w, all, "after adding");
+  // Reorder (same count, as a Morton re-sort does), invalidate, query.
+  std::vector<int> order(w.size());
+  for (int i = 0; i < w.size(); ++i) order[i] = w.size() - 1 - i;
+  w.permute(order);
+  for (auto& b : all) b->invalidate();
+  checkAll(w, all, "after permute");
+  for (auto& b : all)
+    if (b->name() != "all_pairs") {
+      EXPECT_EQ(b->rebuilds(), 4) << b->name();
+    }
+  // A reorder without invalidate() is a caller bug, but the id check still catches it.
+  w.permute(order);
+  checkAll(w, all, "permute, no invalidate");
+}
+
+TEST(Broadphase, SettingsVariants) {
+  World w = randomWorld(21, 200, 120);
+  std::mt19937 rng(3);
+  // Zero skin: rebuilds at every motion, still exact; tiny cells (every body "large" or the grid
+  // hashed); a fixed radius set far too small (must stay conservative); a huge skin.
+  std::vector<BroadphaseSettings> variants(5);
+  variants[0].skin = 0;
+  variants[1].cellSize = Real(0.5);
+  variants[2].cellSize = Real(3);
+  variants[3].fixedRadius = Real(0.1);
+  variants[4].skin = 30;
+  for (size_t v = 0; v < variants.size(); ++v) {
+    auto all = makeAll(variants[v]);
+    for (int step = 0; step < 15; ++step) {
+      jiggle(w, rng, Real(0.4), Real(0.05));
+      checkAll(w, all, "variant " + std::to_string(v) + " step " + std::to_string(step));
+      if (HasFatalFailure()) return;
+    }
+  }
+  BroadphaseSettings bad;
+  bad.skin = -1;
+  for (const auto& name : kStrategies)
+    if (name != "all_pairs") {
+      EXPECT_THROW(make(name, bad), InputError) << name;
+    }
+}
+
+TEST(Broadphase, SparseFieldUsesHashedGrid) {
+  // A few clusters kilometres apart: the grid's bounding box would hold millions of cells, so
+  // uniform_grid hashes them; bodies in far cells sharing a bucket must still be paired correctly.
+  World w;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<Real> u(0, 1);
+  for (int cluster = 0; cluster < 6; ++cluster) {
+    Vec2 c{20000 * u(rng) - 10000, 20000 * u(rng) - 10000};
+    for (int k = 0; k < 30; ++k)
+      w.addBody(spec(BodyKind::Floe, regularPolygon({c.x + 30 * u(rng), c.y + 30 * u(rng)}, 1 + 3 * u(rng), 6, u(rng))));
+  }
+  auto all = makeAll();
+  for (int step = 0; step < 10; ++step) {
+    jiggle(w, rng, Real(0.5), Real(0.1));
+    checkAll(w, all, "sparse step " + std::to_string(step));
+  }
+}
+
+}  // namespace
+}  // namespace gem
