@@ -59,8 +59,8 @@ GEM_HD inline MassProperties massProperties(const Vec2* v, int n) {
   p.principalAngle = Real(0.5) * std::atan2(Real(-2) * p.jxy, p.jxx - p.jyy);
   // Moments in the frame rotated by theta_p (A.11, A.12): the product of inertia vanishes there.
   Real c = std::cos(p.principalAngle), s = std::sin(p.principalAngle);
-  p.ixx = p.jxx * c * c + p.jyy * s * s + Real(2) * p.jxy * s * c;
-  p.iyy = p.jxx * s * s + p.jyy * c * c - Real(2) * p.jxy * s * c;
+  p.ixx = p.jxx * c * c + p.jyy * s * s - Real(2) * p.jxy * s * c;
+  p.iyy = p.jxx * s * s + p.jyy * c * c + Real(2) * p.jxy * s * c;
   p.izz = p.jxx + p.jyy;
   return p;
 }
