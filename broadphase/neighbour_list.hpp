@@ -12,6 +12,7 @@
 // the vessel alone may use the whole skin (half as many rebuilds), and the proof is the same.
 #pragma once
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -46,7 +47,7 @@ class NeighbourList {
 
   // This step's candidates: the listed pairs whose bounding circles overlap now, in list order
   // (sorted). Clears out first.
-  void filterByCircles(const World& world, std::vector<CandidatePair>& out) const;
+  void filterByCircles(const World& world, std::vector<CandidatePair>& out);
   const std::vector<ListedPair>& pairs() const { return m_pairs; }
 
  private:
@@ -55,7 +56,8 @@ class NeighbourList {
   Real m_skin;
   bool m_valid = false;
   long m_rebuilds = 0;
-  std::vector<ListedPair> m_raw, m_pairs, m_scratch;
+  std::vector<ListedPair> m_raw, m_pairs;
+  std::vector<CandidatePair> m_filtered;
   std::vector<int> m_count;
   // Reference state at the last build, by slot.
   std::vector<Real> m_x0, m_y0, m_angle0;

@@ -17,8 +17,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -270,15 +268,20 @@ void cleanup(Poly& q, double minEdge) {
 
 // Brings the vertex count into [minSides, maxSides]: above, cut the corner of least area; below,
 // chamfer the sharpest corner (new vertices a fifth of the way along its edges). Both keep the
-// polygon convex and inside the original.
-void fitVertexCount(Poly& q, int minSides, int maxSides) {
-  while (q.n > maxSides) {
+// polygon convex and inside the original. Corners are also cut down towards `preferred` sides as
+// long as the area stays above keepArea: a large power cell has many neighbours, and without this
+// every large floe would be a near-regular heptagon.
+void fitVertexCount(Poly& q, int minSides, int maxSides, int preferred, double keepArea) {
+  double currentArea = area(q);
+  while (q.n > maxSides || (q.n > preferred && q.n > minSides)) {
     int best = 0;
     double bestArea = std::numeric_limits<double>::infinity();
     for (int k = 0; k < q.n; ++k) {
-      const double a = cross(q.v[k] - q.v[(k + q.n - 1) % q.n], q.v[(k + 1) % q.n] - q.v[k]);
+      const double a = 0.5 * cross(q.v[k] - q.v[(k + q.n - 1) % q.n], q.v[(k + 1) % q.n] - q.v[k]);
       if (a < bestArea) bestArea = a, best = k;
     }
+    if (q.n <= maxSides && currentArea - bestArea < keepArea) break;
+    currentArea -= bestArea;
     std::copy(q.v + best + 1, q.v + q.n, q.v + best);
     std::copy(q.label + best + 1, q.label + q.n, q.label + best);
     --q.n;
@@ -298,6 +301,36 @@ void fitVertexCount(Poly& q, int minSides, int maxSides) {
     q.v[best] = cur + 0.2 * (prev - cur);
     q.v[best + 1] = cur + 0.2 * (nxt - cur);
     q.label[best + 1] = q.label[best];
+  }
+}
+
+// Natural floes are seldom longer than about three times their width, but a small power cell
+// squeezed between large ones can be a sliver. Such a container is cut back across its long
+// axis, symmetrically about its centroid, until sqrt(largest / smallest principal second
+// moment) (the length / width of a rectangle) is at most maxAspect.
+void trimToAspect(Poly& q, double maxAspect) {
+  Poly tmp;
+  for (int pass = 0; pass < 6 && q.n >= 3; ++pass) {
+    const P2 c = centroid(q);
+    double sxx = 0, syy = 0, sxy = 0;  // second moments about the centroid (times 12)
+    for (int k = 0; k < q.n; ++k) {
+      const P2 a = q.v[k] - c, b = q.v[(k + 1) % q.n] - c;
+      const double ak = cross(a, b);
+      sxx += (a.x * a.x + a.x * b.x + b.x * b.x) * ak;
+      syy += (a.y * a.y + a.y * b.y + b.y * b.y) * ak;
+      sxy += 0.5 * (a.x * b.y + 2 * a.x * a.y + 2 * b.x * b.y + b.x * a.y) * ak;
+    }
+    const double mean = 0.5 * (sxx + syy), spread = std::hypot(0.5 * (sxx - syy), sxy);
+    const double small = mean - spread, large = mean + spread;
+    if (!(small > 0) || std::sqrt(large / small) <= maxAspect * (1 + 1e-9)) return;
+    const double axisAngle = 0.5 * std::atan2(2 * sxy, sxx - syy);  // direction of largest spread
+    const P2 u{std::cos(axisAngle), std::sin(axisAngle)};
+    double lo = 0, hi = 0;
+    for (int k = 0; k < q.n; ++k) lo = std::min(lo, dot(u, q.v[k] - c)), hi = std::max(hi, dot(u, q.v[k] - c));
+    // For a rectangle the aspect is proportional to the length: aim there, slightly beyond.
+    const double keep = 0.98 * maxAspect / std::sqrt(large / small);
+    clip(q, u, dot(u, c) + keep * hi, -1, tmp);
+    clip(tmp, -1.0 * u, -dot(u, c) - keep * lo, -1, q);
   }
 }
 
@@ -637,6 +670,7 @@ std::vector<BodySpec> generateRandomConvexField(const RandomFieldSpec& spec) {
   if (spec.maxSides < spec.minSides || spec.maxSides > kMaxFloeVertices)
     fail("field.max_sides: expected field.min_sides = ", spec.minSides, " to ", kMaxFloeVertices, ", got ",
          spec.maxSides);
+  if (!(spec.maxAspect >= Real(1.2))) fail("field.max_aspect: expected at least 1.2, got ", spec.maxAspect);
   double coverageSum = 0;
   for (size_t g = 0; g < spec.groups.size(); ++g) {
     if (!(spec.groups[g].coverage > 0)) fail("field.groups[", g, "].coverage: expected > 0, got ", spec.groups[g].coverage);
@@ -734,13 +768,10 @@ std::vector<BodySpec> generateRandomConvexField(const RandomFieldSpec& spec) {
     return std::sqrt(r);
   };
   std::vector<double> gradient(n), direction, wTrial(n);
-  auto solveWeights = [&](double tolerance) {
+  auto solveWeights = [&]() {
     measureAll(diagram, w, site, cells);
-    if (std::getenv("GEM_FIELD_DEBUG")) { size_t e = 0; double mn = 1e9; for (size_t i = 0; i < n; ++i) { e += cells.area[i] <= 0; mn = std::min(mn, cells.area[i] / share[i]); } fprintf(stderr, "start: empty %zu min ratio %.3f misfits %zu\n", e, mn, misfits(cells)); }
     for (int iteration = 0; iteration < kMaxNewtonSteps; ++iteration) {
-      double worst = 0;
-      for (size_t i = 0; i < n; ++i) worst = std::max(worst, std::fabs(cells.area[i] / share[i] - 1));
-      if (worst <= tolerance && misfits(cells) == 0) break;
+      if (misfits(cells) == 0) break;
       for (size_t i = 0; i < n; ++i) gradient[i] = share[i] - cells.area[i];
       direction = solveLaplacian(cells, gradient);
       const double before = residual(cells);
@@ -752,33 +783,12 @@ std::vector<BodySpec> generateRandomConvexField(const RandomFieldSpec& spec) {
         for (size_t i = 0; i < n && accepted; ++i)
           accepted = trial.area[i] >= 0.5 * std::min(cells.area[i], share[i]);
       }
-      if (std::getenv("GEM_FIELD_DEBUG")) {
-        double e2 = 0, emin = 1e9, emax = 0;
-        for (size_t i = 0; i < n; ++i) { double r = trial.area[i] / share[i]; e2 += (r - 1) * (r - 1); emin = std::min(emin, r); emax = std::max(emax, r); }
-        fprintf(stderr, "iter %d accepted %d misfits %zu rms %.3f min %.3f max %.3f\n", iteration, accepted, misfits(trial), std::sqrt(e2 / n), emin, emax);
-      }
       if (!accepted) break;  // cannot happen in exact arithmetic; the containers below cope
       w.swap(wTrial);
       std::swap(cells, trial);
     }
   };
-  const int lloydRounds = std::getenv("GEM_FIELD_LLOYD") ? atoi(std::getenv("GEM_FIELD_LLOYD")) : 0;
-  const double lloydTol = std::getenv("GEM_FIELD_TOL") ? atof(std::getenv("GEM_FIELD_TOL")) : 1.0;
-  solveWeights(lloydRounds > 0 ? lloydTol : (std::getenv("GEM_FIELD_FINALTOL") ? atof(std::getenv("GEM_FIELD_FINALTOL")) : 1e9));
-  for (int round = 0; round < lloydRounds; ++round) {
-    for (size_t i = 0; i < n; ++i) site[i] = site[i] + cells.centroid[i];
-    diagram.rebuild();
-    // Moved sites under the old weights may leave a cell empty, from which Newton cannot start:
-    // pull the weights towards equal (w = 0, the Voronoi diagram, never has an empty cell).
-    const std::vector<double> wMoved = w;
-    for (double lambda = 1;; lambda *= 0.5) {
-      for (size_t i = 0; i < n; ++i) w[i] = lambda < 1e-3 ? 0 : lambda * wMoved[i];
-      measureAll(diagram, w, site, cells);
-      if (lambda < 1e-3 || *std::min_element(cells.area.begin(), cells.area.end()) > 0) break;
-      if (std::getenv("GEM_FIELD_DEBUG")) fprintf(stderr, "lambda %g has empties\n", lambda);
-    }
-    solveWeights(round + 1 < lloydRounds ? lloydTol : (std::getenv("GEM_FIELD_FINALTOL") ? atof(std::getenv("GEM_FIELD_FINALTOL")) : 1e9));
-  }
+  solveWeights();
 
   // 4. Containers, floe areas, floes.
   const double wMax = *std::max_element(w.begin(), w.end());
@@ -791,8 +801,15 @@ std::vector<BodySpec> generateRandomConvexField(const RandomFieldSpec& spec) {
   for (size_t i = 0; i < n; ++i) {
     diagram.cell(static_cast<int>(i), w, wMax, cell);
     inset(cell, insetBy, shrunk);
-    cleanup(shrunk, 1e-4 * std::sqrt(target[i]));
-    fitVertexCount(shrunk, spec.minSides, spec.maxSides);
+    // Cutting corners can lengthen a polygon and trimming adds corners: twice each settles both.
+    // Half the many-sided cells are cut to one corner fewer than allowed, so that the largest
+    // floes (the cells with most neighbours) are not all maxSides-gons.
+    const int preferred = std::max(spec.minSides, spec.maxSides - static_cast<int>(rng.below(2)));
+    for (int pass = 0; pass < 2; ++pass) {
+      trimToAspect(shrunk, spec.maxAspect);
+      cleanup(shrunk, 1e-4 * std::sqrt(target[i]));
+      fitVertexCount(shrunk, spec.minSides, spec.maxSides, pass == 0 ? preferred : spec.maxSides, target[i] / kRoomFraction);
+    }
     room[i] = shrunk.n > 0 ? area(shrunk) : 0;
     for (int k = 0; k < shrunk.n; ++k) containerVertex.push_back(site[i] + shrunk.v[k]);
     containerStart[i + 1] = static_cast<int>(containerVertex.size());

@@ -31,6 +31,9 @@ struct RandomFieldSpec {
   // With count given, the distribution is rescaled by a common factor to meet the concentration.
   Real sizeMean = Real(6.9), sizeSd = Real(3.9), sizeMin = 2, sizeMax = 20;
   int minSides = 4, maxSides = 7;  // vertices per floe, within 3..kMaxFloeVertices
+  // Largest length / width (sqrt of the principal second moments' ratio): longer cells are cut
+  // back. Natural floes are seldom longer than 2 to 3 times their width.
+  Real maxAspect = Real(2.5);
   Real thickness = Real(0.7);      // m, when groups is empty
   std::vector<ThicknessGroup> groups;  // coverages sum to concentration; each floe in one group
   Real minGap = Real(0.05);        // m, smallest distance between floes, and to the domain edge

@@ -78,7 +78,8 @@ int commandCheck(const RunArguments& a) {
   const Scenario s = load(a);
   resolveBackend(s.backend);
   Simulation sim(s);  // builds the field, checks every body and overlap, parses every event
-  std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(),
+  if (!a.quiet)
+    std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(),
               sim.world().size(), sim.world().count(BodyKind::Floe), s.vessel.present ? ", a vessel" : "", s.steps,
               s.broadphase.c_str(), sim.events().size());
   return 0;
@@ -117,6 +118,7 @@ int main(int argc, char** argv) {
   run->add_flag("--quiet", args.quiet, "no progress line and no summary");
   CLI::App* check = app.add_subcommand("check", "load and validate a scenario without running it");
   addRunOptions(check);
+  check->add_flag("--quiet", args.quiet, "print nothing when the scenario is valid");
   app.add_subcommand("info", "version, build, devices, registered events and broadphases");
   BenchOptions bench;
   CLI::App* benchCommand = app.add_subcommand("bench", "time the CPU backend per step on the thesis fields");

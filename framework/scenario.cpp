@@ -200,7 +200,11 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
     if (hasSteps) s.duration = static_cast<Real>(s.steps) * s.dt;
     s.backend = t.getChoice("backend", "auto", {"auto", "cpu", "cuda"});
     s.broadphase = t.getString("broadphase", s.broadphase);
-    Registry::global().broadphase(s.broadphase);  // unknown name: lists the valid ones
+    try {
+      Registry::global().broadphase(s.broadphase);  // unknown name: lists the valid ones
+    } catch (const InputError& e) {
+      t.fail("broadphase", e.what());
+    }
     s.seed = static_cast<std::uint64_t>(t.getInt("seed", 1, 0, INT64_MAX));
     s.broadphaseSettings.skin = t.getPositive("skin", s.broadphaseSettings.skin);
     s.broadphaseSettings.fixedRadius = t.getNonNegative("fixed_radius", 0);

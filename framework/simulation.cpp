@@ -47,14 +47,23 @@ static void addWalls(const Scenario& s, std::vector<BodySpec>& bodies) {
   }
 }
 
+// The generators report bad specs by key; this adds where the [field] table is.
+static std::vector<BodySpec> generateField(const Scenario& s) {
+  try {
+    if (s.fieldKind == "random_convex") return generateRandomConvexField(s.randomField);
+    return generateHexagonField(s.hexagonField);
+  } catch (const InputError& e) {
+    const toml::node* field = s.root.get("field");
+    const auto line = field ? field->source().begin.line : 0, column = field ? field->source().begin.column : 0;
+    throw InputError(s.fileName, static_cast<int>(line), static_cast<int>(column), e.what());
+  }
+}
+
 World buildWorld(const Scenario& s) {
   std::vector<BodySpec> bodies;
   if (s.walls) addWalls(s, bodies);
-  if (s.fieldKind == "random_convex") {
-    auto field = generateRandomConvexField(s.randomField);
-    bodies.insert(bodies.end(), field.begin(), field.end());
-  } else if (s.fieldKind == "hexagons") {
-    auto field = generateHexagonField(s.hexagonField);
+  if (s.fieldKind == "random_convex" || s.fieldKind == "hexagons") {
+    auto field = generateField(s);
     bodies.insert(bodies.end(), field.begin(), field.end());
   } else if (s.fieldKind == "file") {
     auto field = readIceInitialBodies(s.fieldFile);
@@ -92,8 +101,8 @@ World buildWorld(const Scenario& s) {
     const int n = world.worldVertices(pair.a, p), m = world.worldVertices(pair.b, q);
     const Contact c = computeContact(p, n, world.position(pair.a), q, m, world.position(pair.b));
     if (c.touching)
-      throw InputError(fmt::format("bodies overlap at the start: {} (id {}) and {} (id {}), overlap area {:.4g} m^2",
-                                   origins[pair.a], world.id[pair.a], origins[pair.b], world.id[pair.b], c.area));
+      throw InputError(fmt::format("{}: bodies overlap at the start: {} (id {}) and {} (id {}), overlap area {:.4g} m^2",
+                                   s.fileName, origins[pair.a], world.id[pair.a], origins[pair.b], world.id[pair.b], c.area));
   }
   return world;
 }

@@ -46,13 +46,17 @@ struct Rng {
   int integer(int a, int b) { return std::uniform_int_distribution<int>(a, b)(gen); }
 };
 
+// The nearest double of an exact number. CGAL::to_double of a lazy number only promises 1e-5
+// relative precision (the interval's midpoint); force the exact value first.
+double toDouble(const FT& x) { return CGAL::to_double(CGAL::exact(x)); }
+
 Point toPoint(Vec2 v) { return Point(double(v.x), double(v.y)); }
 Polygon toPolygon(const Poly& p) {
   Polygon out;
   for (Vec2 v : p) out.push_back(toPoint(v));
   return out;
 }
-Vec2 toVec(const Point& p) { return {Real(CGAL::to_double(p.x())), Real(CGAL::to_double(p.y()))}; }
+Vec2 toVec(const Point& p) { return {Real(toDouble(p.x())), Real(toDouble(p.y()))}; }
 
 // Random convex polygon, 3..19 vertices: points at random angles in an annulus of a random
 // ellipse, rounded to Real, then their exact convex hull. Radius = scale.
@@ -333,7 +337,7 @@ void runPairs(unsigned long long seed, int count) {
     CGAL::intersection(ep, eq, std::back_inserter(inter));
     ASSERT_LE(inter.size(), 1u);
     FT exactAreaFT = inter.empty() ? FT(0) : inter[0].outer_boundary().area();
-    double exactArea = CGAL::to_double(exactAreaFT);
+    double exactArea = toDouble(exactAreaFT);
     double minArea = std::min(signedArea(pr.p.data(), int(pr.p.size())), signedArea(pr.q.data(), int(pr.q.size())));
     double areaTol = kRel * minArea + tol * scale;
     bool borderline = exactArea > 0 && exactArea < kRel * minArea;
@@ -366,6 +370,83 @@ TEST(GeometryCgal, ClipAndContactSeed2) { runPairs(2, 2500); }
 TEST(GeometryCgal, ClipAndContactSeed3) { runPairs(3, 2500); }
 TEST(GeometryCgal, ClipAndContactSeed4) { runPairs(4, 2500); }
 
+// Degenerate configurations on purpose: vertices on a coarse grid (exact in Real, and every
+// cross product of them exact), so that shared edges, collinear edges, vertices on edges, touching
+// corners and identical polygons are common. The overlap decision must then be exact.
+Poly gridConvex(Rng& rng, int half, Vec2 offset) {
+  for (;;) {
+    std::vector<Ki::Point_2> pts, hull;
+    int k = rng.integer(3, 10);
+    for (int i = 0; i < k; ++i) pts.emplace_back(rng.integer(-half, half), rng.integer(-half, half));
+    CGAL::convex_hull_2(pts.begin(), pts.end(), std::back_inserter(hull));
+    if (hull.size() < 3) continue;
+    Poly p;
+    for (auto& h : hull) p.push_back(offset + Vec2{Real(h.x()), Real(h.y())});
+    return p;
+  }
+}
+
+TEST(GeometryCgal, DegenerateGridPairs) {
+  Rng rng(51);
+  Vec2 l[kMaxClipVertices], r[kMaxClipVertices];
+  int touching = 0, apart = 0;
+  for (int it = 0; it < 6000; ++it) {
+    SCOPED_TRACE(::testing::Message() << "pair " << it);
+    Poly p = gridConvex(rng, 3, {0, 0});
+    Poly q = it % 10 == 0 ? p : gridConvex(rng, 3, {Real(rng.integer(-6, 6)), Real(rng.integer(-6, 6))});
+    int n = int(p.size()), m = int(q.size());
+    double tol = 1e-12 * 16;
+    std::vector<PolygonWithHoles> inter;
+    CGAL::intersection(toPolygon(p), toPolygon(q), std::back_inserter(inter));
+    double exactArea = inter.empty() ? 0 : toDouble(inter[0].outer_boundary().area());
+    for (int order = 0; order < 2; ++order) {
+      const Poly& a = order ? q : p;
+      const Poly& b = order ? p : q;
+      int na = order ? m : n, nb = order ? n : m;
+      EXPECT_EQ(convexOverlap(a.data(), na, b.data(), nb), exactArea > 0);
+      ClipVertex v[kMaxClipVertices];
+      int k = clipConvex(a.data(), na, b.data(), nb, v);
+      EXPECT_NEAR(k ? clippedArea(v, k) : 0, exactArea, tol);
+      Vec2 ca = areaCentroid(a.data(), na), cb = areaCentroid(b.data(), nb);
+      Contact c = computeContact(a.data(), na, ca, b.data(), nb, cb);
+      ASSERT_EQ(c.touching, exactArea > 0);
+      if (!c.touching) continue;
+      EXPECT_NEAR(c.area, exactArea, tol);
+      EXPECT_NEAR(norm(c.normal), 1.0, 1e-12);
+      EXPECT_NEAR(c.width, norm(c.cross1 - c.cross0), tol);
+      EXPECT_LE(norm(c.point - Real(0.5) * (c.cross0 + c.cross1)), tol);
+      if (!c.contained) {
+        EXPECT_NEAR(c.normal.x * c.width, c.cross1.y - c.cross0.y, 1e-9);  // n = perpRight(cross1 - cross0) / w
+        EXPECT_NEAR(c.normal.y * c.width, c.cross0.x - c.cross1.x, 1e-9);
+        for (Vec2 x : {c.cross0, c.cross1}) {
+          EXPECT_LE(boundaryDistance(x, a), tol);
+          EXPECT_LE(boundaryDistance(x, b), tol);
+        }
+      }
+    }
+    (exactArea > 0 ? touching : apart)++;
+    // Splits along grid lines and diagonals: through vertices and along edges.
+    Vec2 at{Real(rng.integer(-3, 3)), Real(rng.integer(-3, 3))};
+    Vec2 dir{Real(rng.integer(-2, 2)), Real(rng.integer(-2, 2))};
+    if (dir.x == 0 && dir.y == 0) dir = {1, 0};
+    int nl, nr;
+    splitByLine(p.data(), n, at, dir, l, &nl, r, &nr);
+    double area = signedArea(p.data(), n);
+    EXPECT_NEAR((nl ? signedArea(l, nl) : 0) + (nr ? signedArea(r, nr) : 0), area, tol);
+    for (int side = 0; side < 2; ++side) {
+      const Vec2* v = side ? r : l;
+      int k = side ? nr : nl;
+      if (k) {
+        EXPECT_GE(k, 3);
+        EXPECT_TRUE(isStrictlyConvexCCW(v, k));
+      }
+    }
+    if (::testing::Test::HasFailure()) return;
+  }
+  EXPECT_GT(touching, 1000);
+  EXPECT_GT(apart, 1000);
+}
+
 TEST(GeometryCgal, MassProperties) {
   Rng rng(11);
   for (int it = 0; it < 10000; ++it) {
@@ -376,17 +457,17 @@ TEST(GeometryCgal, MassProperties) {
     int n = int(p.size());
     SCOPED_TRACE(::testing::Message() << "polygon " << it);
     ExactMass em = exactMass(p);
-    double area = CGAL::to_double(em.area), tol = kRel * s + 1e-12 * magnitudeOf(p);
+    double area = toDouble(em.area), tol = kRel * s + 1e-12 * magnitudeOf(p);
     MassProperties mp = massProperties(p.data(), n);
     // Areas and moments far from the origin lose digits to the coordinate magnitude (about vertex
     // 0 for the centroid, but the area sum is about the origin).
     double areaTol = kRel * area + 1e-12 * magnitudeOf(p) * s;
     EXPECT_NEAR(signedArea(p.data(), n), area, areaTol);
     EXPECT_NEAR(mp.area, area, areaTol);
-    EXPECT_NEAR(mp.centroid.x, CGAL::to_double(em.cx), tol) << n << " s " << s << " A " << area;
-    EXPECT_NEAR(mp.centroid.y, CGAL::to_double(em.cy), tol);
-    double jTol = 1e-6 * area * s * s;  // inherits the centroid's rounding
-    double jxx = CGAL::to_double(em.jxx), jyy = CGAL::to_double(em.jyy), jxy = CGAL::to_double(em.jxy);
+    EXPECT_NEAR(mp.centroid.x, toDouble(em.cx), tol);
+    EXPECT_NEAR(mp.centroid.y, toDouble(em.cy), tol);
+    double jTol = kRel * area * s * s;
+    double jxx = toDouble(em.jxx), jyy = toDouble(em.jyy), jxy = toDouble(em.jxy);
     EXPECT_NEAR(mp.jxx, jxx, jTol);
     EXPECT_NEAR(mp.jyy, jyy, jTol);
     EXPECT_NEAR(mp.jxy, jxy, jTol);
@@ -421,7 +502,7 @@ TEST(GeometryCgal, EarClip) {
     }
     int n = int(p.size());
     Polygon ep = toPolygon(p);
-    double exactArea = CGAL::to_double(ep.area());
+    double exactArea = toDouble(ep.area());
     int nt = earClip(p.data(), n, tri);
     ASSERT_EQ(nt, n - 2);
     FT sum = 0;
@@ -435,7 +516,7 @@ TEST(GeometryCgal, EarClip) {
     }
     // Exact sum of the exact triangle areas: the triangles tile the polygon.
     EXPECT_EQ(sum, ep.area());
-    EXPECT_NEAR(CGAL::to_double(sum), exactArea, kRel * exactArea);
+    EXPECT_NEAR(toDouble(sum), exactArea, kRel * exactArea);
     if (::testing::Test::HasFailure()) return;
   }
 }
@@ -451,7 +532,7 @@ TEST(GeometryCgal, SplitByLine) {
     double s = rng.uniform(0.5, 20);
     Poly p = randomConvex(rng, origin, s);
     int n = int(p.size());
-    double area = CGAL::to_double(toPolygon(p).area());
+    double area = toDouble(toPolygon(p).area());
     double tol = kRel * s + 1e-12 * magnitudeOf(p);
     // A line through a random point near the polygon (it misses sometimes) or through a vertex.
     Vec2 at = it % 10 == 0 ? p[size_t(rng.integer(0, n - 1))]
@@ -495,7 +576,7 @@ TEST(GeometryCgal, SplitByLine) {
         CGAL::intersection(toPolygon(p), half, std::back_inserter(inter));
         for (auto& h : inter) exactLeft += h.outer_boundary().area();
         // The rounded line may differ from the exact one by an ulp; both are within tolerance.
-        EXPECT_NEAR(al, CGAL::to_double(exactLeft), kRel * area + tol * s);
+        EXPECT_NEAR(al, toDouble(exactLeft), kRel * area + tol * s);
       }
     }
     if (::testing::Test::HasFailure()) return;
@@ -522,7 +603,7 @@ TEST(GeometryCgal, TrianglesOverlap) {
     K::Triangle_2 e0(toPoint(t[0][0]), toPoint(t[0][1]), toPoint(t[0][2]));
     K::Triangle_2 e1(toPoint(t[1][0]), toPoint(t[1][1]), toPoint(t[1][2]));
     bool exact = CGAL::do_intersect(e0, e1);
-    double dist = std::sqrt(CGAL::to_double(CGAL::squared_distance(e0, e1)));
+    double dist = std::sqrt(toDouble(CGAL::squared_distance(e0, e1)));
     double tol = kRel * s;
     // eps = 0: the closed triangles, as CGAL, except within rounding of touching.
     if (dist > tol || exact) {

@@ -1,0 +1,96 @@
+// Bad input never crashes and never runs: each case exits with status 2, one clear message that
+// names the file and line (or the key), and leaves no summary.json (the list, item 7).
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "test_support.hpp"
+
+using gem::test::TempDir;
+
+namespace {
+
+struct BadCase {
+  const char* name;
+  std::string toml;
+  std::vector<std::string> expected;  // substrings of the message
+  std::string file = "case.toml";     // the file the message must name
+};
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
+
+const std::string kSim = "[simulation]\ndt = 0.1\nsteps = 5\n";
+const std::string kDomain = "[domain]\nx = [0.0, 100.0]\ny = [-50.0, 50.0]\n";
+
+std::string floe(const std::string& vertices, const std::string& extra = "") {
+  return "[[floes]]\nvertices = " + vertices + "\nthickness = 1.0\n" + extra;
+}
+
+const std::string kSquare = "[[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]";
+
+std::vector<BadCase> badCases() {
+  return {
+      {"non_convex", kSim + floe("[[0.0, 0.0], [10.0, 0.0], [5.0, 2.0], [10.0, 10.0], [0.0, 10.0]]"), {"floes[0]", "not convex", ":4:"}},
+      {"self_intersecting", kSim + floe("[[0.0, 0.0], [10.0, 10.0], [10.0, 0.0], [0.0, 10.0]]"), {"floes[0]", "not convex"}},
+      {"two_vertices", kSim + floe("[[0.0, 0.0], [10.0, 0.0]]"), {"floes[0]", "3 to 19 vertices"}},
+      {"too_many_vertices", kSim + floe([] {
+         std::string v = "[";
+         for (int k = 0; k < 20; ++k)
+           v += (k ? ", [" : "[") + std::to_string(10 * std::cos(k * 0.314159)) + ", " + std::to_string(10 * std::sin(k * 0.314159)) + "]";
+         return v + "]";
+       }()),
+       {"floes[0]", "3 to 19 vertices, got 20"}},
+      {"nan_vertex", kSim + floe("[[nan, 0.0], [10.0, 0.0], [10.0, 10.0]]"), {"vertices", "finite"}},
+      {"infinite_dt", "[simulation]\ndt = inf\n", {"simulation.dt", "finite", ":2:"}},
+      {"zero_thickness", kSim + floe(kSquare, "thickness = 0.0\n").replace(kSim.size() + floe(kSquare).size() - 16, 16, ""), {"thickness"}},
+      {"negative_dt", "[simulation]\ndt = -0.1\n", {"simulation.dt", "positive"}},
+      {"zero_duration", "[simulation]\nduration = 0.0\n", {"simulation.duration", "positive"}},
+      {"zero_mass", kSim + "[vessel]\nmass = 0.0\n", {"vessel.mass", "positive"}},
+      {"overlap", kSim + floe(kSquare) + floe("[[5.0, 5.0], [15.0, 5.0], [15.0, 15.0], [5.0, 15.0]]"), {"overlap at the start", "floes[0]", "floes[1]"}},
+      {"unknown_top_key", kSim + "[simulaton]\ndt = 0.1\n", {"unknown key \"simulaton\"", "simulation"}},
+      {"unknown_section_key", "[simulation]\ndtt = 0.1\n", {"simulation.dtt", "valid keys here", "dt"}},
+      {"unknown_event", kSim + "[events.dragg]\n", {"events.dragg", "unknown event", "drag"}},
+      {"unknown_event_key", kSim + "[events.drag]\ncdd = 0.1\n", {"events.drag.cdd", "cd"}},
+      {"unknown_broadphase", "[simulation]\nbroadphase = \"octree\"\n", {"octree", "uniform_grid", "variable_radius"}},
+      {"wrong_type", "[simulation]\ndt = \"fast\"\n", {"simulation.dt", "expected a number", ":2:"}},
+      {"malformed_toml", "[simulation]\ndt = 0.1\nduration = = 3\n", {":3:"}},
+      {"bad_dof", kSim + "[vessel]\ndof = 2\n", {"vessel.dof"}},
+      {"missing_ice_file", kSim + "[field]\nkind = \"file\"\nfile = \"nowhere.ice\"\n", {"nowhere.ice"}, "nowhere.ice"},
+      {"malformed_ice_file", kSim + "[field]\nkind = \"file\"\nfile = \"bad.ice\"\n", {"bad.ice:4:1", "malformed XML"}, "bad.ice"},
+      {"field_without_domain", kSim + "[field]\nconcentration = 0.3\n", {"[domain]"}},
+      {"bad_concentration", kSim + kDomain + "[field]\nconcentration = 0.95\n", {"field.concentration"}},
+      {"plugins_not_supported", kSim + "[[plugins]]\npath = \"libx.so\"\n", {"plugins"}},
+  };
+}
+
+}  // namespace
+
+class BadInput : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadInput, ExitsWithStatus2AndAClearMessageAndWritesNoSummary) {
+  const BadCase& c = GetParam();
+  TempDir dir;
+  dir.write("bad.ice", "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 1 0</coordinates\n</frame></iceFloeSim>\n");
+  const auto scenario = dir.write("case.toml", c.toml);
+  const auto out = dir.path() / "run";
+  for (const char* command : {"run", "check"}) {
+    const int status = gem::test::runGem(std::string(command) + " " + scenario.string() + " --quiet" +
+                                             (std::string(command) == "run" ? " --out " + out.string() : ""),
+                                         dir.path() / "log.txt");
+    const std::string log = gem::test::readFile(dir.path() / "log.txt");
+    EXPECT_EQ(status, 2) << command << ": " << log;
+    EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << "one message: " << log;
+    EXPECT_NE(log.find(c.file), std::string::npos) << "names the file: " << log;
+    for (const std::string& e : c.expected) EXPECT_NE(log.find(e), std::string::npos) << "missing \"" << e << "\" in: " << log;
+    EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, BadInput, ::testing::ValuesIn(badCases()),
+                         [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
+
+TEST(BadInputCli, MissingScenarioFileAndUnknownOptionExit2) {
+  TempDir dir;
+  EXPECT_EQ(gem::test::runGem("run " + (dir.path() / "absent.toml").string(), dir.path() / "log.txt"), 2);
+  EXPECT_NE(gem::test::readFile(dir.path() / "log.txt").find("absent.toml"), std::string::npos);
+  EXPECT_EQ(gem::test::runGem("run --frobnicate x.toml", dir.path() / "log.txt"), 2);
+}

@@ -1,0 +1,170 @@
+// End to end: whole scenarios through the scheduler and the gem binary.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "framework/ice_file.hpp"
+#include "framework/registry.hpp"
+#include "framework/simulation.hpp"
+#include "test_support.hpp"
+
+using namespace gem;
+using gem::test::TempDir;
+
+namespace {
+
+// A busy little channel: 40 % ice, the vessel entering it, floes breaking.
+const char* kBusyScene = R"(
+[simulation]
+dt = 0.1
+steps = 300
+seed = 3
+[domain]
+x = [0.0, 120.0]
+y = [-40.0, 40.0]
+walls = true
+[field]
+kind = "random_convex"
+concentration = 0.45
+size_mean = 5.0
+size_sd = 2.0
+size_min = 2.0
+size_max = 12.0
+thickness = 0.4
+[vessel]
+position = [-56.0, 0.0]
+bollard_thrust = 740e3
+open_water_speed = 6.5
+[events.flexural_breaking]
+min_area = 2.0
+)";
+
+struct Trajectory {
+  std::vector<std::int64_t> ids;
+  std::vector<Real> state;
+  std::vector<Real> impacts;
+  long broken = 0;
+};
+
+Trajectory runWith(const std::string& broadphase, const TempDir& dir) {
+  Scenario s = test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"" + broadphase + "\""});
+  Simulation sim(s);
+  Trajectory t;
+  for (long k = 0; k < s.steps; ++k) {
+    sim.step();
+    for (const ImpactRecord& r : sim.impacts()) t.impacts.insert(t.impacts.end(), {r.time, r.force, r.point.x, r.point.y});
+  }
+  const World& w = sim.world();
+  t.ids = w.id;
+  for (int i = 0; i < w.size(); ++i) t.state.insert(t.state.end(), {w.x[i], w.y[i], w.angle[i], w.vx[i], w.vy[i], w.omega[i]});
+  t.broken = sim.floesBroken();
+  return t;
+}
+
+}  // namespace
+
+TEST(Broadphase, EveryStrategyGivesBitIdenticalTrajectories) {
+  TempDir dir;
+  const Trajectory reference = runWith("all_pairs", dir);
+  ASSERT_GT(reference.impacts.size(), 10u);  // the scene really has ship impacts
+  ASSERT_GT(reference.broken, 0);            // and breaks: topology changes are covered too
+  for (const std::string& name : Registry::global().broadphaseNames()) {
+    SCOPED_TRACE(name);
+    const Trajectory t = runWith(name, dir);
+    ASSERT_EQ(t.ids, reference.ids);
+    ASSERT_EQ(t.state.size(), reference.state.size());
+    EXPECT_EQ(0, std::memcmp(t.state.data(), reference.state.data(), t.state.size() * sizeof(Real)));
+    ASSERT_EQ(t.impacts.size(), reference.impacts.size());
+    EXPECT_EQ(0, std::memcmp(t.impacts.data(), reference.impacts.data(), t.impacts.size() * sizeof(Real)));
+  }
+}
+
+TEST(Scenario, EveryEventCanBeTurnedOff) {
+  TempDir dir;
+  for (const EventEntry* e : Registry::global().events()) {
+    SCOPED_TRACE(e->name);
+    Scenario on = test::scenarioFromToml(dir, kBusyScene, {"events." + e->name + ".enabled=true"});
+    Scenario off = test::scenarioFromToml(dir, kBusyScene, {"events." + e->name + ".enabled=false"});
+    auto has = [&](const Simulation& sim) {
+      for (const auto& x : sim.events())
+        if (x.name == e->name) return true;
+      return false;
+    };
+    EXPECT_TRUE(has(Simulation(on)));
+    EXPECT_FALSE(has(Simulation(off)));
+  }
+}
+
+TEST(Scenario, RelativeFieldFileResolvesAgainstTheScenarioFolder) {
+  TempDir dir;
+  std::filesystem::create_directories(dir.path() / "sub" / "fields");
+  std::ofstream(dir.path() / "sub" / "fields" / "two.ice")
+      << "<iceFloeSim numFrames=\"1\"><frame index=\"0\">"
+         "<object index=\"4\"><coordinates>0 0 4 0 4 4 0 4</coordinates><velocity x=\"1\" y=\"0\" a=\"0\"/><thickness>0.5</thickness></object>"
+         "<object index=\"9\"><coordinates>10 0 14 0 12 3</coordinates><velocity x=\"0\" y=\"0\" a=\"0.1\"/><thickness>1.5</thickness></object>"
+         "</frame></iceFloeSim>";
+  const auto file = dir.write("sub/s.toml", "[simulation]\nsteps = 3\n[field]\nkind = \"file\"\nfile = \"fields/two.ice\"\n");
+  Simulation sim(loadScenario(file));
+  ASSERT_EQ(sim.world().size(), 2);
+  EXPECT_EQ(sim.world().count(BodyKind::Floe), 2);
+  EXPECT_NEAR(sim.world().floeMass(), 900 * (16 * 0.5 + 6 * 1.5), 1e-6);
+}
+
+TEST(GemRun, WritesEveryOutputOfTheContract) {
+  TempDir dir;
+  const auto scenario = dir.write("busy.toml", kBusyScene);
+  const auto out = dir.path() / "run";
+  const int status = test::runGem("run " + scenario.string() + " --steps 60 --out " + out.string() +
+                                      " --set output.frame_every=20 --broadphase uniform_grid",
+                                  dir.path() / "log.txt");
+  const std::string log = test::readFile(dir.path() / "log.txt");
+  ASSERT_EQ(status, 0) << log;
+  EXPECT_NE(log.find("real time"), std::string::npos);
+  EXPECT_NE(log.find(out.string()), std::string::npos);  // says where the outputs are
+
+  const std::string summary = test::readFile(out / "summary.json");
+  for (const char* key : {"\"steps\": 60", "\"sim_time_s\"", "\"wall_time_s\"", "\"backend\": \"cpu\"", "\"broadphase\": \"uniform_grid\"",
+                          "\"device\"", "\"floes_initial\"", "\"floes_final\"", "\"ice_mass_initial_kg\"", "\"ice_mass_final_kg\"",
+                          "\"rubble_mass_kg\"", "\"impacts\"", "\"ship_speed\": {\"min\"", "\"impact_force_n\"", "\"gem_version\""})
+    EXPECT_NE(summary.find(key), std::string::npos) << key;
+  auto header = [&](const char* file) {
+    std::ifstream in(out / file);
+    std::string line;
+    std::getline(in, line);
+    return line;
+  };
+  EXPECT_EQ(header("state.csv"), "id,kind,x,y,angle,vx,vy,omega,area,thickness,mass,vertices");
+  EXPECT_EQ(header("timeseries.csv"), "t,ship_x,ship_y,ship_heading,ship_speed,net_thrust,ice_force_x,contacts");
+  EXPECT_EQ(header("impacts.csv"),
+            "t,floe_id,floe_mass,thickness,apex_deg,frame_angle_deg,x,y,nx,ny,x_from_stem,y_from_centerline,vn,fn,flim,broke");
+  const std::string series = test::readFile(out / "timeseries.csv");
+  EXPECT_EQ(std::count(series.begin(), series.end(), '\n'), 61);  // header + one row per step
+  const std::string pvd = test::readFile(out / "frames.pvd");
+  EXPECT_NE(pvd.find("frames/frame_000003.vtp"), std::string::npos);  // frames at steps 0, 20, 40, 60
+  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "frame_000003.vtp"));
+  const auto frames = readIceFile(out / "frames.ice");
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_GT(frames[0].objects.size(), frames[1].objects.size() / 2);
+  // No temporary file is left behind.
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(out))
+    EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
+}
+
+TEST(GemInfo, ListsEveryBuiltInEventAndBroadphase) {
+  TempDir dir;
+  ASSERT_EQ(test::runGem("info", dir.path() / "log.txt"), 0);
+  const std::string log = test::readFile(dir.path() / "log.txt");
+  for (const char* name : {"motion", "drag", "wind", "current", "propulsion", "autopilot", "impact", "elastic_contact",
+                           "ship_impact", "flexural_breaking", "all_pairs", "fixed_radius", "variable_radius",
+                           "uniform_grid", "triangulation_mesh"})
+    EXPECT_NE(log.find(std::string("  ") + name + " "), std::string::npos) << name;
+  EXPECT_NE(log.find("built-in"), std::string::npos);
+}
+
+TEST(GemCheck, ValidatesEveryThesisScenario) {
+  TempDir dir;
+  for (const char* name : {"random_35", "random_39", "random_41", "random_42", "hexagons_46", "random_50", "hexagons_60", "random_69"}) {
+    const std::string file = std::string(GEM_SOURCE_DIR) + "/scenarios/thesis/" + name + ".toml";
+    EXPECT_EQ(test::runGem("check " + file, dir.path() / "log.txt"), 0) << test::readFile(dir.path() / "log.txt");
+  }
+}
