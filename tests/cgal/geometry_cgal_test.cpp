@@ -425,6 +425,23 @@ TEST(GeometryCgal, DegenerateGridPairs) {
       }
     }
     (exactArea > 0 ? touching : apart)++;
+    // The same pair turned and moved 3 km away: rounding breaks the exact touches, and the
+    // tolerance must still call them no contact (and keep every real overlap).
+    {
+      Real ang = Real(rng.uniform(0, 2 * kPi));
+      Vec2 off{Real(rng.uniform(-3000, 3000)), Real(rng.uniform(-3000, 3000))};
+      Poly pw = p, qw = q;
+      for (Vec2& x : pw) x = off + rotate(x, ang);
+      for (Vec2& x : qw) x = off + rotate(x, ang);
+      Contact c = computeContact(pw.data(), n, areaCentroid(pw.data(), n), qw.data(), m, areaCentroid(qw.data(), m));
+      Contact c2 = computeContact(qw.data(), m, areaCentroid(qw.data(), m), pw.data(), n, areaCentroid(pw.data(), n));
+      EXPECT_EQ(c.touching, exactArea > 0);
+      EXPECT_EQ(c2.touching, exactArea > 0);
+      EXPECT_NEAR(c.area, exactArea, 1e-9);
+      EXPECT_NEAR(c2.area, exactArea, 1e-9);
+      EXPECT_EQ(convexOverlap(pw.data(), n, qw.data(), m), exactArea > 0);
+      EXPECT_EQ(convexOverlap(qw.data(), m, pw.data(), n), exactArea > 0);
+    }
     // Splits along grid lines and diagonals: through vertices and along edges.
     Vec2 at{Real(rng.integer(-3, 3)), Real(rng.integer(-3, 3))};
     Vec2 dir{Real(rng.integer(-2, 2)), Real(rng.integer(-2, 2))};
