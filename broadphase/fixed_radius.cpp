@@ -24,24 +24,22 @@ class FixedRadius final : public KeptListBroadphase {
     const int n = world.size();
     const Real skin = list.skin();
     const Real fixed = m_fixedRadius > 0 ? m_fixedRadius : 2 * largestFloeRadius(world) + skin;
-    const Real* radius = world.radius.data();
+    // |c_a - c_b| <= max(fixed, (R_a + skin / 2) + (R_b + skin / 2)).
     m_half.resize(n);
-    for (int i = 0; i < n; ++i) m_half[i] = std::max(fixed / 2, radius[i] + skin / 2);
-    sweepAndPrune(world, m_half, m_order, m_lo, list, [&](int i, int j, Real d2) {
-      const Real reach = std::max(fixed, radius[i] + radius[j] + skin);
-      return d2 <= reach * reach;
-    });
+    for (int i = 0; i < n; ++i) m_half[i] = world.radius[i] + skin / 2;
+    m_sweep.build(world, m_half, fixed, list);
   }
 
  private:
   Real m_fixedRadius;
-  std::vector<Real> m_half, m_lo;
-  std::vector<int> m_order;
+  std::vector<Real> m_half;
+  SweepAndPrune m_sweep;
 };
 
 }  // namespace
 
-GEM_REGISTER_BROADPHASE(FixedRadius, "fixed_radius",
-                        "kept list of pairs within one global radius (default 2 x largest floe radius + skin; thesis 5.4)");
+GEM_REGISTER_BROADPHASE(
+    FixedRadius, "fixed_radius",
+    "kept list of pairs within one global radius (default 2 x largest floe radius + skin; thesis 5.4)");
 
 }  // namespace gem

@@ -1,5 +1,6 @@
 #include "broadphase/neighbour_list.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -124,10 +125,52 @@ void KeptListBroadphase::findCandidates(const World& world, std::vector<Candidat
   filter(world, pairs);
 }
 
+void SweepAndPrune::build(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list) {
+  const int n = world.size();
+  const Real* x = world.x.data();
+  m_lo.resize(n);
+  for (int i = 0; i < n; ++i) m_lo[i] = x[i] - std::max(floor / 2, h[i]);
+  if (static_cast<int>(m_order.size()) != n) {
+    m_order.resize(n);
+    for (int i = 0; i < n; ++i) m_order[i] = i;
+  }
+  // Insertion sort by lo, O(n + inversions); after a reorder of the world the old order means
+  // nothing, so past a work budget sort afresh.
+  long moves = 0;
+  const long budget = 16L * n + 1024;
+  for (int k = 1; k < n && moves <= budget; ++k) {
+    const int v = m_order[k];
+    const Real key = m_lo[v];
+    int q = k - 1;
+    while (q >= 0 && m_lo[m_order[q]] > key) {
+      m_order[q + 1] = m_order[q];
+      --q;
+      ++moves;
+    }
+    m_order[q + 1] = v;
+  }
+  if (moves > budget) std::sort(m_order.begin(), m_order.end(), [&](int p, int q) { return m_lo[p] < m_lo[q]; });
+
+  m_slot.resize(n), m_x.resize(n), m_y.resize(n), m_h.resize(n), m_sortedLo.resize(n), m_hi.resize(n);
+  for (int k = 0; k < n; ++k) {
+    const int i = m_order[k];
+    m_slot[k] = i, m_x[k] = x[i], m_y[k] = world.y[i], m_h[k] = h[i], m_sortedLo[k] = m_lo[i];
+    m_hi[k] = x[i] + std::max(floor / 2, h[i]);
+  }
+  for (int k = 0; k < n; ++k) {
+    const Real hi = m_hi[k];
+    for (int q = k + 1; q < n && m_sortedLo[q] <= hi; ++q) {
+      const Real dx = m_x[k] - m_x[q], dy = m_y[k] - m_y[q], reach = std::max(floor, m_h[k] + m_h[q]);
+      if (dx * dx + dy * dy <= reach * reach) list.add(m_slot[k], m_slot[q]);
+    }
+  }
+}
+
 BroadphaseSettings checkedSettings(const BroadphaseSettings& settings) {
   auto check = [](Real value, const char* key) {
     if (!std::isfinite(value) || value < 0)
-      throw InputError(std::string("broadphase ") + key + " must be a finite length >= 0 m, got " + std::to_string(value));
+      throw InputError(std::string("broadphase ") + key + " must be a finite length >= 0 m, got " +
+                       std::to_string(value));
   };
   check(settings.skin, "skin");
   check(settings.fixedRadius, "fixed_radius");

@@ -11,7 +11,6 @@
 // more than half the skin" made a little tighter: when only the vessel moves through resting ice,
 // the vessel alone may use the whole skin (half as many rebuilds), and the proof is the same.
 #pragma once
-#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -72,6 +71,8 @@ class KeptListBroadphase : public Broadphase {
   void findCandidates(const World& world, std::vector<CandidatePair>& pairs) override;
   void invalidate() override { m_list.invalidate(); }
   long rebuilds() const override { return m_list.rebuilds(); }
+  // The kept list itself, for tests and benchmarks.
+  const NeighbourList& list() const { return m_list; }
 
  protected:
   // Adds every pair the strategy lists between m_list.begin() and m_list.finish(), which the base calls.
@@ -87,55 +88,19 @@ BroadphaseSettings checkedSettings(const BroadphaseSettings& settings);
 // of fixed_radius and uniform_grid. Walls (long, immovable) and the vessel would make it useless.
 Real largestFloeRadius(const World& world);
 
-// Sweep and prune along x: lists every pair (no wall-wall) whose x extents [x - h, x + h] overlap and
-// for which accept(i, j, d2) holds, d2 the squared centroid distance. h[i] must be at least half of
-// the largest distance at which accept can hold for body i, so the sweep never skips such a pair.
-// order is the sweep order kept between builds: bodies move little, so it is nearly sorted and an
-// insertion sort puts it right in about O(n).
-template <class Accept>
-void sweepAndPrune(const World& world, const std::vector<Real>& h, std::vector<int>& order, std::vector<Real>& lo,
-                   NeighbourList& list, Accept accept);
+// Sweep and prune along x, the build of variable_radius, fixed_radius and triangulation_mesh: lists
+// every pair with |c_a - c_b| <= max(floor, h_a + h_b), h one length per body and floor one length
+// for all. Each body spans [x - e, x + e] with e = max(floor / 2, h), so a pair the rule accepts
+// always has overlapping spans. The order of the last build is kept: bodies move little, so it is
+// nearly sorted and an insertion sort fixes it in about O(n). The sweep reads sorted copies of
+// x, y, h, so its inner loop walks memory in order.
+class SweepAndPrune {
+ public:
+  void build(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list);
 
-// ----------------------------------------------------------------------------------------------
-template <class Accept>
-void sweepAndPrune(const World& world, const std::vector<Real>& h, std::vector<int>& order, std::vector<Real>& lo,
-                   NeighbourList& list, Accept accept) {
-  const int n = world.size();
-  lo.resize(n);
-  for (int i = 0; i < n; ++i) lo[i] = world.x[i] - h[i];
-  bool fresh = static_cast<int>(order.size()) != n;
-  if (fresh) {
-    order.resize(n);
-    for (int i = 0; i < n; ++i) order[i] = i;
-  }
-  // Insertion sort by lo: O(n + inversions), and inversions are few when bodies moved by about a
-  // skin. After a reorder of the world the old order means nothing: past a work budget, sort afresh.
-  long moves = 0;
-  const long budget = 16L * n + 1024;
-  for (int k = 1; k < n && moves <= budget; ++k) {
-    const int v = order[k];
-    const Real key = lo[v];
-    int m = k - 1;
-    while (m >= 0 && lo[order[m]] > key) {
-      order[m + 1] = order[m];
-      --m;
-      ++moves;
-    }
-    order[m + 1] = v;
-  }
-  if (moves > budget) std::sort(order.begin(), order.end(), [&](int p, int q) { return lo[p] < lo[q]; });
-  for (int k = 0; k < n; ++k) {
-    const int i = order[k];
-    const Real hiI = world.x[i] + h[i];
-    const bool wallI = world.kind[i] == BodyKind::Wall;
-    for (int m = k + 1; m < n; ++m) {
-      const int j = order[m];
-      if (lo[j] > hiI) break;
-      if (wallI && world.kind[j] == BodyKind::Wall) continue;
-      const Real dx = world.x[i] - world.x[j], dy = world.y[i] - world.y[j];
-      if (accept(i, j, dx * dx + dy * dy)) list.add(i, j);
-    }
-  }
-}
+ private:
+  std::vector<int> m_order, m_slot;
+  std::vector<Real> m_lo, m_sortedLo, m_x, m_y, m_h, m_hi;  // m_lo by slot, the rest by sorted position
+};
 
 }  // namespace gem

@@ -62,13 +62,9 @@ class TriangulationMesh final : public KeptListBroadphase {
   void build(const World& world, NeighbourList& list) override {
     const int n = world.size();
     const Real skin = list.skin();
-    const Real* radius = world.radius.data();
     m_half.resize(n);
-    for (int i = 0; i < n; ++i) m_half[i] = radius[i] + skin / 2;
-    sweepAndPrune(world, m_half, m_order, m_lo, list, [&](int i, int j, Real d2) {
-      const Real reach = radius[i] + radius[j] + skin;
-      return d2 <= reach * reach;
-    });
+    for (int i = 0; i < n; ++i) m_half[i] = world.radius[i] + skin / 2;
+    m_sweep.build(world, m_half, 0, list);
     refreshTriangles(world);
   }
 
@@ -136,7 +132,7 @@ class TriangulationMesh final : public KeptListBroadphase {
   // Any triangle of a meets any triangle of b? Only the triangles whose boxes meet the other body's
   // box take part; the first overlapping pair ends the search.
   bool trianglesMeet(int a, int b, Real eps) {
-    auto gather = [&](int body, const Box& other, Vec2 (*out)[3]) {
+    auto gather = [&](int body, const Box& other, Vec2(*out)[3]) {
       int count = 0;
       const Vec2* v = &m_world[m_vertStart[body]];
       for (int t = m_triStart[body]; t < m_triStart[body + 1]; ++t) {
@@ -157,8 +153,8 @@ class TriangulationMesh final : public KeptListBroadphase {
     return false;
   }
 
-  std::vector<Real> m_half, m_lo;
-  std::vector<int> m_order;
+  std::vector<Real> m_half;
+  SweepAndPrune m_sweep;
   std::unordered_map<std::int64_t, TriangleSet> m_cache;
   std::vector<int> m_triStart, m_vertStart, m_tri;  // m_tri: 3 vertex indices per triangle
   std::vector<Vec2> m_world;

@@ -32,7 +32,8 @@ namespace {
 
 class UniformGrid final : public KeptListBroadphase {
  public:
-  explicit UniformGrid(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin), m_cellSize(s.cellSize) {}
+  explicit UniformGrid(const BroadphaseSettings& s)
+      : KeptListBroadphase(checkedSettings(s).skin), m_cellSize(s.cellSize) {}
   std::string name() const override { return "uniform_grid"; }
 
  protected:
@@ -84,11 +85,11 @@ class UniformGrid final : public KeptListBroadphase {
     sortByKey(m);
 
     // Sorted copies, so that the sweep reads memory in order.
-    m_sx.resize(m), m_sy.resize(m), m_sh.resize(m), m_skey.resize(m), m_sslot.resize(m), m_swall.resize(m);
+    m_sx.resize(m), m_sy.resize(m), m_sh.resize(m), m_skey.resize(m), m_sslot.resize(m);
     for (int k = 0; k < m; ++k) {
       const int i = m_order[k];
       m_sx[k] = x[i], m_sy[k] = y[i], m_sh[k] = radius[i] + skin / 2;
-      m_skey[k] = m_key[i], m_sslot[k] = i, m_swall[k] = world.kind[i] == BodyKind::Wall;
+      m_skey[k] = m_key[i], m_sslot[k] = i;
     }
 
     // The sweep. For body k in cell `key`: run 1 is the rest of its cell and the cell to its right
@@ -97,7 +98,7 @@ class UniformGrid final : public KeptListBroadphase {
     int end1 = 0, begin2 = 0, end2 = 0;
     auto test = [&](int k, int q) {
       const Real dx = m_sx[k] - m_sx[q], dy = m_sy[k] - m_sy[q], reach = m_sh[k] + m_sh[q];
-      if (dx * dx + dy * dy <= reach * reach && !(m_swall[k] && m_swall[q])) list.add(m_sslot[k], m_sslot[q]);
+      if (dx * dx + dy * dy <= reach * reach) list.add(m_sslot[k], m_sslot[q]);
     };
     for (int k = 0; k < m; ++k) {
       const std::int64_t key = m_skey[k];
@@ -108,11 +109,11 @@ class UniformGrid final : public KeptListBroadphase {
       for (int q = begin2; q < end2; ++q) test(k, q);
     }
 
-    // Large bodies against every body (each large-large pair once).
+    // Large bodies against every body (each large-large pair once). Wall-wall pairs are dropped by
+    // NeighbourList::finish for every strategy.
     for (int l : m_large)
       for (int j = 0; j < n; ++j) {
         if (j == l || (m_isLarge[j] && j < l)) continue;
-        if (world.kind[l] == BodyKind::Wall && world.kind[j] == BodyKind::Wall) continue;
         const Real dx = x[l] - x[j], dy = y[l] - y[j], reach = radius[l] + radius[j] + skin;
         if (dx * dx + dy * dy <= reach * reach) list.add(l, j);
       }
@@ -139,7 +140,7 @@ class UniformGrid final : public KeptListBroadphase {
   }
 
   Real m_cellSize;
-  std::vector<char> m_isLarge, m_swall;
+  std::vector<char> m_isLarge;
   std::vector<int> m_large, m_order, m_sslot;
   std::vector<std::int64_t> m_cx, m_cy, m_key, m_skey;
   std::vector<Real> m_sx, m_sy, m_sh;

@@ -14,12 +14,7 @@ class InputError : public std::runtime_error {
       : std::runtime_error(format(file, line, column, message)) {}
 
  private:
-  static std::string format(const std::string& file, int line, int column, const std::string& message) {
-    std::string where = file;
-    if (line > 0) where += ":" + std::to_string(line);
-    if (line > 0 && column > 0) where += ":" + std::to_string(column);
-    return where.empty() ? message : where + ": " + message;
-  }
+  static std::string format(const std::string& file, int line, int column, const std::string& message);
 };
 
 }  // namespace gem

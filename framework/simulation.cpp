@@ -180,7 +180,17 @@ void Simulation::reorderAlongCurve() {
 void Simulation::narrowphase() {
   const int n = m_world.size();
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
-  for (int i = 0; i < n; ++i) m_world.worldVertices(i, &m_worldVertices[static_cast<size_t>(i) * kMaxVertices]);
+  m_boxes.resize(n);
+  for (int i = 0; i < n; ++i) {
+    Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
+    const int count = m_world.worldVertices(i, v);
+    Box& box = m_boxes[i];
+    box = {v[0].x, v[0].y, v[0].x, v[0].y};
+    for (int k = 1; k < count; ++k) {
+      box.x0 = std::min(box.x0, v[k].x), box.x1 = std::max(box.x1, v[k].x);
+      box.y0 = std::min(box.y0, v[k].y), box.y1 = std::max(box.y1, v[k].y);
+    }
+  }
 
   m_contactA.clear();
   m_contactB.clear();
@@ -189,9 +199,9 @@ void Simulation::narrowphase() {
   for (const CandidatePair& pair : m_pairs) {
     const int a = pair.a, b = pair.b;
     if (m_world.invMass[a] == 0 && m_world.invMass[b] == 0) continue;
-    const Real dx = m_world.x[a] - m_world.x[b], dy = m_world.y[a] - m_world.y[b];
-    const Real reach = m_world.radius[a] + m_world.radius[b];
-    if (dx * dx + dy * dy > reach * reach) continue;
+    // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
+    const Box &ba = m_boxes[a], &bb = m_boxes[b];
+    if (ba.x0 > bb.x1 || bb.x0 > ba.x1 || ba.y0 > bb.y1 || bb.y0 > ba.y1) continue;
     const Contact c = computeContact(&m_worldVertices[static_cast<size_t>(a) * kMaxVertices], m_world.vertexCount[a],
                                      m_world.position(a), &m_worldVertices[static_cast<size_t>(b) * kMaxVertices],
                                      m_world.vertexCount[b], m_world.position(b));

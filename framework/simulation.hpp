@@ -70,6 +70,10 @@ class Simulation {
 
   // Per-step buffers, kept to avoid allocation.
   std::vector<Vec2> m_worldVertices;  // kMaxVertices per body
+  struct Box {
+    Real x0, y0, x1, y1;
+  };
+  std::vector<Box> m_boxes;  // world-aligned bounding box of each body, this step
   std::vector<CandidatePair> m_pairs;
   std::vector<int> m_contactA, m_contactB;
   std::vector<PairContact> m_contacts;
