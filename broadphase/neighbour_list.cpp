@@ -12,7 +12,7 @@ namespace gem {
 // of the build and of this check can never let a pair on the very edge of the list slip out.
 constexpr Real kTrigger = Real(1) - Real(1e-6);
 
-bool NeighbourList::needsRebuild(const World& world) const {
+bool NeighbourList::update(const World& world) {
   if (!m_valid) return true;
   const int n = world.size();
   if (n != static_cast<int>(m_x0.size())) return true;
@@ -21,28 +21,25 @@ bool NeighbourList::needsRebuild(const World& world) const {
   const Real* angle = world.angle.data();
   const Real* radius = world.radius.data();
   const std::int64_t* id = world.id.data();
-  Real first = 0, second = 0;
+  const Real limit = kTrigger * m_skin / 2;
   for (int i = 0; i < n; ++i) {
     // A reorder or an in-place replacement without invalidate() would make the list point at the
     // wrong bodies: the ids guard against it for the price of one load per body.
     if (id[i] != m_id0[i]) return true;
+    if (m_direct[i]) continue;  // its pairs are found afresh every step
     const Real dx = x[i] - m_x0[i], dy = y[i] - m_y0[i];
     // The farthest a point at distance R from the centroid moves under a turn of da is the chord
     // 2 R |sin(da / 2)| <= R |da wrapped to [-pi, pi]|: an angle that was wrapped by the motion code
     // (a jump of 2 pi) then counts as no turn, as it should. The wrap is rare, so it is branched.
     Real da = std::fabs(angle[i] - m_angle0[i]);
     if (da > kPi) da = std::fabs(std::remainder(da, Real(2) * kPi));
-    const Real d = std::sqrt(dx * dx + dy * dy) + radius[i] * da;
-    if (d > second) {
-      if (d > first) {
-        second = first;
-        first = d;
-      } else {
-        second = d;
-      }
+    if (std::sqrt(dx * dx + dy * dy) + radius[i] * da > limit) {
+      m_direct[i] = 1;
+      m_directList.push_back(i);
+      if (static_cast<int>(m_directList.size()) > kMaxDirect) return true;
     }
   }
-  return first + second > kTrigger * m_skin;
+  return false;
 }
 
 void NeighbourList::begin() { m_raw.clear(); }
@@ -86,6 +83,7 @@ void NeighbourList::finish(const World& world) {
   for (size_t k = 0; k < m_pairs.size(); ++k) {
     ListedPair p = m_pairs[k];
     if (world.kind[p.a] == BodyKind::Wall && world.kind[p.b] == BodyKind::Wall) continue;
+    if (world.kind[p.a] == BodyKind::Vessel || world.kind[p.b] == BodyKind::Vessel) continue;  // direct
     if (out > 0 && m_pairs[out - 1].a == p.a && m_pairs[out - 1].b == p.b) continue;
     const Real reach = world.radius[p.a] + world.radius[p.b];
     p.reach2 = reach * reach;
@@ -96,28 +94,56 @@ void NeighbourList::finish(const World& world) {
   m_y0.assign(world.y.begin(), world.y.end());
   m_angle0.assign(world.angle.begin(), world.angle.end());
   m_id0.assign(world.id.begin(), world.id.end());
+  m_direct.assign(n, 0);
+  m_directList.clear();
+  for (int i = 0; i < n; ++i)
+    if (world.kind[i] == BodyKind::Vessel) m_direct[i] = 1, m_directList.push_back(i);
   m_valid = true;
   ++m_rebuilds;
 }
 
 void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePair>& out) {
   // Branch-free: every listed pair is written to a scratch row and kept by advancing the count;
-  // about a third pass, so a branch would mispredict often. The scratch never shrinks.
+  // about a third pass, so a branch would mispredict often. The scratch never shrinks. Pairs of a
+  // direct body are skipped here: the direct pass below finds them.
   if (m_filtered.size() < m_pairs.size()) m_filtered.resize(m_pairs.size());
   const Real* x = world.x.data();
   const Real* y = world.y.data();
+  const char* direct = m_direct.data();
   CandidatePair* dst = m_filtered.data();
   size_t count = 0;
   for (const ListedPair& p : m_pairs) {
     const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
     dst[count] = {p.a, p.b};
-    count += dx * dx + dy * dy <= p.reach2;
+    count += (dx * dx + dy * dy <= p.reach2) & !(direct[p.a] | direct[p.b]);
   }
-  out.assign(m_filtered.begin(), m_filtered.begin() + static_cast<std::ptrdiff_t>(count));
+  if (m_directList.empty()) {
+    out.assign(m_filtered.begin(), m_filtered.begin() + static_cast<std::ptrdiff_t>(count));
+    return;
+  }
+  // Direct bodies (the vessel, and floes that moved more than half the skin since the build) are
+  // tested against every body: one pass each, a microsecond per thousand bodies, instead of a
+  // rebuild of the whole list every few steps while the vessel shoves floes at its own speed.
+  const Real* radius = world.radius.data();
+  const int n = world.size();
+  m_directPairs.clear();
+  for (int v : m_directList) {
+    for (int j = 0; j < n; ++j) {
+      if (j == v || (direct[j] && j < v)) continue;  // a pair of two direct bodies is found once
+      if (world.kind[v] == BodyKind::Wall && world.kind[j] == BodyKind::Wall) continue;
+      const Real dx = x[v] - x[j], dy = y[v] - y[j], reach = radius[v] + radius[j];
+      if (dx * dx + dy * dy <= reach * reach) m_directPairs.push_back(j < v ? CandidatePair{j, v} : CandidatePair{v, j});
+    }
+  }
+  auto before = [](CandidatePair p, CandidatePair q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
+  std::sort(m_directPairs.begin(), m_directPairs.end(), before);
+  out.resize(count + m_directPairs.size());
+  std::merge(m_filtered.begin(), m_filtered.begin() + static_cast<std::ptrdiff_t>(count), m_directPairs.begin(),
+             m_directPairs.end(), out.begin(), before);
 }
 
 void KeptListBroadphase::findCandidates(const World& world, std::vector<CandidatePair>& pairs) {
-  if (m_list.needsRebuild(world)) {
+  if (m_list.update(world)) {
     m_list.begin();
     build(world, m_list);
     m_list.finish(world);

@@ -6,10 +6,16 @@
 // R_a + R_b + skin at the build. Two bodies can only touch while their bounding circles overlap,
 // |c_a - c_b| <= R_a + R_b, and since the build the centroid distance has changed by at most
 // d_a + d_b, d the bound on how far any point of a body has moved. So while d_a + d_b <= skin for
-// every pair, every touching pair is still listed. We check this with the two largest bounds:
-// d_1st + d_2nd >= d_a + d_b for any two bodies. That is MODEL.md's "rebuild before any body has moved
-// more than half the skin" made a little tighter: when only the vessel moves through resting ice,
-// the vessel alone may use the whole skin (half as many rebuilds), and the proof is the same.
+// every pair, every touching pair is still listed. MODEL.md's rule ("rebuild before any body can
+// have moved more than half the skin") keeps every d <= skin / 2, which guarantees that.
+//
+// Here a body that passes half the skin does not force a rebuild at once: it becomes *direct*,
+// its listed pairs are ignored, and it is tested against every body each step (one O(n) pass of
+// bounding circles, merged into the sorted candidates). For the bodies still listed every d stays
+// <= skin / 2, so the list stays complete for them, and the direct pass covers the rest: nothing
+// is missed. The vessel is always direct (it moves at several m/s through resting ice and would
+// set the rebuild rate alone), and so are the few floes it is shoving; the list is rebuilt when
+// more than kMaxDirect bodies are direct.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -31,9 +37,12 @@ class NeighbourList {
   explicit NeighbourList(Real skin) : m_skin(skin) {}
 
   Real skin() const { return m_skin; }
-  // Never built, invalidated, body count or identities changed, or some pair may have closed in by
-  // more than the skin since the build. One pass over the bodies, no allocation.
-  bool needsRebuild(const World& world) const;
+  // True when the list must be rebuilt: never built, invalidated, body count or identities changed,
+  // or more than kMaxDirect bodies have become direct. Otherwise marks every body that has moved
+  // more than half the skin since the build as direct. One pass over the bodies.
+  bool update(const World& world);
+  int directCount() const { return static_cast<int>(m_directList.size()); }
+  static constexpr int kMaxDirect = 8;
   void invalidate() { m_valid = false; }
   long rebuilds() const { return m_rebuilds; }
 
@@ -61,6 +70,11 @@ class NeighbourList {
   // Reference state at the last build, by slot.
   std::vector<Real> m_x0, m_y0, m_angle0;
   std::vector<std::int64_t> m_id0;
+  // Direct bodies, tested against every body each step by filterByCircles: the vessels, and the
+  // bodies that moved more than half the skin since the build.
+  std::vector<char> m_direct;
+  std::vector<int> m_directList;
+  std::vector<CandidatePair> m_directPairs;
 };
 
 // Base of the kept-list strategies: rebuild when the rule asks, then filter. A strategy says only

@@ -74,14 +74,14 @@ class TriangulationMesh final : public KeptListBroadphase {
       std::fill(m_stamp.begin(), m_stamp.end(), 0u);
       m_epoch = 1;
     }
+    // The kept list's candidates (bounding circles overlap, direct bodies included), then triangles.
+    m_list.filterByCircles(world, m_circles);
     const Real* x = world.x.data();
     const Real* y = world.y.data();
-    for (const ListedPair& p : m_list.pairs()) {
-      const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
-      if (dx * dx + dy * dy > p.reach2) continue;
+    for (const CandidatePair& p : m_circles) {
       place(world, p.a);
       place(world, p.b);
-      const Real eps = kEpsRel * (std::sqrt(p.reach2) + std::fabs(x[p.a]) + std::fabs(y[p.a]));
+      const Real eps = kEpsRel * (world.radius[p.a] + world.radius[p.b] + std::fabs(x[p.a]) + std::fabs(y[p.a]));
       if (!boxesMeet(m_box[p.a], m_box[p.b], eps)) continue;
       if (trianglesMeet(p.a, p.b, eps)) pairs.push_back({p.a, p.b});
     }
@@ -154,6 +154,7 @@ class TriangulationMesh final : public KeptListBroadphase {
   }
 
   std::vector<Real> m_half;
+  std::vector<CandidatePair> m_circles;
   SweepAndPrune m_sweep;
   std::unordered_map<std::int64_t, TriangleSet> m_cache;
   std::vector<int> m_triStart, m_vertStart, m_tri;  // m_tri: 3 vertex indices per triangle

@@ -232,7 +232,7 @@ TEST(Broadphase, RandomWorldsSupersetOfTruth) {
 }
 
 // The kept lists themselves, right after a build: exactly the pairs within R_a + R_b + skin (and,
-// for fixed_radius, also those within the fixed radius), never two walls.
+// for fixed_radius, also those within the fixed radius), never two walls, never the vessel.
 TEST(Broadphase, KeptListsHoldExactlyTheSkinPairs) {
   World w = randomWorld(17, 300, 140);
   Real largestFloe = 0;
@@ -256,6 +256,8 @@ TEST(Broadphase, KeptListsHoldExactlyTheSkinPairs) {
       for (int a = 0; a < w.size(); ++a)
         for (int b2 = a + 1; b2 < w.size(); ++b2) {
           if (w.kind[a] == BodyKind::Wall && w.kind[b2] == BodyKind::Wall) continue;
+          // The vessel is never listed: it is tested directly every step.
+          if (w.kind[a] == BodyKind::Vessel || w.kind[b2] == BodyKind::Vessel) continue;
           const Real dx = w.x[a] - w.x[b2], dy = w.y[a] - w.y[b2];
           const Real reach = std::max(fixed, (w.radius[a] + s.skin / 2) + (w.radius[b2] + s.skin / 2));
           if (dx * dx + dy * dy <= reach * reach) expected.push_back({a, b2});
@@ -326,18 +328,24 @@ TEST(Broadphase, RebuildOnlyWhenNeeded) {
     for (int k = 0; k < 20; ++k) b->findCandidates(w, pairs);
     EXPECT_EQ(b->rebuilds(), 1) << name;
 
-    // One floe alone moving 0.3 m a step: d_1st + d_2nd = 0.3 k passes the 2 m skin at k = 7.
+    // One floe alone moving 0.3 m a step: past half the 2 m skin at k = 4 it becomes direct (tested
+    // against everything each step) instead of forcing a rebuild.
     const int f = w.size() - 1;
-    for (int k = 1; k <= 6; ++k) {
+    const NeighbourList& list = dynamic_cast<const KeptListBroadphase&>(*b).list();
+    const int vessels = list.directCount();  // the vessel is always direct
+    for (int k = 1; k <= 7; ++k) {
       w.x[f] += Real(0.3);
       b->findCandidates(w, pairs);
+      EXPECT_EQ(list.directCount(), vessels + (k >= 4 ? 1 : 0)) << name << " k " << k;
     }
     EXPECT_EQ(b->rebuilds(), 1) << name;
-    w.x[f] += Real(0.3);
+    b->invalidate();
     b->findCandidates(w, pairs);
     EXPECT_EQ(b->rebuilds(), 2) << name;
+    EXPECT_EQ(list.directCount(), vessels);  // a build starts afresh
 
-    // Every movable body moving 0.3 m a step: 0.6 k > 2 at k = 4.
+    // Every movable body moving 0.3 m a step: all pass half the skin at k = 4, far more than
+    // kMaxDirect of them, so the list is rebuilt then.
     for (int k = 1; k <= 4; ++k) {
       for (int i = 0; i < w.size(); ++i)
         if (w.kind[i] != BodyKind::Wall) w.y[i] += Real(0.3);
@@ -345,13 +353,19 @@ TEST(Broadphase, RebuildOnlyWhenNeeded) {
       EXPECT_EQ(b->rebuilds(), k < 4 ? 2 : 3) << name << " k " << k;
     }
 
-    // Turning counts R |d angle|: 1.5 m of rim travel on the vessel is within the skin, 2.5 m is not.
-    const int v = static_cast<int>(std::find(w.kind.begin(), w.kind.end(), BodyKind::Vessel) - w.kind.begin());
-    const Real r = w.radius[v];
-    w.angle[v] += Real(1.5) / r;
+    // Turning counts R |d angle|: 0.9 m of rim travel on a floe is within half the skin, 1.1 m not.
+    int g = -1;  // the largest floe but f: its turn stays well below half a revolution
+    for (int i = 0; i < f; ++i)
+      if (w.kind[i] == BodyKind::Floe && (g < 0 || w.radius[i] > w.radius[g])) g = i;
+    const Real r = w.radius[g];
+    w.angle[g] += Real(0.9) / r;
     b->findCandidates(w, pairs);
+    EXPECT_EQ(list.directCount(), vessels) << name;
+    w.angle[g] += Real(0.2) / r;
+    b->findCandidates(w, pairs);
+    EXPECT_EQ(list.directCount(), vessels + 1) << name;
     EXPECT_EQ(b->rebuilds(), 3) << name;
-    w.angle[v] += Real(1.0) / r;
+    b->invalidate();
     b->findCandidates(w, pairs);
     EXPECT_EQ(b->rebuilds(), 4) << name;
 
