@@ -17,6 +17,7 @@
 #include "framework/runner.hpp"
 #include "framework/scenario.hpp"
 #include "framework/simulation.hpp"
+#include "framework/stepper.hpp"
 
 namespace fs = std::filesystem;
 using namespace gem;
@@ -87,8 +88,13 @@ int commandCheck(const RunArguments& a) {
 
 int commandInfo() {
   std::printf("GEM %s (GPU Event Mechanics)\n", GEM_VERSION);
-  std::printf("build: real type %s, CUDA backend: not built (CPU only)\n", sizeof(Real) == 8 ? "double" : "float");
-  std::printf("devices: cpu\n\nevents (phase, default, origin):\n");
+  const BackendEntry* cuda = findBackend("cuda");
+  std::printf("build: real type %s, backends: %s%s\n", sizeof(Real) == 8 ? "double" : "float",
+              fmt::format("{}", fmt::join(backendNames(), ", ")).c_str(),
+              cuda ? ", CUDA architectures " GEM_CUDA_ARCHITECTURES : " (no CUDA backend in this build)");
+  std::printf("devices: cpu");
+  if (cuda) std::printf(", %s", cuda->available() ? cuda->deviceName().c_str() : "no CUDA device found");
+  std::printf("\n\nevents (phase, default, origin):\n");
   for (const EventEntry* e : Registry::global().events())
     std::printf("  %-18s %-9s %-4s %-9s %s\n", e->name.c_str(), eventPhaseName(e->phase), e->enabledByDefault ? "on" : "off",
                 e->origin.c_str(), e->description.c_str());

@@ -64,6 +64,8 @@ class EventInstance {
   virtual void runSolo(const SoloPhaseData&) {}
   virtual void runMotion(const MotionPhaseData&) {}
   virtual void runTopology(TopologyData&) {}
+  // The parsed Params, so that a device driver of the same event is made from the very same values.
+  virtual const void* params() const = 0;
 };
 
 // What an event's factory gets: its parameter table (strict) and the whole scenario
@@ -116,6 +118,7 @@ class CpuPairDriver final : public EventInstance {
     for (int k = 0; k < d.count; ++k)
       Event::apply(m_params, d.bodies[d.contactA[k]], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], d.ctx, d.sink);
   }
+  const void* params() const override { return &m_params; }
 
  private:
   Params m_params;
@@ -130,6 +133,7 @@ class CpuSoloDriver final : public EventInstance {
   void runSolo(const SoloPhaseData& d) override {
     for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.changes[i], d.ctx);
   }
+  const void* params() const override { return &m_params; }
 
  private:
   Params m_params;
@@ -144,6 +148,7 @@ class CpuMotionDriver final : public EventInstance {
   void runMotion(const MotionPhaseData& d) override {
     for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.ctx);
   }
+  const void* params() const override { return &m_params; }
 
  private:
   Params m_params;
@@ -156,6 +161,7 @@ class TopologyDriver final : public EventInstance {
   using Params = typename Event::Params;
   explicit TopologyDriver(const Params& p) : m_params(p) {}
   void runTopology(TopologyData& d) override { Event::apply(m_params, d); }
+  const void* params() const override { return &m_params; }
 
  private:
   Params m_params;

@@ -13,7 +13,7 @@
 #include "framework/atomic_file.hpp"
 #include "framework/errors.hpp"
 #include "framework/ice_file.hpp"
-#include "framework/simulation.hpp"
+#include "framework/stepper.hpp"
 #include "framework/vtk_writer.hpp"
 
 namespace gem {
@@ -60,12 +60,6 @@ void writeStateCsv(const std::filesystem::path& file, const World& w) {
 
 }  // namespace
 
-std::string resolveBackend(const std::string& requested) {
-  if (requested == "cuda")
-    throw InputError("simulation.backend = \"cuda\": this build of GEM has no CUDA backend yet (use \"cpu\" or \"auto\")");
-  return "cpu";
-}
-
 std::string summaryJson(const RunSummary& s) {
   return fmt::format(
       "{{\n"
@@ -85,14 +79,14 @@ std::string summaryJson(const RunSummary& s) {
 RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   RunSummary summary;
   summary.backend = resolveBackend(scenario.backend);
-  summary.device = "cpu";
   summary.broadphase = scenario.broadphase;
   summary.outputDir = scenario.output.dir.string();
 
-  Simulation sim(scenario);  // bad input throws here, before anything is written
-  World& world = sim.world();
-  summary.floesInitial = world.count(BodyKind::Floe);
-  summary.iceMassInitial = world.floeMass();
+  std::unique_ptr<Stepper> stepper = makeStepper(scenario);  // bad input throws here, before anything is written
+  Stepper& sim = *stepper;
+  summary.device = sim.device();
+  summary.floesInitial = sim.hostWorld().count(BodyKind::Floe);
+  summary.iceMassInitial = sim.hostWorld().floeMass();
 
   const auto& dir = scenario.output.dir;
   std::filesystem::create_directories(dir);
@@ -114,8 +108,8 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   auto lastProgress = start;
   auto writeFrames = [&]() {
-    if (vtk) vtk->addFrame(world, sim.time());
-    if (ice) ice->addFrame(world, sim.time());
+    if (vtk) vtk->addFrame(sim.hostWorld(), sim.time());
+    if (ice) ice->addFrame(sim.hostWorld(), sim.time());
   };
 
   try {
@@ -130,23 +124,20 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
                                         r.force, std::isfinite(r.forceLimit) ? fmt::format("{:.9g}", r.forceLimit) : "inf",
                                         r.broke ? 1 : 0);
       }
-      const int v = sim.vesselSlot();
-      if (v >= 0) {
-        const Vec2 forward{std::cos(world.angle[v]), std::sin(world.angle[v])};
-        const Real surge = dot(world.velocity(v), forward);
+      const VesselSample vessel = sim.vessel();
+      const Vec2 forward{std::cos(vessel.heading), std::sin(vessel.heading)};
+      const Real surge = dot(vessel.velocity, forward);
+      if (vessel.present) {
         speed.add(surge);
         netThrust.add(Propulsion::netThrust(thrust, surge));
       }
       if ((k + 1) % out.timeseriesEvery == 0) {
-        if (v >= 0) {
-          const Vec2 forward{std::cos(world.angle[v]), std::sin(world.angle[v])};
-          const Real surge = dot(world.velocity(v), forward);
-          timeseries.stream() << fmt::format("{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n", sim.time(), world.x[v],
-                                             world.y[v], world.angle[v], surge, Propulsion::netThrust(thrust, surge),
-                                             sim.vesselIceForce().x, sim.contactCount());
-        } else {
+        if (vessel.present)
+          timeseries.stream() << fmt::format("{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n", sim.time(),
+                                             vessel.position.x, vessel.position.y, vessel.heading, surge,
+                                             Propulsion::netThrust(thrust, surge), sim.vesselIceForce().x, sim.contactCount());
+        else
           timeseries.stream() << fmt::format("{:.6g},,,,,,,{}\n", sim.time(), sim.contactCount());
-        }
       }
       if (frames && (k + 1) % out.frameEvery == 0) writeFrames();
       if (options.progress && !options.quiet) {
@@ -174,6 +165,7 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   summary.wallTime = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.steps = scenario.steps;
   summary.simTime = sim.time();
+  const World& world = sim.hostWorld();
   summary.floesFinal = world.count(BodyKind::Floe);
   summary.iceMassFinal = world.floeMass();
   summary.rubbleMass = sim.rubbleMass();

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "framework/scenario.hpp"
+#include "framework/stepper.hpp"
 
 namespace gem {
 
@@ -28,9 +29,6 @@ struct RunSummary {
   Stats shipSpeed, impactForce, netThrust;
   std::string outputDir;
 };
-
-// The backend a scenario asks for, resolved on this build ("auto" is "cpu" without CUDA).
-std::string resolveBackend(const std::string& requested);
 
 RunSummary runScenario(const Scenario& scenario, const RunOptions& options);
 

@@ -138,6 +138,12 @@ int Simulation::vesselSlot() const {
   return -1;
 }
 
+VesselSample Simulation::vessel() {
+  const int v = vesselSlot();
+  if (v < 0) return VesselSample{false, {0, 0}, 0, {0, 0}};
+  return VesselSample{true, m_world.position(v), m_world.angle[v], m_world.velocity(v)};
+}
+
 static int dofOf(const World& w, int i, int vesselDof) {
   switch (w.kind[i]) {
     case BodyKind::Wall: return 0;

@@ -9,6 +9,7 @@
 #include "broadphase/broadphase.hpp"
 #include "framework/registry.hpp"
 #include "framework/scenario.hpp"
+#include "framework/stepper.hpp"
 #include "framework/world.hpp"
 
 namespace gem {
@@ -27,32 +28,35 @@ struct EnabledEvent {
   std::unique_ptr<EventInstance> instance;
 };
 
-class Simulation {
+class Simulation final : public Stepper {
  public:
   explicit Simulation(const Scenario& scenario);
   // For tests: a world built by hand, with the scenario's events and broadphase.
   Simulation(const Scenario& scenario, World world);
 
-  void step();
+  void step() override;
 
   World& world() { return m_world; }
   const World& world() const { return m_world; }
   const Scenario& scenario() const { return m_scenario; }
-  long stepIndex() const { return m_step; }
-  Real time() const { return m_time; }
+  long stepIndex() const override { return m_step; }
+  Real time() const override { return m_time; }
+  const World& hostWorld() override { return m_world; }
+  VesselSample vessel() override;
+  std::string device() const override { return "cpu"; }
   const std::vector<EnabledEvent>& events() const { return m_events; }
   Broadphase& broadphase() { return *m_broadphase; }
 
   // What the last step produced.
-  const std::vector<ImpactRecord>& impacts() const { return m_impacts; }
-  int contactCount() const { return static_cast<int>(m_contacts.size()); }
+  const std::vector<ImpactRecord>& impacts() const override { return m_impacts; }
+  int contactCount() const override { return static_cast<int>(m_contacts.size()); }
   int candidateCount() const { return static_cast<int>(m_pairs.size()); }
-  Vec2 vesselIceForce() const { return m_vesselIceForce; }  // N, world frame, from the step's impulses
+  Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
   int vesselSlot() const;                                   // -1 without a vessel
 
   // Totals since the start.
-  double rubbleMass() const { return m_rubbleMass; }
-  long floesBroken() const { return m_floesBroken; }
+  double rubbleMass() const override { return m_rubbleMass; }
+  long floesBroken() const override { return m_floesBroken; }
 
  private:
   void setUp();

@@ -1,0 +1,53 @@
+#include "framework/stepper.hpp"
+
+#include <map>
+
+#include <fmt/format.h>
+
+#include "framework/errors.hpp"
+#include "framework/simulation.hpp"
+
+namespace gem {
+
+static std::map<std::string, BackendEntry>& backends() {
+  static std::map<std::string, BackendEntry> table = [] {
+    std::map<std::string, BackendEntry> t;
+    t["cpu"] = BackendEntry{"cpu", [] { return true; }, [] { return std::string("cpu"); },
+                            [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); }};
+    return t;
+  }();
+  return table;
+}
+
+void registerBackend(BackendEntry entry) { backends()[entry.name] = std::move(entry); }
+
+const BackendEntry* findBackend(const std::string& name) {
+  auto it = backends().find(name);
+  return it == backends().end() ? nullptr : &it->second;
+}
+
+std::vector<std::string> backendNames() {
+  std::vector<std::string> names;
+  for (const auto& [name, entry] : backends()) names.push_back(name);
+  return names;
+}
+
+std::string resolveBackend(const std::string& requested) {
+  if (requested == "auto") {
+    const BackendEntry* cuda = findBackend("cuda");
+    return cuda && cuda->available() ? "cuda" : "cpu";
+  }
+  const BackendEntry* entry = findBackend(requested);
+  if (!entry)
+    throw InputError(fmt::format("simulation.backend = \"{}\": this build of GEM has no such backend (built: {})", requested,
+                                 fmt::join(backendNames(), ", ")));
+  if (!entry->available())
+    throw InputError(fmt::format("simulation.backend = \"{}\": no device for it was found on this machine", requested));
+  return requested;
+}
+
+std::unique_ptr<Stepper> makeStepper(const Scenario& scenario) {
+  return findBackend(resolveBackend(scenario.backend))->make(scenario);
+}
+
+}  // namespace gem

@@ -1,0 +1,58 @@
+// A backend steps a scenario's world: the CPU one (Simulation) or a device one. The runner and the
+// benchmarks see only this interface, so a backend added later (CUDA) changes neither.
+#pragma once
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/event_api.hpp"
+#include "framework/scenario.hpp"
+#include "framework/world.hpp"
+
+namespace gem {
+
+// The vessel's state after the last step, cheap to read every step.
+struct VesselSample {
+  bool present;
+  Vec2 position;
+  Real heading;
+  Vec2 velocity;
+};
+
+class Stepper {
+ public:
+  virtual ~Stepper() = default;
+  virtual void step() = 0;
+  virtual long stepIndex() const = 0;
+  virtual Real time() const = 0;
+  // The whole state on the host; a device backend copies it here when asked (outputs, frames).
+  virtual const World& hostWorld() = 0;
+  virtual VesselSample vessel() = 0;
+  // What the last step produced.
+  virtual const std::vector<ImpactRecord>& impacts() const = 0;
+  virtual int contactCount() const = 0;
+  virtual Vec2 vesselIceForce() const = 0;  // N, from the step's impulses on the vessel
+  // Totals since the start.
+  virtual double rubbleMass() const = 0;
+  virtual long floesBroken() const = 0;
+  virtual std::string device() const = 0;
+};
+
+struct BackendEntry {
+  std::string name;
+  std::function<bool()> available;  // a device exists
+  std::function<std::string()> deviceName;
+  std::function<std::unique_ptr<Stepper>(const Scenario&)> make;
+};
+
+void registerBackend(BackendEntry entry);
+const BackendEntry* findBackend(const std::string& name);
+std::vector<std::string> backendNames();
+
+// "auto" is "cuda" when that backend is built and a device is present, else "cpu". Asking for a
+// backend that is not built, or has no device, is an InputError that says so.
+std::string resolveBackend(const std::string& requested);
+std::unique_ptr<Stepper> makeStepper(const Scenario& scenario);
+
+}  // namespace gem
