@@ -126,6 +126,19 @@ void readFloes(const toml::array& floes, TableReader& parent, Scenario& s) {
   }
 }
 
+// Open-water speed for a bollard thrust when the scenario gives none: the thesis's pairs (issue 2;
+// thesis 6.2.1: 23 kN 1.4 m/s ... 740 kN 6.5 m/s), interpolated linearly in log T - log V, so
+// that --set vessel.bollard_thrust=92e3 alone gives the thesis's 2.6 m/s.
+Real openWaterSpeedFor(Real bollardThrust) {
+  static const Real table[][2] = {{23e3, 1.4}, {46e3, 1.9}, {92e3, 2.6}, {181.5e3, 3.6}, {370e3, 4.9}, {740e3, 6.5}};
+  constexpr int n = 6;
+  const Real t = std::max<Real>(bollardThrust, 1);
+  int k = 0;
+  while (k < n - 2 && t > table[k + 1][0]) ++k;
+  const Real f = std::log(t / table[k][0]) / std::log(table[k + 1][0] / table[k][0]);
+  return table[k][1] * std::exp(f * std::log(table[k + 1][1] / table[k][1]));
+}
+
 void readVessel(TableReader& t, Scenario& s) {
   VesselSpec& v = s.vessel;
   v.present = true;
@@ -138,7 +151,7 @@ void readVessel(TableReader& t, Scenario& s) {
   v.dof = static_cast<int>(t.getInt("dof", 1, 1, 3));
   if (v.dof == 2) t.fail("dof", "must be 1 (surge) or 3 (surge, sway, yaw)");
   v.bollardThrust = t.getNonNegative("bollard_thrust", v.bollardThrust);
-  v.openWaterSpeed = t.getPositive("open_water_speed", v.openWaterSpeed);
+  v.openWaterSpeed = t.getPositive("open_water_speed", openWaterSpeedFor(v.bollardThrust));
   v.speed = t.getNonNegative("speed", v.openWaterSpeed);  // MODEL.md 7: starts at V_ow
   auto hull = t.findPoints("vertices");
   auto frames = t.findReals("frame_angle_deg");

@@ -88,6 +88,9 @@ struct Scenario {
 // word is taken as a string). outDir, when not empty, replaces output.dir.
 Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
 
+// The thesis's open-water speed for a bollard thrust (interpolated in log-log), m/s.
+Real openWaterSpeedFor(Real bollardThrust);
+
 // The default hull: 100 m x 20 m with a sloped bow (see vessel.cpp for the numbers).
 void defaultHull(Real length, Real beam, std::vector<Vec2>& vertices, std::vector<Real>& frameAnglesDeg);
 

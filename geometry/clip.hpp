@@ -28,11 +28,11 @@ namespace detail {
 GEM_HD inline void extentAndMagnitude(const Vec2* v, int n, Real* extent, Real* magnitude) {
   Real x0 = v[0].x, x1 = v[0].x, y0 = v[0].y, y1 = v[0].y;
   for (int i = 1; i < n; ++i) {
-    x0 = std::fmin(x0, v[i].x), x1 = std::fmax(x1, v[i].x);
-    y0 = std::fmin(y0, v[i].y), y1 = std::fmax(y1, v[i].y);
+    x0 = minR(x0, v[i].x), x1 = maxR(x1, v[i].x);
+    y0 = minR(y0, v[i].y), y1 = maxR(y1, v[i].y);
   }
-  *extent = std::fmax(x1 - x0, y1 - y0);
-  *magnitude = std::fmax(std::fmax(std::fabs(x0), std::fabs(x1)), std::fmax(std::fabs(y0), std::fabs(y1)));
+  *extent = maxR(x1 - x0, y1 - y0);
+  *magnitude = maxR(maxR(std::fabs(x0), std::fabs(x1)), maxR(std::fabs(y0), std::fabs(y1)));
 }
 
 GEM_HD inline bool nearPoint(Vec2 a, Vec2 b, Real tol) {
@@ -74,7 +74,7 @@ GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVer
   detail::extentAndMagnitude(q, m, &extQ, &magQ);
   // Vertices closer than this are one vertex: relative to the smaller body (the overlap's scale)
   // and to the coordinate magnitude (the rounding of world coordinates).
-  Real tol = kGeomRelTol * (std::fmin(extP, extQ) + std::fmax(magP, magQ));
+  Real tol = kGeomRelTol * (detail::minR(extP, extQ) + detail::maxR(magP, magQ));
 
   ClipVertex tmp[kMaxClipVertices];
   ClipVertex* src = out;
@@ -87,9 +87,12 @@ GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVer
     Vec2 a = q[j], e = q[j + 1 == m ? 0 : j + 1] - a;
     // Signed test: cross(e, x - a) >= 0 is inside (left of a counter-clockwise edge).
     bool anyOut = false, anyIn = false;
-    for (int i = 0; i < k; ++i) {
-      if (cross(e, src[i].p - a) < Real(0)) anyOut = true;
-      else anyIn = true;
+    for (int i = 0; i < k && !(anyOut && anyIn); ++i) {
+      if (cross(e, src[i].p - a) < Real(0)) {
+        anyOut = true;
+      } else {
+        anyIn = true;
+      }
     }
     if (!anyOut) continue;  // this edge does not cut the polygon: nothing to copy
     if (!anyIn) return 0;   // wholly outside this edge: no overlap

@@ -86,17 +86,20 @@ GEM_HD inline Contact computeContact(const Vec2* p, int n, Vec2 centroidP, const
     twice += ai;
     cx += (a.x + b.x) * ai;
     cy += (a.y + b.y) * ai;
-    x0 = std::fmin(x0, v[i].p.x), x1 = std::fmax(x1, v[i].p.x);
-    y0 = std::fmin(y0, v[i].p.y), y1 = std::fmax(y1, v[i].p.y);
+    x0 = detail::minR(x0, v[i].p.x), x1 = detail::maxR(x1, v[i].p.x);
+    y0 = detail::minR(y0, v[i].p.y), y1 = detail::maxR(y1, v[i].p.y);
     if (v[i].inEdge != v[i].outEdge) {
-      if (nCross == 0) i0 = i;
-      else if (nCross == 1) i1 = i;
+      if (nCross == 0) {
+        i0 = i;
+      } else if (nCross == 1) {
+        i1 = i;
+      }
       ++nCross;
     }
   }
   Real area = Real(0.5) * twice;
-  Real extent = std::fmax(x1 - x0, y1 - y0);
-  Real magnitude = std::fmax(std::fmax(std::fabs(x0), std::fabs(x1)), std::fmax(std::fabs(y0), std::fabs(y1)));
+  Real extent = detail::maxR(x1 - x0, y1 - y0);
+  Real magnitude = detail::maxR(detail::maxR(std::fabs(x0), std::fabs(x1)), detail::maxR(std::fabs(y0), std::fabs(y1)));
   Real tol = kGeomRelTol * (extent + magnitude);
   // A sliver thinner than tol (area / extent) is a touch, not an overlap.
   if (!(area > tol * extent)) return ct;
@@ -150,7 +153,7 @@ GEM_HD inline Contact computeContact(const Vec2* p, int n, Vec2 centroidP, const
     Real lo = 0, hi = 0;
     for (int i = 0; i < k; ++i) {
       Real s = dot(t, v[i].p - ct.point);
-      lo = std::fmin(lo, s), hi = std::fmax(hi, s);
+      lo = detail::minR(lo, s), hi = detail::maxR(hi, s);
     }
     ct.width = hi - lo;
     ct.cross0 = ct.point - Real(0.5) * ct.width * t;

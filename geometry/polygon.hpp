@@ -9,9 +9,11 @@
 namespace gem {
 
 // a_i = x_i y_{i+1} - x_{i+1} y_i, the doubled signed area of triangle (0, v_i, v_{i+1}) (A.1).
+// Summed about vertex 0 rather than the origin: far from the origin (world coordinates) the terms
+// would otherwise cancel and, in float, lose the area to rounding.
 GEM_HD inline Real signedArea(const Vec2* v, int n) {
   Real twice = 0;
-  for (int i = 0; i < n; ++i) twice += cross(v[i], v[(i + 1) % n]);
+  for (int i = 1; i + 1 < n; ++i) twice += cross(v[i] - v[0], v[i + 1] - v[0]);
   return Real(0.5) * twice;
 }
 

@@ -9,14 +9,21 @@
 namespace gem {
 
 // Relative tolerance of the geometry predicates: a penetration, sliver or vertex gap smaller than
-// this times the local length scale is treated as zero. It sits far above the rounding of the
-// engine's Real (2e-16 for double, 1e-7 for float) and far below anything physical.
-constexpr Real kGeomRelTol = sizeof(Real) >= 8 ? Real(1e-12) : Real(1e-5);
+// this times the local length scale (body size + coordinate magnitude) is treated as zero. It sits
+// well above the rounding of the engine's Real (2e-16 for double, 1.2e-7 for float: about 8 ulps
+// there) and far below anything physical (double: 1 nm at 1 km from the origin; float: 1 mm).
+// Without it, bodies that share an edge touch or overlap at random once rotated into world
+// coordinates (tests/cgal: DegenerateGridPairs).
+constexpr Real kGeomRelTol = sizeof(Real) >= 8 ? Real(1e-12) : Real(1e-6);
 
 // Cheap length scale of a vector without a square root: |a|_1 lies within sqrt(2) of |a|.
 GEM_HD inline Real l1Norm(Vec2 a) { return std::fabs(a.x) + std::fabs(a.y); }
 
 namespace detail {
+
+// Plain min/max: std::fmin/fmax honour NaN rules and are library calls on the host.
+GEM_HD inline Real minR(Real a, Real b) { return a < b ? a : b; }
+GEM_HD inline Real maxR(Real a, Real b) { return a > b ? a : b; }
 
 // True when some edge of p separates q: every q vertex lies on or outside the edge's line (to
 // within the tolerance), so touching along an edge or at a point is separation, not overlap.

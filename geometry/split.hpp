@@ -24,7 +24,7 @@ GEM_HD inline int finishPiece(Vec2* out, int k, Real tol) {
   Real twice = 0, extent = 0;
   for (int i = 1; i < k; ++i) {
     if (i + 1 < k) twice += cross(out[i] - out[0], out[i + 1] - out[0]);
-    extent = std::fmax(extent, l1Norm(out[i] - out[0]));
+    extent = maxR(extent, l1Norm(out[i] - out[0]));
   }
   return Real(0.5) * twice > tol * extent ? k : 0;
 }

@@ -74,9 +74,9 @@ GEM_HD inline bool trianglesOverlap(const Vec2* t0, const Vec2* t1, Real eps) {
     for (int i = 0; i < 3; ++i) {
       Vec2 e = a[i == 2 ? 0 : i + 1] - a[i];
       Vec2 nrm{e.y, -e.x};  // outward for a counter-clockwise triangle
-      Real g = dot(nrm, b[0] - a[i]);
-      g = std::fmin(g, dot(nrm, b[1] - a[i]));
-      g = std::fmin(g, dot(nrm, b[2] - a[i]));
+      Real g0 = dot(nrm, b[0] - a[i]), g1 = dot(nrm, b[1] - a[i]), g2 = dot(nrm, b[2] - a[i]);
+      Real g = g0 < g1 ? g0 : g1;
+      g = g < g2 ? g : g2;
       if (g > Real(0) && g * g > eps * eps * norm2(e)) return false;
     }
   }

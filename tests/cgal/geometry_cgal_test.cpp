@@ -7,6 +7,7 @@
 #include <CGAL/Boolean_set_operations_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Gmpq.h>
 #include <CGAL/Polygon_2.h>
 #include <CGAL/Polygon_with_holes_2.h>
 #include <CGAL/convex_hull_2.h>
@@ -36,8 +37,13 @@ using Polygon = CGAL::Polygon_2<K>;
 using PolygonWithHoles = CGAL::Polygon_with_holes_2<K>;
 using Poly = std::vector<Vec2>;
 
-// Relative tolerance of a result against the exact value, for the engine's Real.
-constexpr double kRel = sizeof(Real) >= 8 ? 1e-9 : 2e-3;
+// Tolerances for the engine's Real: kRel relative to the polygons' size, kMag relative to the
+// coordinate magnitude (world coordinates far from the origin round at that scale), kUnit for
+// identities between unit vectors computed from the same numbers.
+constexpr bool kDouble = sizeof(Real) >= 8;
+constexpr double kRel = kDouble ? 1e-9 : 1e-4;
+constexpr double kMag = kDouble ? 1e-12 : 1e-5;
+constexpr double kUnit = kDouble ? 1e-12 : 1e-5;
 
 struct Rng {
   std::mt19937_64 gen;
@@ -55,6 +61,11 @@ Polygon toPolygon(const Poly& p) {
   Polygon out;
   for (Vec2 v : p) out.push_back(toPoint(v));
   return out;
+}
+double exactArea(const Vec2* v, int k) {
+  Polygon out;
+  for (int i = 0; i < k; ++i) out.push_back(toPoint(v[i]));
+  return toDouble(out.area());
 }
 Vec2 toVec(const Point& p) { return {Real(toDouble(p.x())), Real(toDouble(p.y()))}; }
 
@@ -81,7 +92,10 @@ Poly randomConvex(Rng& rng, Vec2 centre, double scale) {
 
 double extentOf(const Poly& p) {
   double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
-  for (Vec2 v : p) x0 = std::min(x0, double(v.x)), x1 = std::max(x1, double(v.x)), y0 = std::min(y0, double(v.y)), y1 = std::max(y1, double(v.y));
+  for (Vec2 v : p) {
+    x0 = std::min(x0, double(v.x)), x1 = std::max(x1, double(v.x));
+    y0 = std::min(y0, double(v.y)), y1 = std::max(y1, double(v.y));
+  }
   return std::max(x1 - x0, y1 - y0);
 }
 double magnitudeOf(const Poly& p) {
@@ -118,27 +132,30 @@ Poly simplified(Poly p, double tol) {
   return p;
 }
 
-// Exact area, centroid and second moments about the exact centroid (MODEL.md 1, A.1 to A.8).
+// Exact area, centroid and second moments about the exact centroid (MODEL.md 1, A.1 to A.8), in
+// plain GMP rationals (the lazy kernel number would build a long expression DAG here).
 struct ExactMass {
-  FT area, cx, cy, jxx, jyy, jxy;
+  CGAL::Gmpq area, cx, cy, jxx, jyy, jxy;
 };
 ExactMass exactMass(const Poly& p) {
+  using Q = CGAL::Gmpq;
   ExactMass m{0, 0, 0, 0, 0, 0};
   size_t n = p.size();
-  std::vector<Point> v;
-  for (Vec2 x : p) v.push_back(toPoint(x));
+  std::vector<Q> x, y;
+  for (Vec2 v : p) x.emplace_back(double(v.x)), y.emplace_back(double(v.y));
   for (size_t i = 0; i < n; ++i) {
-    const Point &a = v[i], &b = v[(i + 1) % n];
-    FT ai = a.x() * b.y() - b.x() * a.y();
+    size_t j = (i + 1) % n;
+    Q ai = x[i] * y[j] - x[j] * y[i];
     m.area += ai;
-    m.cx += (a.x() + b.x()) * ai;
-    m.cy += (a.y() + b.y()) * ai;
+    m.cx += (x[i] + x[j]) * ai;
+    m.cy += (y[i] + y[j]) * ai;
   }
   m.cx /= 3 * m.area;
   m.cy /= 3 * m.area;
   for (size_t i = 0; i < n; ++i) {
-    FT ax = v[i].x() - m.cx, ay = v[i].y() - m.cy, bx = v[(i + 1) % n].x() - m.cx, by = v[(i + 1) % n].y() - m.cy;
-    FT ai = ax * by - bx * ay;
+    size_t j = (i + 1) % n;
+    Q ax = x[i] - m.cx, ay = y[i] - m.cy, bx = x[j] - m.cx, by = y[j] - m.cy;
+    Q ai = ax * by - bx * ay;
     m.jxx += (ay * ay + ay * by + by * by) * ai;
     m.jyy += (ax * ax + ax * bx + bx * bx) * ai;
     m.jxy += (ax * by + 2 * ax * ay + 2 * bx * by + bx * ay) * ai;
@@ -177,19 +194,20 @@ Pair randomPair(Rng& rng) {
   return pr;
 }
 
-// Exact points where the boundaries of p and q cross (proper edge-edge intersections; for random
-// inputs no vertex lies on the other boundary).
+// Exact points where the boundaries of p and q properly cross: edges whose endpoints lie strictly
+// on opposite sides of each other (exact predicates), intersected in exact arithmetic. Shared
+// vertices and collinear overlaps are not crossings.
 std::vector<Vec2> exactCrossings(const Poly& p, const Poly& q) {
   std::vector<Vec2> out;
   for (size_t i = 0; i < p.size(); ++i) {
-    K::Segment_2 s(toPoint(p[i]), toPoint(p[(i + 1) % p.size()]));
+    Point a = toPoint(p[i]), b = toPoint(p[(i + 1) % p.size()]);
     for (size_t j = 0; j < q.size(); ++j) {
-      K::Segment_2 t(toPoint(q[j]), toPoint(q[(j + 1) % q.size()]));
-      if (!CGAL::do_intersect(s, t)) continue;
-      auto r = CGAL::intersection(s, t);
-      // Only proper crossings: a shared vertex (identical polygons) is not one.
-      const Point* x = boost::get<Point>(&*r);
-      if (x && *x != s.source() && *x != s.target() && *x != t.source() && *x != t.target()) out.push_back(toVec(*x));
+      Point c = toPoint(q[j]), d = toPoint(q[(j + 1) % q.size()]);
+      if (CGAL::orientation(a, b, c) * CGAL::orientation(a, b, d) >= 0) continue;
+      if (CGAL::orientation(c, d, a) * CGAL::orientation(c, d, b) >= 0) continue;
+      K::Vector_2 ab = b - a, cd = d - c;
+      FT t = CGAL::determinant(c - a, cd) / CGAL::determinant(ab, cd);
+      out.push_back(toVec(a + t * ab));
     }
   }
   return out;
@@ -203,7 +221,7 @@ struct Stats {
 void checkOrder(const Poly& p, const Poly& q, const Polygon& exact, double exactArea, double areaTol, double tol) {
   int n = int(p.size()), m = int(q.size());
   double minArea = std::min(signedArea(p.data(), n), signedArea(q.data(), m));
-  bool borderline = exactArea > 0 ? exactArea < kRel * minArea : false;
+  bool borderline = exactArea > 0 && exactArea < kRel * minArea + tol * std::max(extentOf(p), extentOf(q));
   ClipVertex v[kMaxClipVertices];
   int k = clipConvex(p.data(), n, q.data(), m, v);
   double area = k ? clippedArea(v, k) : 0;
@@ -249,39 +267,72 @@ void checkContact(const Poly& p, const Poly& q, double exactArea, bool borderlin
   }
   ++st.overlapping;
   for (const Contact* x : {&c, &r}) {
-    EXPECT_NEAR(norm(x->normal), 1.0, 1e-12 + kRel);
+    EXPECT_NEAR(norm(x->normal), 1.0, kUnit);
     EXPECT_NEAR(x->width, norm(x->cross1 - x->cross0), tol);
     Vec2 nn = normalized(x->cross1 - x->cross0);
     if (x->width > 1e3 * tol) {  // n = perpRight(cross1 - cross0) / w
-      EXPECT_NEAR(x->normal.x, nn.y, 1e3 * kRel);
-      EXPECT_NEAR(x->normal.y, -nn.x, 1e3 * kRel);
+      EXPECT_NEAR(x->normal.x, nn.y, kUnit + tol / x->width);
+      EXPECT_NEAR(x->normal.y, -nn.x, kUnit + tol / x->width);
     }
     EXPECT_LE(norm(x->point - Real(0.5) * (x->cross0 + x->cross1)), tol);
   }
   std::vector<Vec2> ex = exactCrossings(p, q);
+  double far = 0;
+  for (size_t i = 0; i < ex.size(); ++i)
+    for (size_t j = i + 1; j < ex.size(); ++j) far = std::max(far, double(norm(ex[i] - ex[j])));
+  // Near-degenerate: crossings within rounding of each other or of a vertex, where rounding may
+  // legitimately merge them (a corner poking out by less than tol reads as containment).
+  bool nearDegenerate = !ex.empty() && far <= 10 * tol;
+  for (Vec2 x : ex)
+    for (const Poly* poly : {&p, &q})
+      for (Vec2 y : *poly) nearDegenerate = nearDegenerate || norm(x - y) <= 10 * tol;
+  if (nearDegenerate) {
+    ++st.borderline;
+    return;
+  }
   EXPECT_EQ(c.contained, ex.empty());
   EXPECT_EQ(r.contained, ex.empty());
-  // Both orders describe the same contact: same line, opposite normals.
+  // Both orders describe the same contact: same line, opposite normals (the line's direction is
+  // known to about tol / w).
   EXPECT_NEAR(c.width, r.width, tol);
   EXPECT_LE(norm(c.point - r.point), tol);
-  if (norm(cq - cp) > 1e3 * tol) {
-    EXPECT_LE(norm(c.normal + r.normal), 1e3 * kRel);
-  } else if (ex.empty()) {  // coinciding centroids (identical polygons): +x in both orders
-    EXPECT_LE(norm(c.normal - Vec2{1, 0}), 1e3 * kRel);
-    EXPECT_LE(norm(r.normal - Vec2{1, 0}), 1e3 * kRel);
+  if (ex.empty() ? norm(cq - cp) > 1e3 * tol : c.width > 1e3 * tol) {
+    EXPECT_LE(norm(c.normal + r.normal), kUnit + 4 * tol / (ex.empty() ? double(norm(cq - cp)) : c.width));
+  } else if (ex.empty() && norm(cq - cp) == 0) {  // identical polygons: +x in both orders
+    EXPECT_LE(norm(c.normal - Vec2{1, 0}), kUnit);
+    EXPECT_LE(norm(r.normal - Vec2{1, 0}), kUnit);
+  }
+  // Apex vertices: the vertex of Q inside P nearest c, and the same for P. Vertices within tol of
+  // the other boundary may go either way.
+  for (int side = 0; side < 2; ++side) {
+    const Poly& a = side ? p : q;  // whose vertex
+    const Poly& b = side ? q : p;  // inside which
+    int apex = side ? c.apexVertexP : c.apexVertexQ;
+    Polygon eb = toPolygon(b);
+    double bestDeep = 1e300;
+    for (Vec2 x : a) {
+      if (eb.bounded_side(toPoint(x)) == CGAL::ON_BOUNDED_SIDE && boundaryDistance(x, b) > tol)
+        bestDeep = std::min(bestDeep, double(norm(x - c.point)));
+    }
+    if (bestDeep < 1e300) {
+      ASSERT_GE(apex, 0);
+      EXPECT_LE(norm(a[size_t(apex)] - c.point), bestDeep + tol);
+    }
+    if (apex >= 0) {
+      Vec2 x = a[size_t(apex)];
+      EXPECT_TRUE(eb.bounded_side(toPoint(x)) == CGAL::ON_BOUNDED_SIDE || boundaryDistance(x, b) <= tol);
+    } else {
+      EXPECT_EQ(bestDeep, 1e300);
+    }
   }
   if (ex.empty()) {
     ++st.contained;
-    Vec2 d = normalized(cq - cp);
     if (norm(cq - cp) > 1e3 * tol) {
-      EXPECT_LE(norm(c.normal - d), 1e3 * kRel);
+      EXPECT_LE(norm(c.normal - normalized(cq - cp)), kUnit);
     }
     return;
   }
   // Crossing points: the exact pair, or the exact farthest pair for more than two.
-  double far = 0;
-  for (size_t i = 0; i < ex.size(); ++i)
-    for (size_t j = i + 1; j < ex.size(); ++j) far = std::max(far, double(norm(ex[i] - ex[j])));
   EXPECT_NEAR(c.width, far, tol);
   for (Vec2 x : {c.cross0, c.cross1}) {
     EXPECT_LE(boundaryDistance(x, p), tol);
@@ -295,32 +346,18 @@ void checkContact(const Poly& p, const Poly& q, double exactArea, bool borderlin
     // n points from P into Q: P's vertices inside Q lie on the +n side of the line, Q's inside P on
     // the -n side (exact inside tests).
     Polygon ep = toPolygon(p), eq = toPolygon(q);
-    for (Vec2 x : p)
+    for (Vec2 x : p) {
       if (eq.bounded_side(toPoint(x)) == CGAL::ON_BOUNDED_SIDE) {
         EXPECT_GE(dot(c.normal, x - c.point), -tol);
       }
-    for (Vec2 x : q)
+    }
+    for (Vec2 x : q) {
       if (ep.bounded_side(toPoint(x)) == CGAL::ON_BOUNDED_SIDE) {
         EXPECT_LE(dot(c.normal, x - c.point), tol);
       }
+    }
   } else {
     ++st.manyCrossings;
-  }
-  // Apex vertices: the vertex of Q inside P nearest c (exactly inside), and the same for P.
-  for (int side = 0; side < 2; ++side) {
-    const Poly& a = side ? p : q;  // whose vertex
-    const Poly& b = side ? q : p;  // inside which
-    int apex = side ? c.apexVertexP : c.apexVertexQ;
-    Polygon eb = toPolygon(b);
-    double best = 1e300;
-    for (Vec2 x : a)
-      if (eb.bounded_side(toPoint(x)) == CGAL::ON_BOUNDED_SIDE) best = std::min(best, double(norm(x - c.point)));
-    if (best < 1e300) {
-      ASSERT_GE(apex, 0);
-      EXPECT_NEAR(norm(a[size_t(apex)] - c.point), best, tol);
-    } else {
-      EXPECT_EQ(apex, -1);
-    }
   }
 }
 
@@ -331,7 +368,7 @@ void runPairs(unsigned long long seed, int count) {
     Pair pr = randomPair(rng);
     SCOPED_TRACE(::testing::Message() << "seed " << seed << " pair " << it);
     double scale = std::min(extentOf(pr.p), extentOf(pr.q));
-    double tol = kRel * scale + 1e-12 * std::max(magnitudeOf(pr.p), magnitudeOf(pr.q));
+    double tol = kRel * scale + kMag * std::max(magnitudeOf(pr.p), magnitudeOf(pr.q));
     Polygon ep = toPolygon(pr.p), eq = toPolygon(pr.q);
     std::vector<PolygonWithHoles> inter;
     CGAL::intersection(ep, eq, std::back_inserter(inter));
@@ -340,7 +377,8 @@ void runPairs(unsigned long long seed, int count) {
     double exactArea = toDouble(exactAreaFT);
     double minArea = std::min(signedArea(pr.p.data(), int(pr.p.size())), signedArea(pr.q.data(), int(pr.q.size())));
     double areaTol = kRel * minArea + tol * scale;
-    bool borderline = exactArea > 0 && exactArea < kRel * minArea;
+    // Borderline: an overlap thinner than the tolerance (either way is right).
+    bool borderline = exactArea > 0 && exactArea < kRel * minArea + tol * std::max(extentOf(pr.p), extentOf(pr.q));
     st.borderline += borderline;
     // do_intersect (closed sets) agrees whenever the overlap has area.
     if (exactArea > 0) {
@@ -356,7 +394,7 @@ void runPairs(unsigned long long seed, int count) {
   // The generator must exercise every case.
   EXPECT_GT(st.overlapping, count / 2);
   EXPECT_GT(st.contained, count / 50);
-  EXPECT_GT(st.twoCrossings, count / 4);
+  EXPECT_GT(st.twoCrossings, count / 5);
   EXPECT_GT(st.manyCrossings, 0);
   std::printf("pairs %d overlapping %d contained %d two-crossing %d many-crossing %d borderline %d\n", st.pairs,
               st.overlapping, st.contained, st.twoCrossings, st.manyCrossings, st.borderline);
@@ -395,7 +433,7 @@ TEST(GeometryCgal, DegenerateGridPairs) {
     Poly p = gridConvex(rng, 3, {0, 0});
     Poly q = it % 10 == 0 ? p : gridConvex(rng, 3, {Real(rng.integer(-6, 6)), Real(rng.integer(-6, 6))});
     int n = int(p.size()), m = int(q.size());
-    double tol = 1e-12 * 16;
+    double tol = kDouble ? 1e-12 * 16 : 1e-5 * 16;
     std::vector<PolygonWithHoles> inter;
     CGAL::intersection(toPolygon(p), toPolygon(q), std::back_inserter(inter));
     double exactArea = inter.empty() ? 0 : toDouble(inter[0].outer_boundary().area());
@@ -412,12 +450,12 @@ TEST(GeometryCgal, DegenerateGridPairs) {
       ASSERT_EQ(c.touching, exactArea > 0);
       if (!c.touching) continue;
       EXPECT_NEAR(c.area, exactArea, tol);
-      EXPECT_NEAR(norm(c.normal), 1.0, 1e-12);
+      EXPECT_NEAR(norm(c.normal), 1.0, kUnit);
       EXPECT_NEAR(c.width, norm(c.cross1 - c.cross0), tol);
       EXPECT_LE(norm(c.point - Real(0.5) * (c.cross0 + c.cross1)), tol);
       if (!c.contained) {
-        EXPECT_NEAR(c.normal.x * c.width, c.cross1.y - c.cross0.y, 1e-9);  // n = perpRight(cross1 - cross0) / w
-        EXPECT_NEAR(c.normal.y * c.width, c.cross0.x - c.cross1.x, 1e-9);
+        EXPECT_NEAR(c.normal.x * c.width, c.cross1.y - c.cross0.y, tol);  // n = perpRight(cross1 - cross0) / w
+        EXPECT_NEAR(c.normal.y * c.width, c.cross0.x - c.cross1.x, tol);
         for (Vec2 x : {c.cross0, c.cross1}) {
           EXPECT_LE(boundaryDistance(x, a), tol);
           EXPECT_LE(boundaryDistance(x, b), tol);
@@ -437,8 +475,9 @@ TEST(GeometryCgal, DegenerateGridPairs) {
       Contact c2 = computeContact(qw.data(), m, areaCentroid(qw.data(), m), pw.data(), n, areaCentroid(pw.data(), n));
       EXPECT_EQ(c.touching, exactArea > 0);
       EXPECT_EQ(c2.touching, exactArea > 0);
-      EXPECT_NEAR(c.area, exactArea, 1e-9);
-      EXPECT_NEAR(c2.area, exactArea, 1e-9);
+      double worldTol = kMag * 3000 * 50;  // rounding at 3 km times the perimeter
+      EXPECT_NEAR(c.area, exactArea, worldTol);
+      EXPECT_NEAR(c2.area, exactArea, worldTol);
       EXPECT_EQ(convexOverlap(pw.data(), n, qw.data(), m), exactArea > 0);
       EXPECT_EQ(convexOverlap(qw.data(), m, pw.data(), n), exactArea > 0);
     }
@@ -474,17 +513,17 @@ TEST(GeometryCgal, MassProperties) {
     int n = int(p.size());
     SCOPED_TRACE(::testing::Message() << "polygon " << it);
     ExactMass em = exactMass(p);
-    double area = toDouble(em.area), tol = kRel * s + 1e-12 * magnitudeOf(p);
+    double area = CGAL::to_double(em.area), tol = kRel * s + kMag * magnitudeOf(p);
     MassProperties mp = massProperties(p.data(), n);
     // Areas and moments far from the origin lose digits to the coordinate magnitude (about vertex
     // 0 for the centroid, but the area sum is about the origin).
-    double areaTol = kRel * area + 1e-12 * magnitudeOf(p) * s;
+    double areaTol = kRel * area + kMag * magnitudeOf(p) * s;
     EXPECT_NEAR(signedArea(p.data(), n), area, areaTol);
     EXPECT_NEAR(mp.area, area, areaTol);
-    EXPECT_NEAR(mp.centroid.x, toDouble(em.cx), tol);
-    EXPECT_NEAR(mp.centroid.y, toDouble(em.cy), tol);
+    EXPECT_NEAR(mp.centroid.x, CGAL::to_double(em.cx), tol);
+    EXPECT_NEAR(mp.centroid.y, CGAL::to_double(em.cy), tol);
     double jTol = kRel * area * s * s;
-    double jxx = toDouble(em.jxx), jyy = toDouble(em.jyy), jxy = toDouble(em.jxy);
+    double jxx = CGAL::to_double(em.jxx), jyy = CGAL::to_double(em.jyy), jxy = CGAL::to_double(em.jxy);
     EXPECT_NEAR(mp.jxx, jxx, jTol);
     EXPECT_NEAR(mp.jyy, jyy, jTol);
     EXPECT_NEAR(mp.jxy, jxy, jTol);
@@ -550,7 +589,7 @@ TEST(GeometryCgal, SplitByLine) {
     Poly p = randomConvex(rng, origin, s);
     int n = int(p.size());
     double area = toDouble(toPolygon(p).area());
-    double tol = kRel * s + 1e-12 * magnitudeOf(p);
+    double tol = kRel * s + kMag * magnitudeOf(p);
     // A line through a random point near the polygon (it misses sometimes) or through a vertex.
     Vec2 at = it % 10 == 0 ? p[size_t(rng.integer(0, n - 1))]
                            : origin + Vec2{Real(rng.uniform(-1.1, 1.1) * s), Real(rng.uniform(-1.1, 1.1) * s)};
@@ -558,7 +597,7 @@ TEST(GeometryCgal, SplitByLine) {
     Vec2 dir{Real(std::cos(a)), Real(std::sin(a))};
     int nl, nr;
     splitByLine(p.data(), n, at, dir, l, &nl, r, &nr);
-    double al = nl ? signedArea(l, nl) : 0, ar = nr ? signedArea(r, nr) : 0;
+    double al = nl ? exactArea(l, nl) : 0, ar = nr ? exactArea(r, nr) : 0;  // exact areas of our pieces
     EXPECT_NEAR(al + ar, area, kRel * area + tol * s);
     cut += nl > 0 && nr > 0;
     // Each piece: convex, counter-clockwise, on its side of the line, and its area is the exact
@@ -567,7 +606,7 @@ TEST(GeometryCgal, SplitByLine) {
       const Vec2* v = side ? r : l;
       int k = side ? nr : nl;
       if (k == 0) continue;
-      EXPECT_GT(signedArea(v, k), 0);
+      EXPECT_GT(exactArea(v, k), 0);
       for (int i = 0; i < k; ++i) {
         Vec2 x = v[(i + k - 1) % k], y = v[i], z = v[(i + 1) % k];
         EXPECT_GE(cross(y - x, z - y), -tol * norm(z - x));
