@@ -18,6 +18,7 @@
 #include "framework/scenario.hpp"
 #include "framework/simulation.hpp"
 #include "framework/stepper.hpp"
+#include "framework/sweep.hpp"
 
 namespace fs = std::filesystem;
 using namespace gem;
@@ -133,6 +134,14 @@ int main(int argc, char** argv) {
   benchCommand->add_option("--cases", bench.cases, "which cases: 456, 824, 10000 (default all)");
   benchCommand->add_option("--broadphase", bench.broadphases, "broadphases to time (default variable_radius)");
 
+  SweepOptions sweep;
+  CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
+  sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
+  sweepCommand->add_option("--out", sweep.outDir, "sweep folder (default runs/NAME)");
+  sweepCommand->add_option("--jobs", sweep.jobs, "cases run at once (default: all cores)");
+  sweepCommand->add_option("--case-index", sweep.caseIndex, "run only case I (0-based), e.g. in a job array");
+  sweepCommand->add_flag("--quiet", sweep.quiet, "no progress");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -143,6 +152,7 @@ int main(int argc, char** argv) {
     if (*run) return commandRun(args);
     if (*check) return commandCheck(args);
     if (*benchCommand) return runBench(bench);
+    if (*sweepCommand) return runSweep(sweep);
     return commandInfo();
   } catch (const InputError& e) {
     std::fprintf(stderr, "gem: error: %s\n", e.what());
