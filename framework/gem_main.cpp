@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "framework/bench.hpp"
+#include "framework/calibration.hpp"
 #include "framework/errors.hpp"
 #include "framework/registry.hpp"
 #include "framework/runner.hpp"
@@ -134,6 +135,11 @@ int main(int argc, char** argv) {
   benchCommand->add_option("--cases", bench.cases, "which cases: 456, 824, 10000 (default all)");
   benchCommand->add_option("--broadphase", bench.broadphases, "broadphases to time (default variable_radius)");
 
+  std::string calibrationFile = std::string(GEM_SOURCE_DIR) + "/scenarios/thesis/calibration.toml", calibrationOut = "runs/calibration";
+  CLI::App* calibrateCommand = app.add_subcommand("calibrate", "the 32 calibration impacts of thesis 6.2.2.1: logged vs direct force");
+  calibrateCommand->add_option("scenario", calibrationFile, "base scenario (default scenarios/thesis/calibration.toml)");
+  calibrateCommand->add_option("--out", calibrationOut, "folder for calibration.csv");
+
   SweepOptions sweep;
   CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
   sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
@@ -153,6 +159,7 @@ int main(int argc, char** argv) {
     if (*check) return commandCheck(args);
     if (*benchCommand) return runBench(bench);
     if (*sweepCommand) return runSweep(sweep);
+    if (*calibrateCommand) return runCalibration(calibrationFile, calibrationOut, false) <= 0.02 ? 0 : 1;
     return commandInfo();
   } catch (const InputError& e) {
     std::fprintf(stderr, "gem: error: %s\n", e.what());
