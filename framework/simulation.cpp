@@ -187,7 +187,13 @@ void Simulation::narrowphase() {
   const int n = m_world.size();
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
   m_boxes.resize(n);
+  m_vertexPose.resize(n, Pose{-1, 0, 0, 0});
   for (int i = 0; i < n; ++i) {
+    // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
+    // vertices from an earlier step are still exact, so only bodies that moved are transformed.
+    const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
+    if (pose == m_vertexPose[i]) continue;
+    m_vertexPose[i] = pose;
     Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
     const int count = m_world.worldVertices(i, v);
     Box& box = m_boxes[i];

@@ -78,6 +78,12 @@ class Simulation final : public Stepper {
     Real x0, y0, x1, y1;
   };
   std::vector<Box> m_boxes;  // world-aligned bounding box of each body, this step
+  struct Pose {
+    std::int64_t id;
+    Real x, y, angle;
+    bool operator==(const Pose&) const = default;
+  };
+  std::vector<Pose> m_vertexPose;  // the pose m_worldVertices and m_boxes were computed for, by slot
   std::vector<CandidatePair> m_pairs;
   std::vector<int> m_contactA, m_contactB;
   std::vector<PairContact> m_contacts;
