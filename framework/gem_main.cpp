@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "framework/analyze.hpp"
 #include "framework/bench.hpp"
 #include "framework/calibration.hpp"
 #include "framework/errors.hpp"
@@ -140,6 +141,11 @@ int main(int argc, char** argv) {
   calibrateCommand->add_option("scenario", calibrationFile, "base scenario (default scenarios/thesis/calibration.toml)");
   calibrateCommand->add_option("--out", calibrationOut, "folder for calibration.csv");
 
+  AnalyzeOptions analyze;
+  CLI::App* analyzeCommand = app.add_subcommand("analyze", "impact-load statistics and plots of a run or sweep folder");
+  analyzeCommand->add_option("dir", analyze.dir, "run folder or sweep folder")->required();
+  analyzeCommand->add_flag("--quiet", analyze.quiet, "print nothing but errors");
+
   SweepOptions sweep;
   CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
   sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
@@ -159,6 +165,7 @@ int main(int argc, char** argv) {
     if (*check) return commandCheck(args);
     if (*benchCommand) return runBench(bench);
     if (*sweepCommand) return runSweep(sweep);
+    if (*analyzeCommand) return runAnalyze(analyze);
     if (*calibrateCommand) return runCalibration(calibrationFile, calibrationOut, false) <= 0.02 ? 0 : 1;
     return commandInfo();
   } catch (const InputError& e) {
