@@ -68,12 +68,13 @@ std::string summaryJson(const RunSummary& s) {
       "  \"floes_initial\": {},\n  \"floes_final\": {},\n  \"floes_broken\": {},\n"
       "  \"ice_mass_initial_kg\": {},\n  \"ice_mass_final_kg\": {},\n  \"rubble_mass_kg\": {},\n"
       "  \"impacts\": {},\n  \"ship_speed\": {},\n  \"impact_force_n\": {},\n  \"net_thrust_n\": {},\n"
-      "  \"resistance_mean_n\": {}\n}}\n",
+      "  \"resistance_mean_n\": {},\n  \"ship_speed_in_ice\": {},\n  \"resistance_in_ice_n\": {}\n}}\n",
       GEM_VERSION, s.steps, jsonNumber(s.simTime), jsonNumber(s.wallTime),
       jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY), s.backend, s.broadphase, s.device,
       s.floesInitial, s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial), jsonNumber(s.iceMassFinal),
       jsonNumber(s.rubbleMass), s.impacts, jsonStats(s.shipSpeed), jsonStats(s.impactForce), jsonStats(s.netThrust),
-      s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null");
+      s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null", jsonStats(s.shipSpeedInIce),
+      s.netThrustInIce.count ? jsonNumber(s.netThrustInIce.mean) : "null");
 }
 
 RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
@@ -104,7 +105,7 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   const VesselSpec& vessel = scenario.vessel;
   const Propulsion::Params thrust{vessel.bollardThrust,
                                   vessel.bollardThrust / (vessel.openWaterSpeed * vessel.openWaterSpeed * vessel.openWaterSpeed)};
-  Accumulator speed, force, netThrust;
+  Accumulator speed, force, netThrust, speedInIce, netThrustInIce;
   const auto start = std::chrono::steady_clock::now();
   auto lastProgress = start;
   auto writeFrames = [&]() {
@@ -130,6 +131,12 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
       if (vessel.present) {
         speed.add(surge);
         netThrust.add(Propulsion::netThrust(thrust, surge));
+        // The steady part of the transit (thesis 6.2.1.3): the whole hull inside the field's x range.
+        if (scenario.hasDomain && vessel.position.x - scenario.vessel.length / 2 >= scenario.domain.x0 &&
+            vessel.position.x + scenario.vessel.length / 2 <= scenario.domain.x1) {
+          speedInIce.add(surge);
+          netThrustInIce.add(Propulsion::netThrust(thrust, surge));
+        }
       }
       if ((k + 1) % out.timeseriesEvery == 0) {
         if (vessel.present)
@@ -174,6 +181,8 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   summary.shipSpeed = speed.stats();
   summary.impactForce = force.stats();
   summary.netThrust = netThrust.stats();
+  summary.shipSpeedInIce = speedInIce.stats();
+  summary.netThrustInIce = netThrustInIce.stats();
 
   timeseries.commit();
   impacts.commit();

@@ -27,6 +27,8 @@ struct RunSummary {
   double iceMassInitial = 0, iceMassFinal = 0, rubbleMass = 0;
   long impacts = 0, floesBroken = 0;
   Stats shipSpeed, impactForce, netThrust;
+  // Over the steady part of the transit: the whole hull within the domain's x range.
+  Stats shipSpeedInIce, netThrustInIce;
   std::string outputDir;
 };
 
