@@ -188,6 +188,11 @@ void readOutput(TableReader& t, Scenario& s) {
 
 }  // namespace
 
+const toml::table* Scenario::eventTable(const std::string& name) const {
+  const toml::table* events = root["events"].as_table();
+  return events ? (*events)[name].as_table() : nullptr;
+}
+
 Scenario loadScenario(const fs::path& file, const std::vector<std::string>& overrides) {
   Scenario s;
   s.fileName = file.string();
@@ -255,7 +260,7 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
         if (!b) top.failAt(*e, fmt::format("events.{}.enabled: expected true or false", name));
         enabled = *b;
       }
-      s.events[name] = Scenario::EventSetting{enabled, table};
+      s.events[name] = Scenario::EventSetting{enabled};
     }
   }
   if (const toml::array* plugins = top.findArray("plugins")) {

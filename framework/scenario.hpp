@@ -73,15 +73,18 @@ struct Scenario {
 
   VesselSpec vessel;
 
-  // [events.NAME]: enabled flag and the table of parameters (null when absent).
+  // [events.NAME] given in the scenario: its enabled flag. Its table is looked up in root by
+  // eventTable(), never stored as a pointer, so a copied Scenario stays self-contained.
   struct EventSetting {
     bool enabled;
-    const toml::table* table;
   };
   std::map<std::string, EventSetting> events;
 
   std::vector<PluginSpec> plugins;
   OutputSpec output;
+
+  // The [events.NAME] table of this scenario's root, or null when absent.
+  const toml::table* eventTable(const std::string& name) const;
 };
 
 // Reads and validates a scenario. overrides are "dotted.key=VALUE" (VALUE in TOML syntax; a bare

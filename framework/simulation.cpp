@@ -117,7 +117,7 @@ void Simulation::setUp() {
   m_broadphase = Registry::global().broadphase(m_scenario.broadphase).make(m_scenario.broadphaseSettings);
   for (const EventEntry* entry : Registry::global().events()) {
     auto it = m_scenario.events.find(entry->name);
-    const toml::table* table = it == m_scenario.events.end() ? nullptr : it->second.table;
+    const toml::table* table = m_scenario.eventTable(entry->name);
     const bool enabled = it == m_scenario.events.end() ? entry->enabledByDefault : it->second.enabled;
     TableReader reader(table, "events." + entry->name, m_scenario.fileName);
     reader.accept("enabled");

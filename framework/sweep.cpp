@@ -1,9 +1,224 @@
 #include "framework/sweep.hpp"
 
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "framework/atomic_file.hpp"
 #include "framework/errors.hpp"
+#include "framework/runner.hpp"
+#include "framework/scenario.hpp"
+#include "framework/sweep_file.hpp"
+#include "framework/sweep_summary.hpp"
+
+namespace fs = std::filesystem;
 
 namespace gem {
 
-int runSweep(const SweepOptions&) { throw InputError("gem sweep is not implemented yet"); }
+namespace {
+
+std::vector<std::string> overrideStrings(const SweepCase& c) {
+  std::vector<std::string> out;
+  for (const SweepOverride& o : c.overrides) out.push_back(o.key + "=" + o.toml);
+  return out;
+}
+
+// A case's scenario, writing into dir; its document made to stand on its own in dir: output.dir
+// = "." (the folder of its scenario.toml) and a field file given by its absolute path.
+Scenario loadCase(const SweepCase& c, const fs::path& dir) {
+  Scenario s = loadScenario(c.base, overrideStrings(c));
+  s.output.dir = dir;
+  if (!s.root.contains("output")) s.root.insert("output", toml::table{});
+  s.root.get("output")->as_table()->insert_or_assign("dir", ".");
+  if (s.fieldKind == "file") {
+    s.fieldFile = s.fieldFile.lexically_normal();
+    s.root.get("field")->as_table()->insert_or_assign("file", s.fieldFile.string());
+  }
+  return s;
+}
+
+// Loads a case as loadCase does; when its scenario is rejected, blames the sweep file's line for
+// the override at fault (found by trying each alone), or the base scenario's own line.
+Scenario validateCase(const SweepDefinition& sweep, const SweepCase& c, const fs::path& dir) {
+  const std::string where = fmt::format("case {} \"{}\"", &c - sweep.cases.data(), c.name);
+  try {
+    Scenario s = loadCase(c, dir);
+    if (s.fieldKind == "file" && !fs::is_regular_file(s.fieldFile)) {
+      int line = c.line, column = c.column;
+      for (const SweepOverride& o : c.overrides)
+        if (o.key == "field.file") line = o.line, column = o.column;
+      throw InputError(sweep.fileName, line, column, fmt::format("{}: no such field file: {}", where, s.fieldFile.string()));
+    }
+    return s;
+  } catch (const InputError& error) {
+    if (std::string(error.what()).rfind(sweep.fileName, 0) == 0) throw;  // already ours
+    loadScenario(c.base);  // a base that fails alone throws its own error (its file, line and column)
+    for (const SweepOverride& o : c.overrides) {
+      try {
+        loadScenario(c.base, {o.key + "=" + o.toml});
+      } catch (const InputError& alone) {
+        throw InputError(sweep.fileName, o.line, o.column, fmt::format("{}: {} = {}: {}", where, o.key, o.toml, alone.what()));
+      }
+    }
+    throw InputError(sweep.fileName, c.line, c.column, fmt::format("{}: {}", where, error.what()));
+  }
+}
+
+std::string scenarioText(const SweepDefinition& sweep, const SweepCase& c, const Scenario& s) {
+  std::ostringstream out;
+  out << "# Case \"" << c.name << "\" of the sweep " << sweep.file.string() << " (gem sweep)\n# base: " << c.base.string() << "\n";
+  for (const SweepOverride& o : c.overrides) out << "# set " << o.key << " = " << o.toml << "\n";
+  out << "\n" << toml::toml_formatter{s.root, toml::toml_formatter::default_flags & ~toml::format_flags::indentation} << "\n";
+  return out.str();
+}
+
+std::string readText(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::string formatDuration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  return s >= 3600 ? fmt::format("{}h{:02}m", s / 3600, (s / 60) % 60) : fmt::format("{}m{:02}s", s / 60, s % 60);
+}
+
+// What the workers share: the queue of cases to run and the tally.
+struct SweepState {
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::atomic<size_t> next{0};
+  size_t finished = 0, running = 0;
+  std::vector<std::pair<std::string, std::string>> failures;  // case name, message
+};
+
+}  // namespace
+
+int runSweep(const SweepOptions& options) {
+  const SweepDefinition sweep = readSweepFile(options.sweepFile);
+  const fs::path outDir = options.outDir.empty() ? sweep.file.parent_path() / "runs" / sweep.name
+                                                 : fs::absolute(options.outDir).lexically_normal();
+  const size_t count = sweep.cases.size();
+  if (options.caseIndex < -1 || options.caseIndex >= static_cast<long>(count))
+    throw InputError(fmt::format("--case-index {}: {} has {} cases (0 to {})", options.caseIndex, sweep.fileName, count, count - 1));
+
+  // Every case is loaded before any runs: a typo in the sweep fails now, not hours in.
+  std::vector<fs::path> dirs;
+  std::vector<std::string> texts;
+  for (const SweepCase& c : sweep.cases) {
+    dirs.push_back(outDir / "cases" / c.name);
+    texts.push_back(scenarioText(sweep, c, validateCase(sweep, c, dirs.back())));
+  }
+
+  std::vector<size_t> selected;
+  if (options.caseIndex >= 0) selected.push_back(static_cast<size_t>(options.caseIndex));
+  else
+    for (size_t i = 0; i < count; ++i) selected.push_back(i);
+  if (options.caseIndex >= 0) std::printf("%s\n", sweep.cases[selected[0]].name.c_str());
+
+  // Resume: complete cases whose scenario has not changed are skipped.
+  std::vector<size_t> todo;
+  size_t skipped = 0, stale = 0;
+  for (size_t i : selected) {
+    if (fs::exists(dirs[i] / "summary.json")) {
+      if (readText(dirs[i] / "scenario.toml") == texts[i]) {
+        ++skipped;
+        continue;
+      }
+      ++stale;
+    }
+    todo.push_back(i);
+  }
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const size_t jobs = std::min<size_t>(options.jobs > 0 ? static_cast<size_t>(options.jobs) : cores, std::max<size_t>(todo.size(), 1));
+  fs::create_directories(outDir / "cases");
+  const bool terminal = !options.quiet && isatty(fileno(stderr));
+  if (!options.quiet) {
+    std::printf("gem sweep %s: %zu case%s", sweep.name.c_str(), count, count == 1 ? "" : "s");
+    if (options.caseIndex >= 0) std::printf(", running case %ld only", options.caseIndex);
+    std::printf("; %zu to run on %zu thread%s", todo.size(), jobs, jobs == 1 ? "" : "s");
+    if (skipped) std::printf(", %zu already complete", skipped);
+    if (stale) std::printf(", %zu complete but changed since (run again)", stale);
+    std::printf("\n  folder %s\n", outDir.string().c_str());
+    std::fflush(stdout);
+  }
+
+  SweepState state;
+  const auto start = std::chrono::steady_clock::now();
+  auto worker = [&]() {
+    for (size_t k = state.next++; k < todo.size(); k = state.next++) {
+      const size_t i = todo[k];
+      const SweepCase& c = sweep.cases[i];
+      {
+        std::lock_guard lock(state.mutex);
+        ++state.running;
+      }
+      const auto caseStart = std::chrono::steady_clock::now();
+      std::string failure;
+      try {
+        Scenario s = loadCase(c, dirs[i]);
+        fs::create_directories(dirs[i]);
+        // The old summary goes first: a scenario.toml beside a summary of another scenario would
+        // pass for complete if this run failed before writing its own.
+        fs::remove(dirs[i] / "summary.json");
+        writeFileAtomically(dirs[i] / "scenario.toml", texts[i]);
+        RunOptions runOptions;
+        runOptions.quiet = true;
+        runScenario(s, runOptions);
+      } catch (const std::exception& e) {
+        failure = e.what();
+      } catch (...) {
+        failure = "unknown error";
+      }
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - caseStart).count();
+      std::lock_guard lock(state.mutex);
+      --state.running;
+      ++state.finished;
+      if (!failure.empty()) state.failures.emplace_back(c.name, failure);
+      if (!options.quiet && !terminal) {
+        if (failure.empty()) std::printf("  [%zu/%zu] %s  %.1f s\n", state.finished, todo.size(), c.name.c_str(), seconds);
+        else std::printf("  [%zu/%zu] %s  FAILED: %s\n", state.finished, todo.size(), c.name.c_str(), failure.c_str());
+        std::fflush(stdout);
+      }
+      state.changed.notify_all();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (size_t t = 0; t < jobs && t < todo.size(); ++t) threads.emplace_back(worker);
+  if (terminal && !todo.empty()) {
+    std::unique_lock lock(state.mutex);
+    while (state.finished < todo.size()) {
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double eta = state.finished ? elapsed / state.finished * (todo.size() - state.finished) : NAN;
+      std::fprintf(stderr, "\r  cases %zu/%zu done, %zu running%s, elapsed %s, ETA %s   ", state.finished, todo.size(),
+                   state.running, state.failures.empty() ? "" : fmt::format(", {} failed", state.failures.size()).c_str(),
+                   formatDuration(elapsed).c_str(), formatDuration(eta).c_str());
+      std::fflush(stderr);
+      state.changed.wait_for(lock, std::chrono::milliseconds(500));
+    }
+    std::fprintf(stderr, "\r  cases %zu/%zu done in %s%*s\n", state.finished, todo.size(),
+                 formatDuration(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()).c_str(), 30, "");
+  }
+  for (std::thread& t : threads) t.join();
+
+  const fs::path csv = outDir / "summary.csv";
+  const int rows = writeSweepSummary(sweep, csv, dirs);
+  for (const auto& [name, message] : state.failures)
+    std::fprintf(stderr, "gem sweep: case %s failed: %s\n", name.c_str(), message.c_str());
+  if (!options.quiet) std::printf("  summary %s (%d of %zu cases complete)\n", csv.string().c_str(), rows, count);
+  return state.failures.empty() ? 0 : 1;
+}
 
 }  // namespace gem

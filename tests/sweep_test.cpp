@@ -1,0 +1,357 @@
+// gem sweep (issue 5, item 1): expansion of a sweep file into cases, the run folders and their
+// scenarios, resume, --case-index, the gathered summary.csv, bad sweep files and failing cases.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "framework/errors.hpp"
+#include "framework/runner.hpp"
+#include "framework/sweep.hpp"
+#include "framework/sweep_file.hpp"
+#include "framework/sweep_summary.hpp"
+#include "test_support.hpp"
+
+using namespace gem;
+using gem::test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A tiny channel: 20 floes, a small vessel entering them; milliseconds per run.
+const char* kBase = R"(
+[simulation]
+dt = 0.1
+steps = 40
+seed = 2
+[domain]
+x = [0.0, 60.0]
+y = [-20.0, 20.0]
+walls = true
+[field]
+kind = "random_convex"
+count = 20
+concentration = 0.3
+size_mean = 4.0
+size_sd = 1.0
+size_min = 2.0
+size_max = 7.0
+thickness = 0.5
+[vessel]
+length = 30.0
+beam = 8.0
+mass = 5e5
+position = [-16.0, 0.0]
+bollard_thrust = 92e3
+[output]
+frame_every = 0
+)";
+
+const char* kProduct = R"([sweep]
+base = "base.toml"
+set = { "simulation.steps" = 30 }
+[parameters]
+"vessel.bollard_thrust" = [46e3, 92e3]
+field.concentration = [0.25, 0.3]
+)";
+
+std::vector<std::string> lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+// Splits one CSV line, honouring quoted fields.
+std::vector<std::string> csvCells(const std::string& line) {
+  std::vector<std::string> cells(1);
+  bool quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') cells.back() += '"', ++i;
+    else if (c == '"') quoted = !quoted;
+    else if (c == ',' && !quoted) cells.emplace_back();
+    else cells.back() += c;
+  }
+  return cells;
+}
+
+int sweep(const fs::path& file, const fs::path& out, int jobs = 2, long caseIndex = -1) {
+  SweepOptions o;
+  o.sweepFile = file.string();
+  o.outDir = out.string();
+  o.jobs = jobs;
+  o.caseIndex = caseIndex;
+  o.quiet = true;
+  return runSweep(o);
+}
+
+const std::string kHeaderTail =
+    "impacts,ship_speed_min,ship_speed_mean,ship_speed_max,impact_force_min,impact_force_mean,impact_force_max,"
+    "resistance_mean,wall_time_s,ship_speed_in_ice_mean,resistance_in_ice_mean";
+
+}  // namespace
+
+TEST(SweepFile, ProductExpandsFirstParameterSlowest) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const SweepDefinition def = readSweepFile(dir.write("study.toml", kProduct));
+  EXPECT_EQ(def.name, "study");
+  EXPECT_EQ(def.columns, (std::vector<std::string>{"vessel.bollard_thrust", "field.concentration"}));
+  ASSERT_EQ(def.cases.size(), 4u);
+  EXPECT_EQ(def.cases[0].name, "bollard_thrust=46000,concentration=0.25");
+  EXPECT_EQ(def.cases[1].name, "bollard_thrust=46000,concentration=0.3");
+  EXPECT_EQ(def.cases[2].name, "bollard_thrust=92000,concentration=0.25");
+  EXPECT_EQ(def.cases[3].name, "bollard_thrust=92000,concentration=0.3");
+  EXPECT_EQ(sweepCell(def.cases[2], "vessel.bollard_thrust"), "92000");
+  EXPECT_EQ(sweepCell(def.cases[2], "simulation.steps"), "");  // sweep.set is common, not a column
+  ASSERT_EQ(def.cases[3].overrides.size(), 3u);
+  EXPECT_EQ(def.cases[3].overrides[0].key, "simulation.steps");
+  EXPECT_EQ(def.cases[3].overrides[0].toml, "30");  // integers stay integers
+  EXPECT_EQ(def.cases[3].base, fs::absolute(dir.path() / "base.toml").lexically_normal());
+}
+
+TEST(SweepFile, CasesTimesParametersAndNonScalarValues) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  dir.write("other.toml", kBase);
+  const SweepDefinition def = readSweepFile(dir.write("s.toml", R"([sweep]
+name = "mix"
+base = "base.toml"
+[parameters]
+"events.wind.force" = [1.0, 2.0]
+"events.current.force" = [0.5]
+"field.groups" = [[{ coverage = 0.1, thickness = 1.2 }], [{ coverage = 0.2, thickness = 0.5 }]]
+[[cases]]
+name = "001_46"
+set = { "vessel.bollard_thrust" = 46e3 }
+[[cases]]
+name = "b"
+base = "other.toml"
+)"));
+  EXPECT_EQ(def.name, "mix");
+  ASSERT_EQ(def.cases.size(), 8u);
+  // Two parameters end in "force": their full keys name them.
+  EXPECT_EQ(def.cases[0].name, "001_46,events.wind.force=1,events.current.force=0.5,groups#0");
+  EXPECT_EQ(def.cases[7].name, "b,events.wind.force=2,events.current.force=0.5,groups#1");
+  EXPECT_EQ(def.cases[7].base.filename(), "other.toml");
+  EXPECT_EQ(def.columns.back(), "vessel.bollard_thrust");
+  EXPECT_EQ(sweepCell(def.cases[0], "vessel.bollard_thrust"), "46000");
+  EXPECT_EQ(sweepCell(def.cases[7], "vessel.bollard_thrust"), "");
+}
+
+TEST(Sweep, RunsEveryCaseWritesScenariosAndGathers) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("study.toml", kProduct);
+  const fs::path out = dir.path() / "out";
+  ASSERT_EQ(sweep(file, out), 0);
+
+  const fs::path caseDir = out / "cases" / "bollard_thrust=46000,concentration=0.3";
+  ASSERT_TRUE(fs::exists(caseDir / "summary.json"));
+  // The case's scenario is the whole base with its overrides, and runs where it lies.
+  const toml::table written = toml::parse_file((caseDir / "scenario.toml").string());
+  EXPECT_EQ(written["vessel"]["bollard_thrust"].value<double>(), 46e3);
+  EXPECT_EQ(written["field"]["concentration"].value<double>(), 0.3);
+  EXPECT_EQ(written["simulation"]["steps"].value<int64_t>(), 30);
+  EXPECT_EQ(written["vessel"]["mass"].value<double>(), 5e5);
+  const Scenario reloaded = loadScenario(caseDir / "scenario.toml");
+  EXPECT_EQ(reloaded.output.dir.lexically_normal(), fs::absolute(caseDir).lexically_normal() / "");
+
+  const std::vector<std::string> csv = lines(out / "summary.csv");
+  ASSERT_EQ(csv.size(), 5u);
+  EXPECT_EQ(csv[0], "name,vessel.bollard_thrust,field.concentration," + kHeaderTail);
+  const std::vector<std::string> row = csvCells(csv[2]);
+  ASSERT_EQ(row.size(), 14u);
+  EXPECT_EQ(row[0], "bollard_thrust=46000,concentration=0.3");
+  EXPECT_EQ(row[1], "46000");
+  EXPECT_EQ(row[2], "0.3");
+  const auto summary = readSummaryJson(caseDir / "summary.json");
+  EXPECT_EQ(row[3], summary.at("impacts"));
+  EXPECT_EQ(row[5], summary.at("ship_speed.mean"));
+  EXPECT_EQ(row[10], summary.at("resistance_mean_n"));
+  EXPECT_GT(std::stod(row[10]), 0);  // the ice slows the vessel: a positive mean net thrust
+  EXPECT_EQ(row[13], summary.at("resistance_in_ice_n"));
+}
+
+TEST(Sweep, ThreadsDoNotChangeResults) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("study.toml", kProduct);
+  ASSERT_EQ(sweep(file, dir.path() / "one", 1), 0);
+  ASSERT_EQ(sweep(file, dir.path() / "four", 4), 0);
+  const auto a = lines(dir.path() / "one" / "summary.csv"), b = lines(dir.path() / "four" / "summary.csv");
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    auto ca = csvCells(a[i]), cb = csvCells(b[i]);
+    ca.erase(ca.begin() + 11), cb.erase(cb.begin() + 11);  // wall_time_s differs
+    EXPECT_EQ(ca, cb);
+  }
+}
+
+TEST(Sweep, ResumeRunsOnlyIncompleteOrChangedCases) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("study.toml", kProduct);
+  const fs::path out = dir.path() / "out";
+  ASSERT_EQ(sweep(file, out), 0);
+  std::vector<fs::path> summaries;
+  for (const auto& entry : fs::directory_iterator(out / "cases")) summaries.push_back(entry.path() / "summary.json");
+  std::sort(summaries.begin(), summaries.end());
+  ASSERT_EQ(summaries.size(), 4u);
+  std::vector<fs::file_time_type> times;
+  for (const auto& s : summaries) times.push_back(fs::last_write_time(s));
+  fs::remove(summaries[1]);
+  fs::remove(out / "summary.csv");
+
+  ASSERT_EQ(sweep(file, out), 0);
+  for (size_t i = 0; i < summaries.size(); ++i) {
+    ASSERT_TRUE(fs::exists(summaries[i]));
+    if (i != 1) {
+      EXPECT_EQ(fs::last_write_time(summaries[i]), times[i]) << summaries[i] << " ran again";
+    }
+  }
+  EXPECT_EQ(lines(out / "summary.csv").size(), 5u);
+
+  // A changed sweep makes the complete cases stale: they run again with the new scenario.
+  std::string text = kProduct;
+  text.replace(text.find("= 30"), 4, "= 31");
+  dir.write("study.toml", text);
+  ASSERT_EQ(sweep(file, out), 0);
+  for (const auto& s : summaries) EXPECT_EQ(readSummaryJson(s).at("steps"), "31");
+}
+
+TEST(Sweep, CaseIndexRunsExactlyOne) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("study.toml", kProduct);
+  const fs::path out = dir.path() / "out", log = dir.path() / "log.txt";
+  ASSERT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --case-index 2", log), 0) << test::readFile(log);
+  EXPECT_NE(test::readFile(log).find("bollard_thrust=92000,concentration=0.25"), std::string::npos);
+  int complete = 0;
+  for (const auto& entry : fs::directory_iterator(out / "cases")) complete += fs::exists(entry.path() / "summary.json");
+  EXPECT_EQ(complete, 1);
+  EXPECT_TRUE(fs::exists(out / "cases" / "bollard_thrust=92000,concentration=0.25" / "summary.json"));
+  EXPECT_EQ(lines(out / "summary.csv").size(), 2u);
+  EXPECT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --case-index 4", log), 2);
+}
+
+TEST(Sweep, DefaultFolderIsBesideTheSweepFile) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("study.toml", R"([sweep]
+name = "named"
+base = "base.toml"
+[[cases]]
+name = "only"
+set = { "simulation.steps" = 5 }
+)");
+  ASSERT_EQ(sweep(file, ""), 0);
+  EXPECT_TRUE(fs::exists(dir.path() / "runs" / "named" / "cases" / "only" / "summary.json"));
+  EXPECT_EQ(lines(dir.path() / "runs" / "named" / "summary.csv")[0], "name,simulation.steps," + kHeaderTail);
+}
+
+TEST(Sweep, FieldFileStaysValidInTheCaseScenario) {
+  TempDir dir;
+  // A .ice field beside a base in a sub-folder: the case's scenario.toml must still find it.
+  fs::create_directories(dir.path() / "fields");
+  {
+    Scenario s = loadScenario(dir.write("gen.toml", kBase), {"simulation.steps=1", "output.frame_every=1", "output.formats=[\"ice\"]"});
+    s.output.dir = dir.path() / "gen";
+    runScenario(s, RunOptions{true, false});
+  }
+  fs::copy_file(dir.path() / "gen" / "frames.ice", dir.path() / "fields" / "pack.ice");
+  dir.write("fields/base.toml", "[simulation]\ndt = 0.1\nsteps = 5\n[field]\nkind = \"file\"\nfile = \"pack.ice\"\n"
+                               "[vessel]\nlength = 30.0\nbeam = 8.0\nmass = 5e5\nposition = [-16.0, 0.0]\n[output]\nframe_every = 0\n");
+  const fs::path file = dir.write("s.toml", "[sweep]\nbase = \"fields/base.toml\"\n[[cases]]\nname = \"a\"\n");
+  ASSERT_EQ(sweep(file, dir.path() / "out"), 0);
+  const fs::path scenario = dir.path() / "out" / "cases" / "a" / "scenario.toml";
+  const toml::table written = toml::parse_file(scenario.string());
+  EXPECT_EQ(fs::path(*written["field"]["file"].value<std::string>()), (dir.path() / "fields" / "pack.ice").lexically_normal());
+  EXPECT_NO_THROW(loadScenario(scenario));
+}
+
+TEST(Sweep, FailingCaseExitsOneAndOthersAreGathered) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  // "bad" puts a floe on the vessel: valid input, refused when the run builds its world.
+  const fs::path file = dir.write("study.toml", R"([sweep]
+base = "base.toml"
+set = { "simulation.steps" = 10 }
+[[cases]]
+name = "good"
+[[cases]]
+name = "bad"
+set = { floes = [{ vertices = [[-20.0, -2.0], [-10.0, -2.0], [-10.0, 2.0], [-20.0, 2.0]] }] }
+[[cases]]
+name = "also_good"
+set = { "vessel.bollard_thrust" = 46e3 }
+)");
+  const fs::path out = dir.path() / "out", log = dir.path() / "log.txt";
+  ASSERT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --jobs 2", log), 1);
+  EXPECT_NE(test::readFile(log).find("case bad failed"), std::string::npos) << test::readFile(log);
+  const auto csv = lines(out / "summary.csv");
+  ASSERT_EQ(csv.size(), 3u);
+  EXPECT_EQ(csvCells(csv[1])[0], "good");
+  EXPECT_EQ(csvCells(csv[2])[0], "also_good");
+  EXPECT_FALSE(fs::exists(out / "cases" / "bad" / "summary.json"));
+}
+
+TEST(SweepSummary, ReadsGemJson) {
+  TempDir dir;
+  const auto s = readSummaryJson(dir.write("summary.json", R"({"steps": 3, "backend": "cpu", "ship_speed": {"min": 1.5, "mean": null},
+ "list": [1, {"a": 2}], "ok": true})"));
+  EXPECT_EQ(s.at("steps"), "3");
+  EXPECT_EQ(s.at("backend"), "cpu");
+  EXPECT_EQ(s.at("ship_speed.min"), "1.5");
+  EXPECT_EQ(s.at("ship_speed.mean"), "");
+  EXPECT_EQ(s.at("ok"), "true");
+  EXPECT_THROW(readSummaryJson(dir.write("bad.json", "{\"a\": }")), std::runtime_error);
+}
+
+// Bad sweep files: exit 2 through the real binary, naming the sweep file's line and column.
+struct BadSweep {
+  const char* name;
+  std::string toml;
+  std::vector<std::string> expected;
+};
+void PrintTo(const BadSweep& b, std::ostream* os) { *os << b.name; }
+
+class SweepBadInput : public ::testing::TestWithParam<BadSweep> {};
+
+TEST_P(SweepBadInput, ExitsTwoNamingTheLine) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("bad_sweep.toml", GetParam().toml), log = dir.path() / "log.txt";
+  EXPECT_EQ(test::runGem("sweep " + file.string() + " --out " + (dir.path() / "out").string(), log), 2);
+  const std::string message = test::readFile(log);
+  for (const std::string& e : GetParam().expected) EXPECT_NE(message.find(e), std::string::npos) << "missing \"" << e << "\" in: " << message;
+  EXPECT_FALSE(fs::exists(dir.path() / "out" / "cases"));  // nothing ran
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    SweepFiles, SweepBadInput,
+    ::testing::Values(
+        BadSweep{"missing_base", "[sweep]\nname = \"x\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n", {"bad_sweep.toml:1:1", "sweep.base: missing"}},
+        BadSweep{"no_such_base", "[sweep]\nbase = \"nope.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n", {"bad_sweep.toml:2:8", "nope.toml"}},
+        BadSweep{"unknown_sweep_key", "[sweep]\nbase = \"base.toml\"\njobs = 3\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n", {"bad_sweep.toml:3:", "sweep.jobs"}},
+        BadSweep{"unknown_top_key", "[sweep]\nbase = \"base.toml\"\n[parameter]\n\"vessel.bollard_thrust\" = [1.0]\n", {"bad_sweep.toml:3:", "parameter"}},
+        BadSweep{"empty_list", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = []\n", {"bad_sweep.toml:4:", "empty"}},
+        BadSweep{"not_a_list", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = 5.0\n", {"bad_sweep.toml:4:", "expected a list"}},
+        BadSweep{"typo_in_varied_key", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"field.concentration\" = [0.2]\n\"vessel.bolard_thrust\" = [1.0, 2.0]\n",
+                 {"bad_sweep.toml:5:", "vessel.bolard_thrust", "unknown key"}},
+        BadSweep{"value_out_of_range", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"field.concentration\" = [0.2, -0.1]\n",
+                 {"bad_sweep.toml:4:", "case 1", "must be positive"}},
+        BadSweep{"bad_case_set", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n[[cases]]\nname = \"b\"\nset = { \"simulation.dt\" = \"fast\" }\n",
+                 {"bad_sweep.toml:7:", "case 1 \"b\"", "simulation.dt"}},
+        BadSweep{"case_without_name", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nset = { \"simulation.dt\" = 0.05 }\n", {"bad_sweep.toml:3:", "name"}},
+        BadSweep{"duplicate_case", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n[[cases]]\nname = \"a\"\n", {"bad_sweep.toml:5:", "two cases"}},
+        BadSweep{"unsafe_case_name", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"../x\"\n", {"bad_sweep.toml:4:", "name"}},
+        BadSweep{"nothing_to_run", "[sweep]\nbase = \"base.toml\"\n", {"bad_sweep.toml", "[parameters]"}},
+        BadSweep{"toml_syntax", "[sweep]\nbase = \"base.toml\"\n[parameters]\nx = [1\n", {"bad_sweep.toml:4:"}},
+        BadSweep{"varied_in_set_and_parameters",
+                 "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n[[cases]]\nname = \"a\"\nset = { vessel.bollard_thrust = 2.0 }\n",
+                 {"bad_sweep.toml:7:", "also varied"}}),
+    [](const auto& info) { return std::string(info.param.name); });
