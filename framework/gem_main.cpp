@@ -144,6 +144,7 @@ int main(int argc, char** argv) {
   AnalyzeOptions analyze;
   CLI::App* analyzeCommand = app.add_subcommand("analyze", "impact-load statistics and plots of a run or sweep folder");
   analyzeCommand->add_option("dir", analyze.dir, "run folder or sweep folder")->required();
+  analyzeCommand->add_option("--groups", analyze.groups, "case-name prefixes to analyse, e.g. 121,004,040,400")->delimiter(',');
   analyzeCommand->add_flag("--quiet", analyze.quiet, "print nothing but errors");
 
   SweepOptions sweep;
