@@ -1,5 +1,7 @@
 #include "framework/analyze.hpp"
 
+#include "framework/resistance_analysis.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -428,6 +430,9 @@ int runAnalyze(const AnalyzeOptions& options) {
       else ++incomplete;
     }
   }
+  // A resistance sweep (cases "FIELD,bollard_thrust=T") also gets its resistance analysis.
+  const bool resistance = sweep && analyzeResistance(dir, options.quiet);
+  if (runs.empty() && resistance) return 0;
   if (runs.empty())
     throw InputError(fmt::format("{}: no impacts.csv here and none in cases/*/: not a run folder or a sweep folder with a finished "
                                  "case",

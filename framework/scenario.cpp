@@ -90,6 +90,7 @@ void readField(TableReader& t, Scenario& s) {
     r.sizeMax = t.getPositive("size_max", r.sizeMax);
     r.minSides = static_cast<int>(t.getInt("min_sides", r.minSides, 3, kMaxFloeVertices));
     r.maxSides = static_cast<int>(t.getInt("max_sides", r.maxSides, 3, kMaxFloeVertices));
+    r.maxAspect = t.getPositive("max_aspect", r.maxAspect);
     r.seed = s.seed;
     if (const toml::array* groups = t.findArray("groups")) {
       for (size_t g = 0; g < groups->size(); ++g) {

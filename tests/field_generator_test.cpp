@@ -205,17 +205,17 @@ TEST(HexagonField, RotationsBreakTheSymmetry) {
   HexagonFieldSpec spec;
   spec.domain = kChannel;
   const auto floes = generateHexagonField(spec);
-  std::map<long, int> angles;  // edge direction of the first edge, in 0.1 degree steps
+  std::map<long, int> angles;  // direction of the first edge, in 0.001 degree steps
   for (const BodySpec& b : floes) {
     const Vec2 e = b.vertices[1] - b.vertices[0];
-    ++angles[std::lround(std::atan2(e.y, e.x) * 1800 / kPi)];
+    ++angles[std::lround(std::atan2(e.y, e.x) * 180000 / kPi)];
   }
   EXPECT_GT(angles.size(), floes.size() / 4);
   spec.rotationJitterDeg = 0;
   angles.clear();
   for (const BodySpec& b : generateHexagonField(spec)) {
     const Vec2 e = b.vertices[1] - b.vertices[0];
-    ++angles[std::lround(std::atan2(e.y, e.x) * 1800 / kPi)];
+    ++angles[std::lround(std::atan2(e.y, e.x) * 180000 / kPi)];
   }
   EXPECT_EQ(angles.size(), 1u);
 }
@@ -400,33 +400,18 @@ TEST(FieldGenerator, BadSpecsNameTheirKey) {
   badHex([](HexagonFieldSpec& s) { s.concentration = Real(0.89), s.minGap = 2; }, "field.concentration");
 }
 
-// ---------------------------------------------------------------------------------------------
-// Slow checks, not run by default (--gtest_also_run_disabled_tests): many seeds and
-// concentrations, and the 10^6-floe field of the GPU benchmarks with its time.
-TEST(FieldGenerator, DISABLED_ManySeedsAndConcentrations) {
+// Many concentrations, a few seeds each: every field valid and at its concentration.
+TEST(FieldGenerator, ManySeedsAndConcentrations) {
   for (double c : {0.05, 0.2, 0.35, 0.5, 0.69, 0.75, 0.8, 0.85})
-    for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
       RandomFieldSpec spec;
-      spec.domain = {0, 300, -60, 60};
+      spec.domain = {0, 150, -40, 40};
       spec.concentration = Real(c);
       spec.seed = seed;
       const auto floes = generateRandomConvexField(spec);
       EXPECT_NEAR(statsOf(floes, spec.domain).concentration, c, 0.01) << "c " << c << " seed " << seed;
       expectValidField(floes, spec.domain, spec.minGap);
     }
-}
-
-TEST(FieldGenerator, DISABLED_MillionFloes) {
-  RandomFieldSpec spec;
-  const double side = std::sqrt(1e6 * (6.9 * 6.9 + 3.9 * 3.9) / 0.4);
-  spec.domain = {0, Real(side), 0, Real(side)};
-  const auto start = std::chrono::steady_clock::now();
-  const auto floes = generateRandomConvexField(spec);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const FieldStats s = statsOf(floes, spec.domain);
-  printStats("10^6 floes", s);
-  std::printf("[ field    ] 10^6 floes generated in %.2f s\n", seconds);
-  expectValidField(floes, spec.domain, spec.minGap);
 }
 
 }  // namespace
