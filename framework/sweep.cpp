@@ -1,5 +1,7 @@
 #include "framework/sweep.hpp"
 
+#include "framework/mpi_work.hpp"
+
 #include <unistd.h>
 
 #include <atomic>
@@ -107,6 +109,7 @@ struct SweepState {
 }  // namespace
 
 int runSweep(const SweepOptions& options) {
+  MpiWork mpi;  // under mpirun: this rank's share of the world; finalised when the sweep returns
   const SweepDefinition sweep = readSweepFile(options.sweepFile);
   const fs::path outDir = options.outDir.empty() ? sweep.file.parent_path() / "runs" / sweep.name
                                                  : fs::absolute(options.outDir).lexically_normal();
@@ -141,14 +144,18 @@ int runSweep(const SweepOptions& options) {
     }
     todo.push_back(i);
   }
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  // Every rank must see the same list before any of them starts changing case folders.
+  mpi.sumOverRanks(0);
+  // Under MPI a rank runs one case at a time unless --jobs says otherwise (one rank per core).
+  const unsigned cores = mpi.active() ? 1u : std::max(1u, std::thread::hardware_concurrency());
   const size_t jobs = std::min<size_t>(options.jobs > 0 ? static_cast<size_t>(options.jobs) : cores, std::max<size_t>(todo.size(), 1));
   fs::create_directories(outDir / "cases");
   const bool terminal = !options.quiet && isatty(fileno(stderr));
-  if (!options.quiet) {
+  if (!options.quiet && mpi.rank() == 0) {
     std::printf("gem sweep %s: %zu case%s", sweep.name.c_str(), count, count == 1 ? "" : "s");
     if (options.caseIndex >= 0) std::printf(", running case %ld only", options.caseIndex);
-    std::printf("; %zu to run on %zu thread%s", todo.size(), jobs, jobs == 1 ? "" : "s");
+    if (mpi.active()) std::printf("; %zu to run on %d MPI ranks x %zu thread%s", todo.size(), mpi.size(), jobs, jobs == 1 ? "" : "s");
+    else std::printf("; %zu to run on %zu thread%s", todo.size(), jobs, jobs == 1 ? "" : "s");
     if (skipped) std::printf(", %zu already complete", skipped);
     if (stale) std::printf(", %zu complete but changed since (run again)", stale);
     std::printf("\n  folder %s\n", outDir.string().c_str());
@@ -157,8 +164,11 @@ int runSweep(const SweepOptions& options) {
 
   SweepState state;
   const auto start = std::chrono::steady_clock::now();
+  // Under mpirun the ranks share one counter (cases go to whichever rank is free); alone, the
+  // threads of this process share theirs.
+  auto claim = [&]() { return mpi.active() ? mpi.next(todo.size()) : state.next++; };
   auto worker = [&]() {
-    for (size_t k = state.next++; k < todo.size(); k = state.next++) {
+    for (size_t k = claim(); k < todo.size(); k = claim()) {
       const size_t i = todo[k];
       const SweepCase& c = sweep.cases[i];
       {
@@ -188,8 +198,9 @@ int runSweep(const SweepOptions& options) {
       ++state.finished;
       if (!failure.empty()) state.failures.emplace_back(c.name, failure);
       if (!options.quiet && !terminal) {
-        if (failure.empty()) std::printf("  [%zu/%zu] %s  %.1f s\n", state.finished, todo.size(), c.name.c_str(), seconds);
-        else std::printf("  [%zu/%zu] %s  FAILED: %s\n", state.finished, todo.size(), c.name.c_str(), failure.c_str());
+        const std::string who = mpi.active() ? fmt::format("rank {} ", mpi.rank()) : std::string();
+        if (failure.empty()) std::printf("  %s[%zu/%zu] %s  %.1f s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), seconds);
+        else std::printf("  %s[%zu/%zu] %s  FAILED: %s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), failure.c_str());
         std::fflush(stdout);
       }
       state.changed.notify_all();
@@ -197,7 +208,7 @@ int runSweep(const SweepOptions& options) {
   };
   std::vector<std::thread> threads;
   for (size_t t = 0; t < jobs && t < todo.size(); ++t) threads.emplace_back(worker);
-  if (terminal && !todo.empty()) {
+  if (terminal && !todo.empty() && !mpi.active()) {
     std::unique_lock lock(state.mutex);
     while (state.finished < todo.size()) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -213,12 +224,15 @@ int runSweep(const SweepOptions& options) {
   }
   for (std::thread& t : threads) t.join();
 
-  const fs::path csv = outDir / "summary.csv";
-  const int rows = writeSweepSummary(sweep, csv, dirs);
+  // Under MPI every rank waits for all; rank 0 alone gathers the table.
+  const long failures = mpi.sumOverRanks(static_cast<long>(state.failures.size()));
   for (const auto& [name, message] : state.failures)
     std::fprintf(stderr, "gem sweep: case %s failed: %s\n", name.c_str(), message.c_str());
+  if (mpi.rank() != 0) return failures == 0 ? 0 : 1;
+  const fs::path csv = outDir / "summary.csv";
+  const int rows = writeSweepSummary(sweep, csv, dirs);
   if (!options.quiet) std::printf("  summary %s (%d of %zu cases complete)\n", csv.string().c_str(), rows, count);
-  return state.failures.empty() ? 0 : 1;
+  return failures == 0 ? 0 : 1;
 }
 
 }  // namespace gem
