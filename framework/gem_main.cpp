@@ -15,6 +15,7 @@
 #include "framework/bench.hpp"
 #include "framework/calibration.hpp"
 #include "framework/errors.hpp"
+#include "framework/plugin_loader.hpp"
 #include "framework/registry.hpp"
 #include "framework/runner.hpp"
 #include "framework/scenario.hpp"
@@ -89,21 +90,37 @@ int commandCheck(const RunArguments& a) {
   return 0;
 }
 
-int commandInfo() {
+// An entry's origin: "built-in", or for a plugin's "PATH (NAME VERSION)" on a line of its own.
+std::string originColumn(const std::string& origin) { return origin == "built-in" ? origin : "plugin"; }
+void printPluginOrigin(const std::string& origin) {
+  if (origin != "built-in") std::printf("  %-18s from %s\n", "", origin.c_str());
+}
+
+int commandInfo(const std::vector<std::string>& plugins) {
+  loadEnvironmentPlugins();
+  for (const std::string& p : plugins) loadPlugin(p);
   std::printf("GEM %s (GPU Event Mechanics)\n", GEM_VERSION);
   const BackendEntry* cuda = findBackend("cuda");
   std::printf("build: real type %s, backends: %s%s\n", sizeof(Real) == 8 ? "double" : "float",
               fmt::format("{}", fmt::join(backendNames(), ", ")).c_str(),
               cuda ? ", CUDA architectures " GEM_CUDA_ARCHITECTURES : " (no CUDA backend in this build)");
+  std::printf("plugin ABI: version %d, compiler %s %s\n", GEM_PLUGIN_ABI_VERSION, GEM_COMPILER_ID, GEM_COMPILER_VERSION);
   std::printf("devices: cpu");
   if (cuda) std::printf(", %s", cuda->available() ? cuda->deviceName().c_str() : "no CUDA device found");
   std::printf("\n\nevents (phase, default, origin):\n");
-  for (const EventEntry* e : Registry::global().events())
+  for (const EventEntry* e : Registry::global().events()) {
     std::printf("  %-18s %-9s %-4s %-9s %s\n", e->name.c_str(), eventPhaseName(e->phase), e->enabledByDefault ? "on" : "off",
-                e->origin.c_str(), e->description.c_str());
+                originColumn(e->origin).c_str(), e->description.c_str());
+    printPluginOrigin(e->origin);
+  }
   std::printf("\nbroadphases (origin):\n");
-  for (const BroadphaseEntry* b : Registry::global().broadphases())
-    std::printf("  %-18s %-9s %s\n", b->name.c_str(), b->origin.c_str(), b->description.c_str());
+  for (const BroadphaseEntry* b : Registry::global().broadphases()) {
+    std::printf("  %-18s %-9s %s\n", b->name.c_str(), originColumn(b->origin).c_str(), b->description.c_str());
+    printPluginOrigin(b->origin);
+  }
+  const std::vector<LoadedPlugin> loaded = loadedPlugins();
+  std::printf("\nplugins loaded: %s\n", loaded.empty() ? "none (GEM_PLUGIN_PATH, [[plugins]] or gem info --plugin PATH)" : "");
+  for (const LoadedPlugin& p : loaded) std::printf("  %-18s %-9s %s\n", p.name.c_str(), p.version.c_str(), p.path.c_str());
   return 0;
 }
 
@@ -128,7 +145,9 @@ int main(int argc, char** argv) {
   CLI::App* check = app.add_subcommand("check", "load and validate a scenario without running it");
   addRunOptions(check);
   check->add_flag("--quiet", args.quiet, "print nothing when the scenario is valid");
-  app.add_subcommand("info", "version, build, devices, registered events and broadphases");
+  std::vector<std::string> infoPlugins;
+  CLI::App* info = app.add_subcommand("info", "version, build, devices, registered events and broadphases");
+  info->add_option("--plugin", infoPlugins, "load this plugin first (repeatable); GEM_PLUGIN_PATH's are loaded too");
   BenchOptions bench;
   CLI::App* benchCommand = app.add_subcommand("bench", "time the CPU backend per step on the thesis fields");
   benchCommand->add_option("--steps", bench.steps, "steps timed per case");
@@ -162,13 +181,16 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   try {
+    // GEM_PLUGIN_PATH's plugins, for every command: a scenario, gem bench --broadphase or gem info
+    // may name what they add.
+    loadEnvironmentPlugins();
     if (*run) return commandRun(args);
     if (*check) return commandCheck(args);
     if (*benchCommand) return runBench(bench);
     if (*sweepCommand) return runSweep(sweep);
     if (*analyzeCommand) return runAnalyze(analyze);
     if (*calibrateCommand) return runCalibration(calibrationFile, calibrationOut, false) <= 0.02 ? 0 : 1;
-    return commandInfo();
+    return commandInfo(infoPlugins);
   } catch (const InputError& e) {
     std::fprintf(stderr, "gem: error: %s\n", e.what());
     return 2;

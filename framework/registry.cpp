@@ -22,15 +22,61 @@ Registry& Registry::global() {
 }
 
 void Registry::addEvent(EventEntry entry) {
+  if (m_staging) {
+    entry.origin = m_staging->origin;
+    m_staging->events.push_back(std::move(entry));
+    return;
+  }
   auto [it, inserted] = m_events.emplace(entry.name, entry);
   if (!inserted)
     throw InputError(fmt::format("event \"{}\" from {} clashes with the one from {}", entry.name, entry.origin, it->second.origin));
 }
 
 void Registry::addBroadphase(BroadphaseEntry entry) {
+  if (m_staging) {
+    entry.origin = m_staging->origin;
+    m_staging->broadphases.push_back(std::move(entry));
+    return;
+  }
   auto [it, inserted] = m_broadphases.emplace(entry.name, entry);
   if (!inserted)
     throw InputError(fmt::format("broadphase \"{}\" from {} clashes with the one from {}", entry.name, entry.origin, it->second.origin));
+}
+
+void Registry::beginPlugin(const std::string& origin, bool allowOverride) {
+  m_staging = std::make_unique<Staging>();
+  m_staging->origin = origin;
+  m_staging->allowOverride = allowOverride;
+}
+
+void Registry::abortPlugin() { m_staging.reset(); }
+
+namespace {
+
+// A clash of a plugin's entry with one already there (or with another of its own entries).
+template <class Entry>
+void checkClashes(const char* kind, const std::vector<Entry>& staged, const std::map<std::string, Entry>& table, bool allowOverride) {
+  std::map<std::string, const Entry*> seen;
+  for (const Entry& e : staged) {
+    if (!seen.emplace(e.name, &e).second)
+      throw InputError(fmt::format("plugin {}: registers {} \"{}\" twice", e.origin, kind, e.name));
+    auto it = table.find(e.name);
+    if (it != table.end() && !allowOverride)
+      throw InputError(fmt::format("plugin {}: {} \"{}\" clashes with the one from {} (to replace it, give the plugin's "
+                                   "[[plugins]] entry override = true)",
+                                   e.origin, kind, e.name, it->second.origin));
+  }
+}
+
+}  // namespace
+
+void Registry::commitPlugin() {
+  std::unique_ptr<Staging> staging = std::move(m_staging);
+  if (!staging) return;
+  checkClashes("event", staging->events, m_events, staging->allowOverride);
+  checkClashes("broadphase", staging->broadphases, m_broadphases, staging->allowOverride);
+  for (EventEntry& e : staging->events) m_events.insert_or_assign(e.name, std::move(e));
+  for (BroadphaseEntry& b : staging->broadphases) m_broadphases.insert_or_assign(b.name, std::move(b));
 }
 
 const EventEntry* Registry::findEvent(const std::string& name) const {

@@ -1,5 +1,5 @@
 // One registry of events and broadphases by name: built-ins register themselves at load time
-// with the macros below; plugins will use the very same macros (DESIGN.md "Plugins").
+// with the macros below; plugins use the very same macros (DESIGN.md "Plugins", plugin_api.hpp).
 #pragma once
 #include <functional>
 #include <map>
@@ -10,6 +10,9 @@
 
 #include "broadphase/broadphase.hpp"
 #include "framework/event_api.hpp"
+#if defined(GEM_BUILDING_PLUGIN)
+#include "framework/plugin_api.hpp"
+#endif
 
 namespace gem {
 
@@ -102,9 +105,24 @@ class Registry {
   std::vector<std::string> eventNames() const;
   std::vector<std::string> broadphaseNames() const;
 
+  // The plugin loader's side (framework/plugin_loader.cpp). Between beginPlugin and commitPlugin,
+  // added entries are held back and stamped with the plugin's origin; commitPlugin then enters
+  // them all, or none when a name clashes (InputError naming both origins) and the plugin may not
+  // override. abortPlugin drops them.
+  void beginPlugin(const std::string& origin, bool allowOverride);
+  void commitPlugin();
+  void abortPlugin();
+
  private:
   std::map<std::string, EventEntry> m_events;
   std::map<std::string, BroadphaseEntry> m_broadphases;
+  struct Staging {
+    std::string origin;
+    bool allowOverride = false;
+    std::vector<EventEntry> events;
+    std::vector<BroadphaseEntry> broadphases;
+  };
+  std::unique_ptr<Staging> m_staging;  // non-null while a plugin registers
 };
 
 // The CPU drivers: the only loops over bodies and contacts (DESIGN.md "Folders").
@@ -167,11 +185,9 @@ class TopologyDriver final : public EventInstance {
   Params m_params;
 };
 
-struct RegisterEvent {
-  explicit RegisterEvent(EventEntry e) { Registry::global().addEvent(std::move(e)); }
-};
-struct RegisterBroadphase {
-  explicit RegisterBroadphase(BroadphaseEntry e) { Registry::global().addBroadphase(std::move(e)); }
+// A built-in's registration, run when GEM's library loads.
+struct RegisterNow {
+  explicit RegisterNow(void (*add)(Registry&)) { add(Registry::global()); }
 };
 
 #ifndef GEM_ORIGIN
@@ -181,13 +197,29 @@ struct RegisterBroadphase {
 #define GEM_CONCAT_INNER(a, b) a##b
 #define GEM_CONCAT(a, b) GEM_CONCAT_INNER(a, b)
 
+// One macro body for built-ins and plugins: ADD is a statement using `registry`. A built-in runs
+// it when GEM's library loads; a plugin (GEM_BUILDING_PLUGIN defined) only links it into its own
+// list, which the loader runs through gem_plugin_register once the descriptor has been accepted
+// (plugin_api.hpp).
+#if defined(GEM_BUILDING_PLUGIN)
+#define GEM_REGISTRATION(KIND, ADD)                                                              \
+  static void GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)(::gem::Registry & registry) { ADD; } \
+  static ::gem::PluginRegistrationNode GEM_CONCAT(GEM_CONCAT(gem_registration_, KIND), __LINE__){         \
+      &GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)}
+#else
+#define GEM_REGISTRATION(KIND, ADD)                                                              \
+  static void GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)(::gem::Registry & registry) { ADD; } \
+  static const ::gem::RegisterNow GEM_CONCAT(GEM_CONCAT(gem_registration_, KIND), __LINE__){              \
+      &GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)}
+#endif
+
 // Registers an event: EVENT is the evaluator struct, PARSE a function EventConfig& -> EVENT::Params.
 #define GEM_REGISTER_EVENT(DRIVER, PHASE, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)                        \
-  static const ::gem::RegisterEvent GEM_CONCAT(gem_register_event_, __LINE__){::gem::EventEntry{           \
+  GEM_REGISTRATION(event_, registry.addEvent(::gem::EventEntry{                                            \
       NAME, DESCRIPTION, GEM_ORIGIN, PHASE, ENABLED,                                                        \
       [](::gem::EventConfig& config) -> std::unique_ptr<::gem::EventInstance> {                            \
         return std::make_unique<DRIVER<EVENT>>(PARSE(config));                                             \
-      }}}
+      }}))
 #define GEM_REGISTER_PAIR_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
   GEM_REGISTER_EVENT(::gem::CpuPairDriver, ::gem::EventPhase::Pair, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
 #define GEM_REGISTER_SOLO_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
@@ -199,10 +231,10 @@ struct RegisterBroadphase {
 
 // Registers a broadphase class constructible from BroadphaseSettings.
 #define GEM_REGISTER_BROADPHASE(CLASS, NAME, DESCRIPTION)                                                  \
-  static const ::gem::RegisterBroadphase GEM_CONCAT(gem_register_broadphase_, __LINE__){                   \
-      ::gem::BroadphaseEntry{NAME, DESCRIPTION, GEM_ORIGIN,                                                \
-                             [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::Broadphase> { \
-                               return std::make_unique<CLASS>(s);                                          \
-                             }}}
+  GEM_REGISTRATION(broadphase_, registry.addBroadphase(::gem::BroadphaseEntry{                             \
+      NAME, DESCRIPTION, GEM_ORIGIN,                                                                       \
+      [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::Broadphase> {                      \
+        return std::make_unique<CLASS>(s);                                                                 \
+      }}))
 
 }  // namespace gem

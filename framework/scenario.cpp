@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "framework/errors.hpp"
+#include "framework/plugin_loader.hpp"
 #include "framework/registry.hpp"
 #include "framework/table_reader.hpp"
 
@@ -187,6 +188,32 @@ void readOutput(TableReader& t, Scenario& s) {
   t.finish();
 }
 
+// [[plugins]]: path (relative to the scenario's folder) and override. Each is loaded now; the
+// loader's message (what differs, which symbol is missing, which names clash) gets this entry's
+// file:line:column. The path is written back absolute, so a copy of root (a sweep case's
+// scenario.toml) still finds it.
+void readPlugins(const toml::array& plugins, TableReader& top, Scenario& s) {
+  for (const toml::node& p : plugins) {
+    const toml::table* pt = p.as_table();
+    if (!pt) top.failAt(p, "plugins: expected [[plugins]] tables");
+    TableReader t(pt, "plugins", s.fileName);
+    PluginSpec spec;
+    if (!t.has("path")) t.failAt(p, "plugins: each [[plugins]] needs a path = \"...\" (to the plugin's .so)");
+    spec.path = t.getString("path", "");
+    spec.override = t.getBool("override", false);
+    t.finish();
+    if (spec.path.is_relative()) spec.path = s.file.parent_path() / spec.path;
+    spec.path = spec.path.lexically_normal();
+    try {
+      loadPlugin(spec.path, spec.override);
+    } catch (const InputError& e) {
+      t.fail("path", e.what());
+    }
+    const_cast<toml::table*>(pt)->insert_or_assign("path", spec.path.string());
+    s.plugins.push_back(spec);
+  }
+}
+
 }  // namespace
 
 const toml::table* Scenario::eventTable(const std::string& name) const {
@@ -208,6 +235,9 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
   for (const std::string& o : overrides) applyOverride(s.root, o);
 
   TableReader top(&s.root, "", s.fileName);
+  // Plugins first: their events and broadphases are valid names in the sections below.
+  loadEnvironmentPlugins();
+  if (const toml::array* plugins = top.findArray("plugins")) readPlugins(*plugins, top, s);
   {
     TableReader t(top.findTable("simulation"), "simulation", s.fileName);
     s.dt = t.getPositive("dt", s.dt);
@@ -262,19 +292,6 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
         enabled = *b;
       }
       s.events[name] = Scenario::EventSetting{enabled};
-    }
-  }
-  if (const toml::array* plugins = top.findArray("plugins")) {
-    for (const toml::node& p : *plugins) {
-      const toml::table* pt = p.as_table();
-      if (!pt) top.failAt(p, "plugins: expected [[plugins]] tables");
-      TableReader t(pt, "plugins", s.fileName);
-      PluginSpec spec;
-      spec.path = t.getString("path", "");
-      spec.override = t.getBool("override", false);
-      t.finish();
-      // Loading plugins is the plugin issue's work; refuse rather than silently ignore them.
-      t.failAt(p, "plugins: loading plugins is not implemented in this version of GEM");
     }
   }
   {

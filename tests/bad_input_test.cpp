@@ -58,7 +58,7 @@ std::vector<BadCase> badCases() {
       {"malformed_ice_file", kSim + "[field]\nkind = \"file\"\nfile = \"bad.ice\"\n", {"bad.ice:4:1", "malformed XML"}, "bad.ice"},
       {"field_without_domain", kSim + "[field]\nconcentration = 0.3\n", {"[domain]"}},
       {"bad_concentration", kSim + kDomain + "[field]\nconcentration = 0.95\n", {"field.concentration"}},
-      {"plugins_not_supported", kSim + "[[plugins]]\npath = \"libx.so\"\n", {"plugins"}},
+      {"plugin_missing_file", kSim + "[[plugins]]\npath = \"libx.so\"\n", {"plugins.path", "libx.so", "no such file", ":5:"}},
   };
 }
 

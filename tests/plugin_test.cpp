@@ -1,0 +1,203 @@
+// Plugins (issue 4, docs/plugins.md): the descriptor check, every load error with exit status 2
+// and a message naming the file and the cause (broken plugins built by tests/CMakeLists.txt), name
+// clashes and override, and the SDK end to end: install GEM to a prefix, build each example under
+// plugins/ out of tree against it, run its scenario with the installed gem, see it in gem info.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+
+#include "framework/plugin_loader.hpp"
+#include "test_support.hpp"
+
+namespace fs = std::filesystem;
+using gem::test::readFile;
+using gem::test::TempDir;
+
+namespace {
+
+std::string plugin(const std::string& name) { return std::string(GEM_TEST_PLUGIN_DIR) + "/lib" + name + ".so"; }
+
+// Runs a shell command; returns its exit status, its output in `log`.
+int run(const std::string& command, const fs::path& log) {
+  const int status = std::system((command + " > " + log.string() + " 2>&1").c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+const std::string kFloe =
+    "[simulation]\ndt = 0.1\nsteps = 20\nbroadphase = \"all_pairs\"\n"
+    "[[floes]]\nvertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\nthickness = 0.5\nvelocity = [1.0, 0.0]\n";
+
+GemPluginDescriptor matching() {
+  return {GEM_PLUGIN_ABI_VERSION, sizeof(gem::Real), "", GEM_COMPILER_ID, GEM_COMPILER_VERSION, GEM_VERSION, "t", "1"};
+}
+
+}  // namespace
+
+TEST(PluginDescriptor, AcceptsItsOwnBuildAndSaysWhatDiffers) {
+  EXPECT_TRUE(gem::descriptorMismatches(matching()).empty());
+  GemPluginDescriptor d = matching();
+  d.abiVersion = GEM_PLUGIN_ABI_VERSION + 1;
+  d.realSize = 3;  // not read: under another ABI only the version is trusted
+  auto m = gem::descriptorMismatches(d);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_TRUE(contains(m[0], "plugin ABI version")) << m[0];
+  d = matching();
+  d.realSize = sizeof(gem::Real) == 8 ? 4 : 8;
+  d.compilerVersion = "1.0.0";
+  m = gem::descriptorMismatches(d);
+  ASSERT_EQ(m.size(), 2u);
+  EXPECT_TRUE(contains(m[0], "real type")) << m[0];
+  EXPECT_TRUE(contains(m[1], "compiler")) << m[1];
+}
+
+// Each broken library: gem exits 2 with one message naming the file and the cause, and nothing of
+// the library runs after its descriptor (the mismatched ones abort in gem_plugin_register).
+TEST(PluginErrors, EachExitsWithStatus2NamingTheFileAndTheCause) {
+  TempDir dir;
+  const fs::path log = dir.path() / "log.txt";
+  const struct {
+    std::string file, cause;
+  } cases[] = {
+      {plugin("absent"), "no such file"},
+      {plugin("not_a_plugin"), "not a GEM plugin"},
+      {plugin("missing_register"), "missing symbol gem_plugin_register"},
+      {plugin("abi_mismatch"), "plugin ABI version 999 (this GEM: " + std::to_string(GEM_PLUGIN_ABI_VERSION) + ")"},
+      {plugin("real_mismatch"), "real type"},
+      {plugin("compiler_mismatch"), "compiler TurboC 3.0.0"},
+      {dir.write("text.so", "not a library\n").string(), "cannot be loaded"},
+  };
+  for (const auto& c : cases) {
+    EXPECT_EQ(gem::test::runGem("info --plugin " + c.file, log), 2) << c.file;
+    const std::string text = readFile(log);
+    EXPECT_TRUE(contains(text, c.file)) << text;
+    EXPECT_TRUE(contains(text, c.cause)) << text;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
+  }
+}
+
+TEST(PluginErrors, ScenarioEntryGetsTheScenariosFileLineAndColumn) {
+  TempDir dir;
+  fs::copy_file(plugin("abi_mismatch"), dir.path() / "libabi.so");
+  const fs::path scenario = dir.write("case.toml", kFloe + "[[plugins]]\npath = \"libabi.so\"\n");
+  EXPECT_EQ(gem::test::runGem("check " + scenario.string(), dir.path() / "log"), 2);
+  const std::string text = readFile(dir.path() / "log");
+  EXPECT_TRUE(contains(text, "case.toml:10:")) << text;
+  EXPECT_TRUE(contains(text, "libabi.so")) << text;
+  EXPECT_TRUE(contains(text, "plugin ABI version 999")) << text;
+}
+
+TEST(PluginErrors, BrokenPluginOnGemPluginPathExits2) {
+  TempDir dir;
+  fs::create_directories(dir.path() / "p");
+  fs::copy_file(plugin("not_a_plugin"), dir.path() / "p" / "libnot_a_plugin.so");
+  const fs::path log = dir.path() / "log";
+  EXPECT_EQ(run("GEM_PLUGIN_PATH=" + (dir.path() / "p").string() + " " GEM_BINARY_DIR "/gem info", log), 2);
+  EXPECT_TRUE(contains(readFile(log), "GEM_PLUGIN_PATH")) << readFile(log);
+  EXPECT_TRUE(contains(readFile(log), "libnot_a_plugin.so: not a GEM plugin")) << readFile(log);
+  EXPECT_EQ(run("GEM_PLUGIN_PATH=" + (dir.path() / "nowhere").string() + " " GEM_BINARY_DIR "/gem info", log), 2);
+  EXPECT_TRUE(contains(readFile(log), "no such folder")) << readFile(log);
+}
+
+// A plugin's "drag" clashes with the built-in (exit 2, both origins named) unless its entry says
+// override = true; then the plugin's drag (C_d = 5) is the one that runs.
+TEST(PluginRegistry, NameClashIsAnErrorUnlessTheScenarioOverrides) {
+  TempDir dir;
+  const std::string path = plugin("drag_clash");
+  const fs::path clash = dir.write("clash.toml", kFloe + "[[plugins]]\npath = \"" + path + "\"\n");
+  EXPECT_EQ(gem::test::runGem("check " + clash.string(), dir.path() / "log"), 2);
+  const std::string text = readFile(dir.path() / "log");
+  EXPECT_TRUE(contains(text, "clash.toml:10:")) << text;
+  EXPECT_TRUE(contains(text, "event \"drag\"")) << text;
+  EXPECT_TRUE(contains(text, path + " (drag_clash 0.0.1)")) << text;
+  EXPECT_TRUE(contains(text, "built-in")) << text;
+  EXPECT_TRUE(contains(text, "override = true")) << text;
+
+  // The same library twice (once by a path with "..", once plain) is one load, then no clash.
+  const fs::path over = dir.write("override.toml", kFloe + "[[plugins]]\npath = \"" + path + "\"\noverride = true\n" +
+                                                       "[[plugins]]\npath = \"" + GEM_TEST_PLUGIN_DIR + "/../plugins/libdrag_clash.so\"\n");
+  ASSERT_EQ(gem::test::runGem("run " + over.string() + " --quiet --out " + (dir.path() / "over").string(), dir.path() / "log"), 0)
+      << readFile(dir.path() / "log");
+  const fs::path plain = dir.write("plain.toml", kFloe);
+  ASSERT_EQ(gem::test::runGem("run " + plain.string() + " --quiet --out " + (dir.path() / "plain").string(), dir.path() / "log"), 0);
+  // state.csv: id,kind,x,y,angle,vx,...: the plugin's drag slows the floe far more.
+  auto vx = [](const fs::path& state) {
+    std::string text = readFile(state);
+    std::string row = text.substr(text.find('\n') + 1);
+    for (int k = 0; k < 5; ++k) row = row.substr(row.find(',') + 1);
+    return std::stod(row.substr(0, row.find(',')));
+  };
+  const double vxOverride = vx(dir.path() / "over" / "state.csv"), vxPlain = vx(dir.path() / "plain" / "state.csv");
+  EXPECT_GT(vxPlain, 0.8);
+  EXPECT_LT(vxOverride, 0.5 * vxPlain);
+}
+
+// The SDK from the build, as a user does it: install, build each example out of tree, run it.
+TEST(PluginSdk, InstallBuildEachExampleOutOfTreeRunItAndSeeItInGemInfo) {
+  TempDir dir;
+  const fs::path prefix = dir.path() / "prefix", log = dir.path() / "log.txt";
+  const std::string cmake = std::string("\"") + GEM_CMAKE_COMMAND + "\"";
+  ASSERT_EQ(run(cmake + " --install " GEM_BINARY_DIR " --prefix " + prefix.string(), log), 0) << readFile(log);
+  const std::string gem = (prefix / "bin" / "gem").string();
+  ASSERT_TRUE(fs::exists(prefix / "lib" / "cmake" / "gem" / "gemConfig.cmake"));
+  ASSERT_TRUE(fs::exists(prefix / "include" / "gem" / "framework" / "plugin_api.hpp"));
+
+  std::string makeProgram = GEM_MAKE_PROGRAM;
+  const std::string configure = cmake + " -G \"" GEM_CMAKE_GENERATOR "\"" +
+                                (makeProgram.empty() ? "" : " -DCMAKE_MAKE_PROGRAM=\"" + makeProgram + "\"") +
+                                " -DCMAKE_CXX_COMPILER=\"" GEM_CXX_COMPILER "\" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=" +
+                                prefix.string();
+  for (const std::string name : {"shear_current", "rafting_onset", "sweep_and_prune"}) {
+    SCOPED_TRACE(name);
+    const fs::path build = dir.path() / name;
+    ASSERT_EQ(run(configure + " -S " GEM_SOURCE_DIR "/plugins/" + name + " -B " + build.string(), log), 0) << readFile(log);
+    ASSERT_EQ(run(cmake + " --build " + build.string(), log), 0) << readFile(log);
+    const fs::path library = build / ("lib" + name + ".so");
+    ASSERT_TRUE(fs::exists(library));
+
+    // gem info --plugin and GEM_PLUGIN_PATH both list it with its path and version.
+    ASSERT_EQ(run(gem + " info --plugin " + library.string(), log), 0) << readFile(log);
+    EXPECT_TRUE(contains(readFile(log), "from " + fs::canonical(library).string() + " (" + name + " 1.0.0)")) << readFile(log);
+    ASSERT_EQ(run("GEM_PLUGIN_PATH=" + build.string() + " " + gem + " info", log), 0) << readFile(log);
+    EXPECT_TRUE(contains(readFile(log), fs::canonical(library).string())) << readFile(log);
+
+    const fs::path out = dir.path() / ("run_" + name);
+    ASSERT_EQ(run(gem + " run " + (build / "scenario.toml").string() + " --quiet --out " + out.string(), log), 0) << readFile(log);
+    ASSERT_TRUE(fs::exists(out / "summary.json"));
+  }
+
+  // shear_current: U = 0.2 + 0.01 y, floes at y = -40, 0, 40 (state.csv rows in id order): the
+  // first drifts back (U < 0), the last fastest.
+  {
+    std::vector<double> vx;
+    std::string text = readFile(dir.path() / "run_shear_current" / "state.csv");
+    for (size_t at = text.find('\n'); at + 1 < text.size(); at = text.find('\n', at + 1)) {
+      std::string row = text.substr(at + 1);
+      for (int k = 0; k < 5; ++k) row = row.substr(row.find(',') + 1);
+      vx.push_back(std::stod(row.substr(0, row.find(','))));
+    }
+    ASSERT_EQ(vx.size(), 3u);
+    EXPECT_LT(vx[0], 0);
+    EXPECT_GT(vx[1], 0);
+    EXPECT_GT(vx[2], 2 * vx[1]);
+  }
+  // rafting_onset: the thin pair's onset is logged (floes 0 and 1), the thick pair's is not.
+  {
+    const std::string text = readFile(dir.path() / "run_rafting_onset" / "rafting.csv");
+    EXPECT_TRUE(contains(text, "t,floe_a,floe_b,x,y,vc,thickness\n")) << text;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2) << text;
+    EXPECT_TRUE(contains(text, ",0,1,")) << text;
+  }
+  // sweep_and_prune: the same contacts as all_pairs, so the same final state bit for bit.
+  {
+    const fs::path out = dir.path() / "run_all_pairs";
+    ASSERT_EQ(run(gem + " run " + (dir.path() / "sweep_and_prune" / "scenario.toml").string() +
+                      " --broadphase all_pairs --quiet --out " + out.string(), log), 0) << readFile(log);
+    const std::string sap = readFile(dir.path() / "run_sweep_and_prune" / "state.csv");
+    EXPECT_GT(std::count(sap.begin(), sap.end(), '\n'), 20);
+    EXPECT_EQ(sap, readFile(out / "state.csv"));
+    EXPECT_TRUE(contains(readFile(dir.path() / "run_sweep_and_prune" / "summary.json"), "sweep_and_prune"));
+  }
+}
