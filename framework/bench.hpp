@@ -1,5 +1,5 @@
-// gem bench: times the CPU backend per step on the thesis fields (456 hexagons, 824 random floes)
-// and on 10,000 random floes, each with the vessel, and prints a table with the machine's name.
+// gem bench: times a backend per step on the thesis fields (456 hexagons, 824 random floes) and on
+// 10^4, 10^5 and 10^6 random floes at 40 %, each with the vessel, and prints a table with the device.
 #pragma once
 #include <string>
 #include <vector>
@@ -9,8 +9,9 @@ namespace gem {
 struct BenchOptions {
   long steps = 2000;               // timed steps per case (after a warm-up)
   std::string csv;                 // also write the table here when not empty
-  std::vector<std::string> cases;  // "456", "824", "10000"; empty: all
+  std::vector<std::string> cases;  // "456", "824", "10000", "100000", "1000000"; empty: the first three
   std::vector<std::string> broadphases{"variable_radius"};
+  std::vector<std::string> backends{"cpu"};  // "cpu", "cuda"
 };
 
 int runBench(const BenchOptions& options);

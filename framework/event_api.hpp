@@ -110,13 +110,22 @@ struct RecordSink {
   int breakCapacity;
   int* breakCount;
 
+  // On the device many contacts push at once: an integer atomic counter (the CUDA driver then
+  // orders the records deterministically by floe slot, which is the CPU's contact order).
   GEM_HD void push(const ImpactRecord& r) const {
-    int k = (*impactCount)++;
+    const int k = next(impactCount);
     if (k < impactCapacity) impacts[k] = r;
   }
   GEM_HD void push(const BreakRequest& r) const {
-    int k = (*breakCount)++;
+    const int k = next(breakCount);
     if (k < breakCapacity) breaks[k] = r;
+  }
+  GEM_HD static int next(int* counter) {
+#if defined(__CUDA_ARCH__)
+    return atomicAdd(counter, 1);
+#else
+    return (*counter)++;
+#endif
   }
 };
 

@@ -149,10 +149,11 @@ int main(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "version, build, devices, registered events and broadphases");
   info->add_option("--plugin", infoPlugins, "load this plugin first (repeatable); GEM_PLUGIN_PATH's are loaded too");
   BenchOptions bench;
-  CLI::App* benchCommand = app.add_subcommand("bench", "time the CPU backend per step on the thesis fields");
+  CLI::App* benchCommand = app.add_subcommand("bench", "time a backend per step on the thesis fields and on 10^4 to 10^6 floes");
   benchCommand->add_option("--steps", bench.steps, "steps timed per case");
   benchCommand->add_option("--csv", bench.csv, "also write the table as CSV");
-  benchCommand->add_option("--cases", bench.cases, "which cases: 456, 824, 10000 (default all)");
+  benchCommand->add_option("--cases", bench.cases, "which cases: 456, 824, 10000, 100000, 1000000 (default the first three)");
+  benchCommand->add_option("--backend", bench.backends, "backends to time: cpu, cuda (default cpu)");
   benchCommand->add_option("--broadphase", bench.broadphases, "broadphases to time (default variable_radius)");
 
   std::string calibrationFile = std::string(GEM_SOURCE_DIR) + "/scenarios/thesis/calibration.toml", calibrationOut = "runs/calibration";

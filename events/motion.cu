@@ -1,0 +1,8 @@
+// motion: the CUDA driver, the same evaluator as the CPU (DESIGN.md "Writing an event").
+#include "events/motion.hpp"
+#include "framework/cuda/cuda_events.hpp"
+#include "framework/registry.hpp"
+
+namespace gem {
+GEM_REGISTER_CUDA_MOTION_EVENT(Motion, "motion");
+}  // namespace gem

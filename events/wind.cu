@@ -1,0 +1,8 @@
+// wind: the CUDA driver, the same evaluator as the CPU (DESIGN.md "Writing an event").
+#include "events/environmental_force.hpp"
+#include "framework/cuda/cuda_events.hpp"
+#include "framework/registry.hpp"
+
+namespace gem {
+GEM_REGISTER_CUDA_SOLO_EVENT(EnvironmentalForce, "wind");
+}  // namespace gem

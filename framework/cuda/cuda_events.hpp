@@ -1,0 +1,152 @@
+// The CUDA drivers of events: the device twin of CpuPairDriver / CpuSoloDriver / CpuMotionDriver
+// (framework/registry.hpp). Each is one templated kernel that calls the very same evaluator struct
+// as the CPU, so no physics is written twice. An event's events/NAME.cu is one line:
+//   GEM_REGISTER_CUDA_SOLO_EVENT(Drag, "drag");
+// which registers, under the event's name, a factory that takes the parsed Params of the CPU
+// instance (EventInstance::params()), so both backends run from the very same values.
+#pragma once
+#include <cuda_runtime.h>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <type_traits>
+
+#include "framework/cuda/cuda_check.hpp"
+#include "framework/event_api.hpp"
+
+namespace gem::cuda {
+
+// Device pointers of one step's pair phase (contacts are sorted by slot pair (a, b)). The step is
+// a captured CUDA graph replayed every step, so what changes from step to step is read from device
+// memory, not baked into the kernel arguments: the step context and the live contact count (the
+// launch covers the buffers' capacity, `count`).
+struct DevicePairData {
+  const PairBody* bodies;
+  const int* contactA;
+  const int* contactB;
+  const PairContact* contacts;
+  PairSlot* slots;
+  int count;              // capacity covered by the launch
+  const int* liveCount;   // device: this step's contacts
+  const StepContext* ctx; // device
+  RecordSink sink;        // device buffers, integer atomic counters
+};
+
+struct DeviceSoloData {
+  const SoloBody* bodies;
+  VelocityChange* changes;
+  int count;
+  const StepContext* ctx;  // device
+};
+
+struct DeviceMotionData {
+  MotionBody* bodies;
+  int count;
+  const StepContext* ctx;  // device
+};
+
+constexpr int kBlock = 128;
+inline int blocksFor(int n) { return (n + kBlock - 1) / kBlock; }
+
+class CudaEventDriver {
+ public:
+  virtual ~CudaEventDriver() = default;
+  virtual void launchPairs(const DevicePairData&, cudaStream_t) {}
+  virtual void launchSolo(const DeviceSoloData&, cudaStream_t) {}
+  virtual void launchMotion(const DeviceMotionData&, cudaStream_t) {}
+};
+
+using CudaEventFactory = std::function<std::unique_ptr<CudaEventDriver>(const void* params)>;
+void addCudaEvent(const std::string& name, CudaEventFactory factory);
+// nullptr when the event has no CUDA driver.
+const CudaEventFactory* findCudaEvent(const std::string& name);
+
+#if defined(__CUDACC__)
+template <class Event, class Params>
+__global__ void pairEventKernel(Params params, DevicePairData d) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= d.count || k >= *d.liveCount) return;
+  const StepContext ctx = *d.ctx;
+  Event::apply(params, d.bodies[d.contactA[k]], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], ctx, d.sink);
+}
+
+template <class Event, class Params>
+__global__ void soloEventKernel(Params params, DeviceSoloData d) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= d.count) return;
+  const StepContext ctx = *d.ctx;
+  Event::apply(params, d.bodies[i], d.changes[i], ctx);
+}
+
+template <class Event, class Params>
+__global__ void motionKernel(Params params, DeviceMotionData d) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= d.count) return;
+  const StepContext ctx = *d.ctx;
+  Event::apply(params, d.bodies[i], ctx);
+}
+
+template <class Event>
+class CudaPairDriver final : public CudaEventDriver {
+ public:
+  using Params = typename Event::Params;
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  explicit CudaPairDriver(const void* p) : m_params(*static_cast<const Params*>(p)) {}
+  void launchPairs(const DevicePairData& d, cudaStream_t stream) override {
+    if (d.count == 0) return;
+    pairEventKernel<Event, Params><<<blocksFor(d.count), kBlock, 0, stream>>>(m_params, d);
+    GEM_CUDA_CHECK_LAUNCH();
+  }
+
+ private:
+  Params m_params;
+};
+
+template <class Event>
+class CudaSoloDriver final : public CudaEventDriver {
+ public:
+  using Params = typename Event::Params;
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  explicit CudaSoloDriver(const void* p) : m_params(*static_cast<const Params*>(p)) {}
+  void launchSolo(const DeviceSoloData& d, cudaStream_t stream) override {
+    if (d.count == 0) return;
+    soloEventKernel<Event, Params><<<blocksFor(d.count), kBlock, 0, stream>>>(m_params, d);
+    GEM_CUDA_CHECK_LAUNCH();
+  }
+
+ private:
+  Params m_params;
+};
+
+template <class Event>
+class CudaMotionDriver final : public CudaEventDriver {
+ public:
+  using Params = typename Event::Params;
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  explicit CudaMotionDriver(const void* p) : m_params(*static_cast<const Params*>(p)) {}
+  void launchMotion(const DeviceMotionData& d, cudaStream_t stream) override {
+    if (d.count == 0) return;
+    motionKernel<Event, Params><<<blocksFor(d.count), kBlock, 0, stream>>>(m_params, d);
+    GEM_CUDA_CHECK_LAUNCH();
+  }
+
+ private:
+  Params m_params;
+};
+
+struct RegisterCudaEvent {
+  RegisterCudaEvent(const char* name, CudaEventFactory factory) { addCudaEvent(name, std::move(factory)); }
+};
+#endif
+
+}  // namespace gem::cuda
+
+#define GEM_REGISTER_CUDA_EVENT(DRIVER, EVENT, NAME)                                                       \
+  static const ::gem::cuda::RegisterCudaEvent GEM_CONCAT(gem_register_cuda_event_, __LINE__){            \
+      NAME, [](const void* params) -> std::unique_ptr<::gem::cuda::CudaEventDriver> {                     \
+        return std::make_unique<DRIVER<EVENT>>(params);                                                   \
+      }}
+#define GEM_REGISTER_CUDA_PAIR_EVENT(EVENT, NAME) GEM_REGISTER_CUDA_EVENT(::gem::cuda::CudaPairDriver, EVENT, NAME)
+#define GEM_REGISTER_CUDA_SOLO_EVENT(EVENT, NAME) GEM_REGISTER_CUDA_EVENT(::gem::cuda::CudaSoloDriver, EVENT, NAME)
+#define GEM_REGISTER_CUDA_MOTION_EVENT(EVENT, NAME) GEM_REGISTER_CUDA_EVENT(::gem::cuda::CudaMotionDriver, EVENT, NAME)

@@ -1,0 +1,179 @@
+// The CUDA backend's host side: set-up from the scenario (through the CPU Simulation, which parses
+// and checks every event), record ordering, the host topology phase and the periodic re-sort.
+#include "framework/cuda/cuda_simulation.hpp"
+
+#include <cuda_runtime.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "framework/cuda/device_world.hpp"
+#include "framework/simulation.hpp"
+
+namespace gem {
+
+bool cudaAvailable() {
+  static const bool available = [] {
+    int count = 0;
+    if (cudaGetDeviceCount(&count) != cudaSuccess) {
+      cudaGetLastError();  // "no device" is an answer, not an error to leave pending
+      return false;
+    }
+    return count > 0;
+  }();
+  return available;
+}
+
+std::string cudaDeviceName() {
+  if (!cudaAvailable()) return "none";
+  int device = 0;
+  cudaDeviceProp prop{};
+  if (cudaGetDevice(&device) != cudaSuccess || cudaGetDeviceProperties(&prop, device) != cudaSuccess) return "unknown CUDA device";
+  return prop.name;
+}
+
+World& CudaSimulation::world() { return m_cpu->world(); }
+const Scenario& CudaSimulation::scenario() const { return m_cpu->scenario(); }
+
+CudaSimulation::CudaSimulation(const Scenario& scenario)
+    : m_cpu(std::make_unique<Simulation>(scenario)),
+      m_device(std::make_unique<cuda::DeviceWorld>()),
+      m_resultStore(std::make_unique<cuda::DeviceStepResult>()),
+      m_deviceName(cudaDeviceName()) {
+  m_result = m_resultStore.get();
+  // The CPU simulation parsed every event (strictly) and sorted the world along the curve; its
+  // instances give the Params the device drivers are made from, in the same order.
+  for (const EnabledEvent& e : m_cpu->events()) {
+    if (e.phase == EventPhase::Topology) continue;  // runs on the host
+    const cuda::CudaEventFactory* factory = cuda::findCudaEvent(e.name);
+    if (!factory) throw std::runtime_error("event \"" + e.name + "\" has no CUDA driver (an events/" + e.name + ".cu is missing)");
+    auto driver = (*factory)(e.instance->params());
+    if (e.phase == EventPhase::Pair) m_device->addPairEvent(std::move(driver));
+    else if (e.phase == EventPhase::Solo) m_device->addSoloEvent(std::move(driver));
+    else m_device->addMotionEvent(std::move(driver));
+  }
+  const World& w = world();
+  for (int i = 0; i < w.size(); ++i)
+    if (w.kind[i] == BodyKind::Vessel) m_vesselId = w.id[i];
+  upload();
+}
+
+CudaSimulation::~CudaSimulation() = default;
+
+void CudaSimulation::upload() {
+  const World& w = world();
+  m_vesselSlot = -1;
+  for (int i = 0; i < w.size(); ++i)
+    if (w.id[i] == m_vesselId) m_vesselSlot = i;
+  m_device->upload(w, scenario().vessel.dof, m_vesselSlot);
+  m_hostCurrent = true;
+}
+
+void CudaSimulation::downloadState() {
+  if (m_hostCurrent) return;
+  m_device->download(world());
+  m_hostCurrent = true;
+}
+
+const World& CudaSimulation::hostWorld() {
+  downloadState();
+  return world();
+}
+
+VesselSample CudaSimulation::vessel() {
+  if (m_vesselSlot < 0) return VesselSample{false, {0, 0}, 0, {0, 0}};
+  if (m_hostCurrent) {
+    const World& w = world();
+    return VesselSample{true, w.position(m_vesselSlot), w.angle[m_vesselSlot], w.velocity(m_vesselSlot)};
+  }
+  return m_vessel;
+}
+
+void CudaSimulation::step() {
+  const StepContext ctx{scenario().dt, m_time, m_step};
+  cuda::DeviceStepResult& r = *m_result;
+  m_device->step(ctx, r);
+  m_hostCurrent = false;
+  m_candidateCount = r.candidates;
+  m_contactCount = r.contacts;
+
+  // Records: the device appends in any order; the CPU's order is contact order, which for one
+  // vessel is ascending floe slot (contacts are sorted by (a, b) and the vessel is one side of each).
+  m_impacts.swap(r.impacts);
+  m_breaks.swap(r.breaks);
+  if (m_impacts.size() > 1 || m_breaks.size() > 1) {
+    const World& w = world();
+    std::unordered_map<std::int64_t, int> slotOf;
+    for (const auto& x : m_impacts) slotOf[x.floeId] = 0;
+    for (const auto& x : m_breaks) slotOf[x.floeId] = 0;
+    for (int i = 0; i < w.size(); ++i)
+      if (auto it = slotOf.find(w.id[i]); it != slotOf.end()) it->second = i;
+    std::stable_sort(m_impacts.begin(), m_impacts.end(),
+                     [&](const ImpactRecord& a, const ImpactRecord& b) { return slotOf[a.floeId] < slotOf[b.floeId]; });
+    std::stable_sort(m_breaks.begin(), m_breaks.end(),
+                     [&](const BreakRequest& a, const BreakRequest& b) { return slotOf[a.floeId] < slotOf[b.floeId]; });
+  }
+  m_vesselIceForce = (Real(1) / scenario().dt) * r.vesselImpulse;
+  if (m_vesselSlot >= 0) m_vessel = VesselSample{true, r.vesselPosition, r.vesselAngle, r.vesselVelocity};
+
+  // 6. Topology on the host, only in a step that asked for a break (rare): the world goes back and forth.
+  if (!m_breaks.empty()) {
+    downloadState();
+    TopologyData topology{&world(), m_breaks.data(), static_cast<int>(m_breaks.size()), m_time};
+    for (const EnabledEvent& e : m_cpu->events())
+      if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
+    m_rubbleMass += topology.rubbleMass;
+    m_floesBroken += topology.floesBroken;
+    if (topology.changed) upload();
+  }
+
+  ++m_step;
+  m_time = static_cast<Real>(m_step) * scenario().dt;
+  if (scenario().mortonSort && m_step % 200 == 0) {
+    downloadState();
+    reorderAlongCurve();
+    upload();
+  }
+}
+
+// A copy of Simulation::reorderAlongCurve (private there): the same order, so that both backends
+// sum each body's contacts in the same order.
+void CudaSimulation::reorderAlongCurve() {
+  World& w = world();
+  const int n = w.size();
+  if (n < 2) return;
+  Real x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  for (int i = 0; i < n; ++i) {
+    x0 = std::min(x0, w.x[i]), x1 = std::max(x1, w.x[i]);
+    y0 = std::min(y0, w.y[i]), y1 = std::max(y1, w.y[i]);
+  }
+  const Real scale = 65535 / std::max<Real>({x1 - x0, y1 - y0, Real(1e-9)});
+  auto spread = [](std::uint32_t v) {
+    v &= 0xffff;
+    v = (v | (v << 8)) & 0x00ff00ff;
+    v = (v | (v << 4)) & 0x0f0f0f0f;
+    v = (v | (v << 2)) & 0x33333333;
+    v = (v | (v << 1)) & 0x55555555;
+    return v;
+  };
+  std::vector<std::pair<std::uint32_t, int>> keys(n);
+  for (int i = 0; i < n; ++i) {
+    auto gx = static_cast<std::uint32_t>((w.x[i] - x0) * scale), gy = static_cast<std::uint32_t>((w.y[i] - y0) * scale);
+    keys[i] = {spread(gx) | (spread(gy) << 1), i};
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<int> order(n);
+  for (int k = 0; k < n; ++k) order[k] = keys[k].second;
+  w.permute(order);
+}
+
+// The backend's entry: listed by `gem info`, chosen by --backend cuda and by backend = "auto".
+static const bool kRegistered = [] {
+  registerBackend(BackendEntry{"cuda", [] { return cudaAvailable(); }, [] { return cudaDeviceName(); },
+                               [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CudaSimulation>(s); }});
+  return true;
+}();
+
+}  // namespace gem

@@ -1,0 +1,839 @@
+// The device phases of a step (see cuda_simulation.hpp for the list). Semantics copied from
+// framework/simulation.cpp, the reference: any difference in what is summed, or in which order,
+// is a bug (the CUDA-vs-CPU tests compare the two).
+#include "framework/cuda/device_world.hpp"
+
+#include <cooperative_groups.h>
+#include <cub/block/block_reduce.cuh>
+#include <cub/block/block_scan.cuh>
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_scan.cuh>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "framework/cuda/cuda_check.hpp"
+#include "geometry/contact.hpp"
+
+namespace gem::cuda {
+
+// A device array that only grows (steps reuse it; no allocation in the steady state).
+template <class T>
+class DeviceBuffer {
+ public:
+  DeviceBuffer() = default;
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  ~DeviceBuffer() {
+    if (m_data) cudaFree(m_data);  // no throw from a destructor
+  }
+  void ensure(size_t n) {
+    if (n <= m_capacity) return;
+    const size_t capacity = std::max<size_t>(n + n / 2, 64);
+    T* data = nullptr;
+    GEM_CUDA_CHECK(cudaMalloc(&data, capacity * sizeof(T)));
+    if (m_data) GEM_CUDA_CHECK(cudaFree(m_data));
+    m_data = data;
+    m_capacity = capacity;
+  }
+  // Grows keeping the first `keep` elements (the previous step's contact keys survive a regrowth).
+  void ensureKeeping(size_t n, size_t keep) {
+    if (n <= m_capacity) return;
+    DeviceBuffer bigger;
+    bigger.ensure(n);
+    if (keep && m_data) GEM_CUDA_CHECK(cudaMemcpy(bigger.m_data, m_data, keep * sizeof(T), cudaMemcpyDeviceToDevice));
+    swap(bigger);
+  }
+  T* get() const { return m_data; }
+  void upload(const T* h_data, size_t n) {
+    ensure(n);
+    if (n) GEM_CUDA_CHECK(cudaMemcpy(m_data, h_data, n * sizeof(T), cudaMemcpyHostToDevice));
+  }
+  void download(T* h_data, size_t n) const {
+    if (n) GEM_CUDA_CHECK(cudaMemcpy(h_data, m_data, n * sizeof(T), cudaMemcpyDeviceToHost));
+  }
+  void swap(DeviceBuffer& other) {
+    std::swap(m_data, other.m_data);
+    std::swap(m_capacity, other.m_capacity);
+  }
+
+ private:
+  T* m_data = nullptr;
+  size_t m_capacity = 0;
+};
+
+struct Box {
+  Real x0, y0, x1, y1;
+};
+
+// The step's counters, on the device (kernels read and write them), copied to pinned host memory
+// at the end of every step: the one host sync of a step.
+struct StepStats {
+  int impactCount, breakCount;  // RecordSink's counters
+  int candidatesNeeded;         // the broadphase's pair count, even past the capacity
+  int candidates;               // min(needed, capacity)
+  int contacts, previousContacts;
+  int overflow;                 // 1: candidates past the capacity: the step left the state alone
+  Vec2 vesselImpulse;
+  Vec2 vesselPosition, vesselVelocity;
+  Real vesselAngle;
+};
+
+// The grid's view, passed by value to the broadphase kernels.
+struct GridView {
+  const Box* boxes;
+  const Real* invMass;
+  const unsigned char* isLarge;
+  const int* large;  // slots of the large bodies, ascending
+  int largeCount;
+  const int* cellStart;
+  const int* cellEnd;
+  const int* sortedSlot;
+  Real cell;
+  unsigned mask;  // table size - 1
+  int n;
+  int capacity;  // of the candidate list: a row that would pass it is not written (overflow)
+};
+
+struct DeviceState {
+  // World (structure of arrays, as World).
+  DeviceBuffer<std::int64_t> id;
+  DeviceBuffer<BodyKind> kind;
+  DeviceBuffer<int> vertexCount, dof;
+  DeviceBuffer<Vec2> local;
+  DeviceBuffer<Real> x, y, angle, vx, vy, omega, area, thickness, mass, invMass, invInertia, gyration2, gyrationX2,
+      gyrationY2, principalAngle;
+  DeviceBuffer<unsigned char> isLarge;
+  DeviceBuffer<int> large;
+  int largeCount = 0;
+  int n = 0;
+  int vesselSlot = -1;
+  Real cell = 1;
+  unsigned tableSize = 64;
+  int tableBits = 6;
+  // Per step, per body.
+  DeviceBuffer<Vec2> worldVertices;
+  DeviceBuffer<Box> boxes;
+  DeviceBuffer<PairBody> pairBodies;
+  DeviceBuffer<SoloBody> soloBodies;
+  DeviceBuffer<VelocityChange> changes;
+  DeviceBuffer<MotionBody> motionBodies;
+  // Grid.
+  DeviceBuffer<unsigned> cellKey, cellKeySorted;
+  DeviceBuffer<int> slot, slotSorted, cellStart, cellEnd;
+  DeviceBuffer<int> partnerCount, partnerOffset;
+  // Candidates and contacts.
+  DeviceBuffer<int> candA, candB, flag, flagOffset;
+  DeviceBuffer<Contact> candContact;
+  DeviceBuffer<int> contactA, contactB, bKey, bKeySorted, bIndex, bIndexSorted;
+  DeviceBuffer<PairContact> contacts;
+  DeviceBuffer<PairSlot> slots;
+  DeviceBuffer<unsigned long long> contactKey, previousKeys, sortedKeys;
+  int idBits = 0;  // a contact's id pair is keyed (lo << idBits) | hi: a short radix sort
+  // Records.
+  DeviceBuffer<ImpactRecord> impacts;
+  DeviceBuffer<BreakRequest> breaks;
+  DeviceBuffer<StepStats> stats;
+  DeviceBuffer<StepContext> ctx;
+  StepStats* h_stats = nullptr;   // pinned
+  StepContext* h_ctx = nullptr;   // pinned: the graph's first node copies it to ctx
+  DeviceBuffer<unsigned char> temp;  // CUB scratch, sized before capture
+  size_t tempBytes = 0;
+  int capacity = 0;  // candidate (and contact) capacity the graph was captured for
+  cudaStream_t stream = nullptr;
+  cudaGraphExec_t graph = nullptr;
+  std::vector<std::unique_ptr<CudaEventDriver>> pairEvents, soloEvents, motionEvents;
+
+  DeviceState() {
+    GEM_CUDA_CHECK(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking));
+    GEM_CUDA_CHECK(cudaMallocHost(&h_stats, sizeof(StepStats)));
+    GEM_CUDA_CHECK(cudaMallocHost(&h_ctx, sizeof(StepContext)));
+    *h_stats = StepStats{};  // pinned memory starts undefined; previousContacts is read before a first step
+    stats.ensure(1);
+    ctx.ensure(1);
+    GEM_CUDA_CHECK(cudaMemset(stats.get(), 0, sizeof(StepStats)));
+  }
+  ~DeviceState() {
+    if (graph) cudaGraphExecDestroy(graph);
+    if (h_stats) cudaFreeHost(h_stats);
+    if (h_ctx) cudaFreeHost(h_ctx);
+    if (stream) cudaStreamDestroy(stream);
+  }
+  void dropGraph() {
+    if (graph) GEM_CUDA_CHECK(cudaGraphExecDestroy(graph));
+    graph = nullptr;
+  }
+};
+
+// ---- kernels ---------------------------------------------------------------------------------
+
+__device__ inline long long cellCoord(Real v, Real cell) { return static_cast<long long>(floor(v / cell)); }
+
+__device__ inline unsigned cellHash(long long cx, long long cy, unsigned mask) {
+  return (static_cast<unsigned>(cx) * 73856093u ^ static_cast<unsigned>(cy) * 19349663u) & mask;
+}
+
+struct PrepareArgs {
+  int n, vessel;
+  const std::int64_t* id;
+  const BodyKind* kind;
+  const int *vertexCount, *dof;
+  const Vec2* local;
+  const Real *x, *y, *angle, *vx, *vy, *omega, *area, *thickness, *mass, *invMass, *invInertia, *gyration2, *gyrationX2,
+      *gyrationY2, *principalAngle;
+  const unsigned char* isLarge;
+  Real cell;
+  unsigned mask, largeKey;
+  Vec2* worldVertices;
+  Box* boxes;
+  PairBody* pairBodies;
+  SoloBody* soloBodies;
+  VelocityChange* changes;
+  unsigned* cellKey;
+  int* slot;
+};
+
+// Phase 1 and the views: as Simulation::narrowphase's box loop and Simulation::step's view loops.
+__global__ void prepareKernel(PrepareArgs a) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= a.n) return;
+  Vec2* v = a.worldVertices + static_cast<size_t>(i) * kMaxVertices;
+  const int count = a.vertexCount[i];
+  const Vec2 position{a.x[i], a.y[i]};
+  toWorld(a.local + static_cast<size_t>(i) * kMaxVertices, count, position, a.angle[i], v);
+  Box box{v[0].x, v[0].y, v[0].x, v[0].y};
+  for (int k = 1; k < count; ++k) {
+    box.x0 = fmin(box.x0, v[k].x), box.x1 = fmax(box.x1, v[k].x);
+    box.y0 = fmin(box.y0, v[k].y), box.y1 = fmax(box.y1, v[k].y);
+  }
+  a.boxes[i] = box;
+  PairBody b;
+  b.kind = a.kind[i];
+  b.dof = a.dof[i];
+  b.id = a.id[i];
+  b.position = position;
+  b.angle = a.angle[i];
+  b.velocity = Vec2{a.vx[i], a.vy[i]};
+  b.omega = a.omega[i];
+  b.mass = a.mass[i];
+  b.invMass = a.invMass[i];
+  b.invInertia = a.invInertia[i];
+  b.gyration2 = a.gyration2[i];
+  b.gyrationX2 = a.gyrationX2[i];
+  b.gyrationY2 = a.gyrationY2[i];
+  b.principalAngle = a.angle[i] + a.principalAngle[i];
+  b.area = a.area[i];
+  b.thickness = a.thickness[i];
+  b.vertices = v;
+  b.vertexCount = count;
+  a.pairBodies[i] = b;
+  a.soloBodies[i] = SoloBody{b.kind, b.dof, b.position, b.angle, b.velocity, b.omega, b.mass, b.area, b.thickness};
+  a.changes[i] = VelocityChange{{0, 0}, 0};
+  // A small body lives in the cell of its box's lower-left corner; large ones stay out of the grid.
+  a.cellKey[i] = a.isLarge[i] ? a.largeKey : cellHash(cellCoord(box.x0, a.cell), cellCoord(box.y0, a.cell), a.mask);
+  a.slot[i] = i;
+}
+
+__global__ void cellRangeKernel(const unsigned* key, int n, unsigned largeKey, int* start, int* end) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= n || key[k] == largeKey) return;
+  if (k == 0 || key[k - 1] != key[k]) start[key[k]] = k;
+  if (k == n - 1 || key[k + 1] != key[k]) end[key[k]] = k + 1;
+}
+
+// The pair test of Simulation::narrowphase's prefilter: not two immovable bodies, boxes overlap.
+__device__ inline bool accept(const GridView& g, int i, int j) {
+  if (g.invMass[i] == 0 && g.invMass[j] == 0) return false;
+  const Box &ba = g.boxes[i], &bb = g.boxes[j];
+  return !(ba.x0 > bb.x1 || bb.x0 > ba.x1 || ba.y0 > bb.y1 || bb.y0 > ba.y1);
+}
+
+// A tile of Lanes threads per small body: its lanes test Lanes candidates at a time, so the
+// dependent loads of a row are in flight together (a thread per body was latency-bound: 60 us for
+// 824 floes on an H200; a warp per body wastes lanes when there are 10^5 bodies to fill the GPU). Write
+// pass: each hit goes to its rank among the row's hits (ballot + popc), then lane 0 sorts the row
+// by j, so the whole list is sorted by (a, b) as on the CPU.
+template <bool Write, int Lanes>
+__global__ void partnerRowsKernel(GridView g, int* count, const int* offset, int* candA, int* candB) {
+  namespace cg = cooperative_groups;
+  const auto tile = cg::tiled_partition<Lanes>(cg::this_thread_block());
+  const int i = (blockIdx.x * blockDim.x + threadIdx.x) / Lanes, lane = static_cast<int>(tile.thread_rank());
+  if (i > g.n) return;  // i is the same for the whole tile: it returns together
+  if (i == g.n) {
+    if (!Write && lane == 0) count[i] = 0;  // the scan's last element gives the total
+    return;
+  }
+  if (g.isLarge[i]) return;  // largeRow*Kernel
+  if (Write && offset[i + 1] > g.capacity) return;  // overflow: the step is redone with more room
+  const int begin = Write ? offset[i] : 0;
+  int end = begin;
+  auto visit = [&](int j, bool valid) {
+    const bool hit = valid && j > i && accept(g, i, j);
+    const unsigned mask = tile.ballot(hit);
+    if (Write && hit) {
+      const int at = end + __popc(mask & ((1u << lane) - 1));
+      candA[at] = i;
+      candB[at] = j;
+    }
+    end += __popc(mask);
+  };
+  const Box box = g.boxes[i];
+  const long long cx = cellCoord(box.x0, g.cell), cy = cellCoord(box.y0, g.cell);
+  unsigned seen[9];
+  int seenCount = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const unsigned h = cellHash(cx + dx, cy + dy, g.mask);
+      bool repeated = false;
+      for (int s = 0; s < seenCount; ++s) repeated = repeated || seen[s] == h;
+      if (repeated) continue;
+      seen[seenCount++] = h;
+      const int start = g.cellStart[h];
+      if (start < 0) continue;
+      const int stop = g.cellEnd[h];
+      for (int q0 = start; q0 < stop; q0 += Lanes) {
+        const int q = q0 + lane;
+        visit(q < stop ? g.sortedSlot[q] : 0, q < stop);
+      }
+    }
+  for (int l0 = 0; l0 < g.largeCount; l0 += Lanes) {
+    const int l = l0 + lane;
+    visit(l < g.largeCount ? g.large[l] : 0, l < g.largeCount);
+  }
+  if (!Write) {
+    if (lane == 0) count[i] = end;
+    return;
+  }
+  tile.sync();  // the lanes' writes of the row are visible to lane 0
+  if (lane != 0) return;
+  for (int k = begin + 1; k < end; ++k) {
+    const int v = candB[k];
+    int p = k - 1;
+    while (p >= begin && candB[p] > v) {
+      candB[p + 1] = candB[p];
+      --p;
+    }
+    candB[p + 1] = v;
+  }
+}
+
+// Lanes per body: a warp while the bodies alone cannot fill the GPU, fewer when they can
+// (GEM_CUDA_ROW_LANES = 1, 2, 4, 8, 16 or 32 overrides, for measuring).
+static int rowLanes(int n) {
+  static const int forced = [] {
+    const char* v = std::getenv("GEM_CUDA_ROW_LANES");
+    return v ? std::atoi(v) : 0;
+  }();
+  if (forced == 1 || forced == 2 || forced == 4 || forced == 8 || forced == 16 || forced == 32) return forced;
+  return n < 16384 ? 32 : 4;  // measured on an H200: 4 and 8 lanes best at 10^5 floes, 32 at 824
+}
+
+template <bool Write>
+static void launchRows(int lanes, int blocks, cudaStream_t s, const GridView& g, int* count, const int* offset, int* candA, int* candB) {
+  switch (lanes) {
+    case 1: partnerRowsKernel<Write, 1><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
+    case 2: partnerRowsKernel<Write, 2><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
+    case 4: partnerRowsKernel<Write, 4><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
+    case 8: partnerRowsKernel<Write, 8><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
+    case 16: partnerRowsKernel<Write, 16><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
+    default: partnerRowsKernel<Write, 32><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
+  }
+  GEM_CUDA_CHECK_LAUNCH();
+}
+
+// A large body's row (all j > l) is one block's work: a single thread walking 10^5 bodies was
+// most of a step at that size. Order is kept by a block-wide scan, chunk after chunk.
+constexpr int kLargeBlock = 1024;
+
+__global__ void largeRowCountKernel(GridView g, int* count) {
+  using Reduce = cub::BlockReduce<int, kLargeBlock>;
+  __shared__ typename Reduce::TempStorage temp;
+  const int l = g.large[blockIdx.x];
+  int c = 0;
+  for (int j = l + 1 + threadIdx.x; j < g.n; j += kLargeBlock) c += accept(g, l, j) ? 1 : 0;
+  const int total = Reduce(temp).Sum(c);
+  if (threadIdx.x == 0) count[l] = total;
+}
+
+__global__ void largeRowWriteKernel(GridView g, const int* offset, int* candA, int* candB) {
+  using Scan = cub::BlockScan<int, kLargeBlock>;
+  __shared__ typename Scan::TempStorage temp;
+  const int l = g.large[blockIdx.x];
+  if (offset[l + 1] > g.capacity) return;  // overflow: the step is redone with more room
+  int base = offset[l];
+  for (int start = l + 1; start < g.n; start += kLargeBlock) {
+    const int j = start + threadIdx.x;
+    const int hit = j < g.n && accept(g, l, j) ? 1 : 0;
+    int position = 0, total = 0;
+    Scan(temp).ExclusiveSum(hit, position, total);
+    if (hit) candA[base + position] = l, candB[base + position] = j;
+    base += total;
+    __syncthreads();  // temp is reused by the next chunk's scan
+  }
+}
+
+// Over the capacity + 1 entries: candidates past this step's count get flag 0, so the scan of a
+// fixed length (captured in the graph) counts exactly this step's contacts.
+__global__ void narrowphaseKernel(int capacity, const int* needed, const int* candA, const int* candB, const Vec2* worldVertices,
+                                  const int* vertexCount, const Real* x, const Real* y, Contact* out, int* flag, StepStats* stats) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p > capacity) return;
+  const int total = *needed, count = total < capacity ? total : capacity;
+  if (p == 0) {
+    stats->candidatesNeeded = total;
+    stats->candidates = count;
+    stats->overflow = total > capacity ? 1 : 0;
+  }
+  if (p >= count) {
+    flag[p] = 0;
+    return;
+  }
+  const int a = candA[p], b = candB[p];
+  const Contact c = computeContact(worldVertices + static_cast<size_t>(a) * kMaxVertices, vertexCount[a], Vec2{x[a], y[a]},
+                                   worldVertices + static_cast<size_t>(b) * kMaxVertices, vertexCount[b], Vec2{x[b], y[b]});
+  out[p] = c;
+  flag[p] = c.touching ? 1 : 0;
+}
+
+__device__ inline unsigned long long contactIdKey(std::int64_t ia, std::int64_t ib, int bits) {
+  const std::int64_t lo = ia < ib ? ia : ib, hi = ia < ib ? ib : ia;
+  return (static_cast<unsigned long long>(lo) << bits) | static_cast<unsigned long long>(hi);
+}
+
+__device__ inline bool sortedContains(const unsigned long long* keys, int n, unsigned long long key) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (keys[mid] < key) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo < n && keys[lo] == key;
+}
+
+struct CompactArgs {
+  int capacity, n, idBits;
+  unsigned long long padKey;  // larger than any real key: padding sorts to the end
+  const int *candA, *candB;
+  const Contact* cand;
+  const int *flag, *offset;
+  const std::int64_t* id;
+  const unsigned long long* previous;
+  int *contactA, *contactB;
+  PairContact* contacts;
+  PairSlot* slots;
+  unsigned long long* keys;
+  int *bKey, *bIndex;
+  StepStats* stats;
+};
+
+// Compaction in order, onset against the previous step's sorted id pairs. The entries past this
+// step's contacts are padded (slot n, the largest key) so the fixed-length sorts keep them last.
+__global__ void compactContactsKernel(CompactArgs a) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p >= a.capacity) return;
+  const int contacts = a.offset[a.capacity];
+  if (p == 0) a.stats->contacts = contacts;
+  if (!a.flag[p]) {
+    const int k = contacts + (p - a.offset[p]);  // the non-contacts fill [contacts, capacity) once each
+    a.contactA[k] = a.n;
+    a.contactB[k] = a.n;
+    a.keys[k] = a.padKey;
+    a.bKey[k] = a.n;
+    a.bIndex[k] = k;
+    return;
+  }
+  const int k = a.offset[p], ia = a.candA[p], ib = a.candB[p];
+  const unsigned long long key = contactIdKey(a.id[ia], a.id[ib], a.idBits);
+  a.contactA[k] = ia;
+  a.contactB[k] = ib;
+  a.contacts[k] = PairContact{a.cand[p], !sortedContains(a.previous, a.stats->previousContacts, key)};
+  a.slots[k] = PairSlot{{0, 0}};
+  a.keys[k] = key;
+  a.bKey[k] = ib;
+  a.bIndex[k] = k;
+}
+
+// This step's sorted id pairs become the next step's "previous" (not when the step overflowed).
+__global__ void commitContactsKernel(int capacity, const unsigned long long* sorted, unsigned long long* previous, StepStats* stats) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= capacity || stats->overflow) return;
+  const int contacts = stats->contacts;
+  if (k < contacts) previous[k] = sorted[k];
+  if (k == 0) stats->previousContacts = contacts;
+}
+
+// After ids outgrew the key's field width: re-key the kept pairs (the order is unchanged).
+__global__ void rekeyKernel(unsigned long long* keys, const StepStats* stats, int oldBits, int newBits) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= stats->previousContacts) return;
+  const unsigned long long key = keys[k], hi = key & ((1ull << oldBits) - 1), lo = key >> oldBits;
+  keys[k] = (lo << newBits) | hi;
+}
+
+__device__ inline int lowerBound(const int* v, int n, int x) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (v[mid] < x) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
+// One contact's impulse on body b at point c, exactly as Simulation::gatherAndMove.
+__device__ inline void addImpulse(const PairBody& b, Vec2 ji, Vec2 c, VelocityChange& total) {
+  if (b.dof == 0) return;
+  if (b.dof == 1) {
+    const Vec2 heading{cos(b.angle), sin(b.angle)};
+    total.dv += (b.invMass * dot(ji, heading)) * heading;
+    return;
+  }
+  total.dv += b.invMass * ji;
+  total.domega += b.invInertia * cross(c - b.position, ji);
+}
+
+// Each body sums its contacts in contact order: the CPU loop visits contact k's a then b, and a
+// body's contacts as b (a < i) all come before its contacts as a (sorted by a). No atomics.
+// contactA and bKeySorted are sorted with the padding (slot n) last, so searching the whole
+// capacity finds only real contacts.
+__global__ void gatherKernel(int n, int vessel, const PairBody* bodies, const VelocityChange* changes, int capacity,
+                             const int* contactA, const int* bKeySorted, const int* bIndexSorted, const PairContact* contacts,
+                             const PairSlot* slots, MotionBody* motion, StepStats* stats) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const PairBody& b = bodies[i];
+  VelocityChange total = changes[i];
+  Vec2 vesselImpulse{0, 0};
+  for (int q = lowerBound(bKeySorted, capacity, i); q < capacity && bKeySorted[q] == i; ++q) {
+    const int k = bIndexSorted[q];
+    const Vec2 j = slots[k].impulse;
+    if (j.x == 0 && j.y == 0) continue;
+    if (i == vessel) vesselImpulse += j;
+    addImpulse(b, j, contacts[k].geometry.point, total);
+  }
+  for (int k = lowerBound(contactA, capacity, i); k < capacity && contactA[k] == i; ++k) {
+    const Vec2 j = slots[k].impulse;
+    if (j.x == 0 && j.y == 0) continue;
+    if (i == vessel) vesselImpulse += -j;
+    addImpulse(b, -j, contacts[k].geometry.point, total);
+  }
+  if (i == vessel) stats->vesselImpulse = vesselImpulse;
+  motion[i] = MotionBody{b.kind, b.dof, b.position, b.angle, b.velocity + total.dv, b.omega + total.domega};
+}
+
+// The only write of the state; skipped when the step overflowed, so it can simply be run again.
+__global__ void writeBackKernel(int n, int vessel, const MotionBody* motion, Real* x, Real* y, Real* angle, Real* vx, Real* vy,
+                                Real* omega, StepStats* stats) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n || stats->overflow) return;
+  const MotionBody& b = motion[i];
+  x[i] = b.position.x;
+  y[i] = b.position.y;
+  angle[i] = b.angle;
+  vx[i] = b.velocity.x;
+  vy[i] = b.velocity.y;
+  omega[i] = b.omega;
+  if (i == vessel) {
+    stats->vesselPosition = b.position;
+    stats->vesselVelocity = b.velocity;
+    stats->vesselAngle = b.angle;
+  }
+}
+
+static int bitsFor(unsigned long long v) {
+  int bits = 1;
+  while (bits < 64 && (1ull << bits) <= v) ++bits;
+  return bits;
+}
+
+// ---- DeviceWorld -------------------------------------------------------------------------------
+
+DeviceWorld::DeviceWorld() : m_state(std::make_unique<DeviceState>()) {}
+DeviceWorld::~DeviceWorld() = default;
+void DeviceWorld::addPairEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->pairEvents.push_back(std::move(driver)); }
+void DeviceWorld::addSoloEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->soloEvents.push_back(std::move(driver)); }
+void DeviceWorld::addMotionEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->motionEvents.push_back(std::move(driver)); }
+
+void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
+  DeviceState& d = *m_state;
+  d.dropGraph();
+  const int n = w.size();
+  d.n = n;
+  d.vesselSlot = vesselSlot;
+  d.id.upload(w.id.data(), n);
+  d.kind.upload(w.kind.data(), n);
+  d.vertexCount.upload(w.vertexCount.data(), n);
+  d.local.upload(w.localVertices.data(), static_cast<size_t>(n) * kMaxVertices);
+  d.x.upload(w.x.data(), n), d.y.upload(w.y.data(), n), d.angle.upload(w.angle.data(), n);
+  d.vx.upload(w.vx.data(), n), d.vy.upload(w.vy.data(), n), d.omega.upload(w.omega.data(), n);
+  d.area.upload(w.area.data(), n), d.thickness.upload(w.thickness.data(), n), d.mass.upload(w.mass.data(), n);
+  d.invMass.upload(w.invMass.data(), n), d.invInertia.upload(w.invInertia.data(), n);
+  d.gyration2.upload(w.gyration2.data(), n), d.gyrationX2.upload(w.gyrationX2.data(), n);
+  d.gyrationY2.upload(w.gyrationY2.data(), n), d.principalAngle.upload(w.principalAngle.data(), n);
+
+  // dof as Simulation's dofOf. The grid cell is the largest floe diameter, so a floe's box spans at
+  // most one cell; bodies larger than that (walls, the vessel) are "large" and tested against all.
+  std::vector<int> dof(n);
+  Real largestFloe = 0;
+  for (int i = 0; i < n; ++i) {
+    dof[i] = w.kind[i] == BodyKind::Wall ? 0 : (w.kind[i] == BodyKind::Vessel ? vesselDof : 3);
+    if (w.kind[i] == BodyKind::Floe) largestFloe = std::max(largestFloe, w.radius[i]);
+  }
+  d.cell = largestFloe > 0 ? 2 * largestFloe : Real(1);
+  std::vector<unsigned char> isLarge(n);
+  std::vector<int> large;
+  for (int i = 0; i < n; ++i) {
+    isLarge[i] = 2 * w.radius[i] > d.cell;
+    if (isLarge[i]) large.push_back(i);
+  }
+  d.dof.upload(dof.data(), n);
+  d.isLarge.upload(isLarge.data(), n);
+  d.large.upload(large.data(), large.size());
+  d.largeCount = static_cast<int>(large.size());
+  d.tableBits = 6;
+  while ((1u << d.tableBits) < 2u * static_cast<unsigned>(n) && d.tableBits < 30) ++d.tableBits;
+  d.tableSize = 1u << d.tableBits;
+
+  // Contact keys: (lo << idBits) | hi with room for new ids from breaks; widened (and the kept keys
+  // re-keyed) when the ids outgrow it.
+  const int bitsNeeded = bitsFor(static_cast<unsigned long long>(std::max<std::int64_t>(w.nextId, 1)));
+  if (bitsNeeded > 32) throw std::runtime_error("CUDA backend: body ids past 2^32 are not supported");
+  if (bitsNeeded > d.idBits) {
+    const int newBits = std::min(32, bitsNeeded + 2);
+    if (d.idBits > 0 && d.capacity > 0) {
+      rekeyKernel<<<blocksFor(d.capacity), kBlock, 0, d.stream>>>(d.previousKeys.get(), d.stats.get(), d.idBits, newBits);
+      GEM_CUDA_CHECK_LAUNCH();
+      GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
+    }
+    d.idBits = newBits;
+  }
+
+  const size_t nn = std::max(n, 1);
+  d.worldVertices.ensure(nn * kMaxVertices);
+  d.boxes.ensure(nn), d.pairBodies.ensure(nn), d.soloBodies.ensure(nn), d.changes.ensure(nn), d.motionBodies.ensure(nn);
+  d.cellKey.ensure(nn), d.cellKeySorted.ensure(nn), d.slot.ensure(nn), d.slotSorted.ensure(nn);
+  d.cellStart.ensure(d.tableSize), d.cellEnd.ensure(d.tableSize);
+  d.partnerCount.ensure(nn + 1), d.partnerOffset.ensure(nn + 1);
+  if (d.capacity == 0) {
+    // Grows when a step needs more (that step is then run again). GEM_CUDA_CAPACITY sets the start,
+    // so that a test can force the regrowth path.
+    const char* start = std::getenv("GEM_CUDA_CAPACITY");
+    d.capacity = start ? std::max(1, std::atoi(start)) : 4 * n + 256;
+  }
+}
+
+void DeviceWorld::download(World& w) const {
+  const DeviceState& d = *m_state;
+  const int n = w.size();
+  d.x.download(w.x.data(), n), d.y.download(w.y.data(), n), d.angle.download(w.angle.data(), n);
+  d.vx.download(w.vx.data(), n), d.vy.download(w.vy.data(), n), d.omega.download(w.omega.data(), n);
+}
+
+namespace {
+
+// The CUB calls of a step, for a fixed n and capacity: run with temp == nullptr they only add up
+// the scratch they need (so every buffer exists before the capture), then for real.
+struct CubCalls {
+  DeviceState& d;
+  void* temp;
+  size_t& bytes;  // in: available (real run); out: the largest need (sizing run)
+  bool sizing;
+
+  // need by reference: read after the CUB call has written it (argument order is unspecified).
+  void check(cudaError_t status, const size_t& need, const char* what) {
+    ::gem::cuda::check(status, what, __FILE__, __LINE__);
+    if (sizing) bytes = std::max(bytes, need);
+  }
+  void cellSort(int n, int bits) {
+    size_t need = sizing ? 0 : bytes;
+    check(cub::DeviceRadixSort::SortPairs(temp, need, d.cellKey.get(), d.cellKeySorted.get(), d.slot.get(), d.slotSorted.get(), n, 0,
+                                          bits, d.stream),
+          need, "cub SortPairs (cells)");
+  }
+  void scanPartners(int n) {
+    size_t need = sizing ? 0 : bytes;
+    check(cub::DeviceScan::ExclusiveSum(temp, need, d.partnerCount.get(), d.partnerOffset.get(), n + 1, d.stream), need, "cub ExclusiveSum (partners)");
+  }
+  void scanFlags(int capacity) {
+    size_t need = sizing ? 0 : bytes;
+    check(cub::DeviceScan::ExclusiveSum(temp, need, d.flag.get(), d.flagOffset.get(), capacity + 1, d.stream), need, "cub ExclusiveSum (flags)");
+  }
+  void sortKeys(int capacity, int bits) {
+    size_t need = sizing ? 0 : bytes;
+    check(cub::DeviceRadixSort::SortKeys(temp, need, d.contactKey.get(), d.sortedKeys.get(), capacity, 0, bits, d.stream), need, "cub SortKeys (contact ids)");
+  }
+  void sortB(int capacity, int bits) {
+    size_t need = sizing ? 0 : bytes;
+    check(cub::DeviceRadixSort::SortPairs(temp, need, d.bKey.get(), d.bKeySorted.get(), d.bIndex.get(), d.bIndexSorted.get(), capacity, 0,
+                                          bits, d.stream),
+          need, "cub SortPairs (b side)");
+  }
+};
+
+// Enqueues one whole step on d.stream (captured into the graph, never run outside it).
+void enqueueStep(DeviceState& d) {
+  cudaStream_t s = d.stream;
+  const int n = d.n, capacity = d.capacity;
+  const unsigned largeKey = d.tableSize;  // past every cell: large bodies sort to the end
+  size_t bytes = d.tempBytes;
+  CubCalls cubCalls{d, d.temp.get(), bytes, false};
+  StepStats* stats = d.stats.get();
+
+  GEM_CUDA_CHECK(cudaMemcpyAsync(d.ctx.get(), d.h_ctx, sizeof(StepContext), cudaMemcpyHostToDevice, s));
+  GEM_CUDA_CHECK(cudaMemsetAsync(stats, 0, 2 * sizeof(int), s));  // the record counters
+
+  // 1. World vertices, boxes, views, cell keys.
+  PrepareArgs a{n, d.vesselSlot, d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.local.get(), d.x.get(), d.y.get(),
+                d.angle.get(), d.vx.get(), d.vy.get(), d.omega.get(), d.area.get(), d.thickness.get(), d.mass.get(),
+                d.invMass.get(), d.invInertia.get(), d.gyration2.get(), d.gyrationX2.get(), d.gyrationY2.get(),
+                d.principalAngle.get(), d.isLarge.get(), d.cell, d.tableSize - 1, largeKey, d.worldVertices.get(), d.boxes.get(),
+                d.pairBodies.get(), d.soloBodies.get(), d.changes.get(), d.cellKey.get(), d.slot.get()};
+  prepareKernel<<<blocksFor(n), kBlock, 0, s>>>(a);
+  GEM_CUDA_CHECK_LAUNCH();
+
+  // 2. Broadphase: sort by cell, cell ranges, count, scan, write (rows sorted: pairs by (a, b)).
+  cubCalls.cellSort(n, bitsFor(largeKey));
+  GEM_CUDA_CHECK(cudaMemsetAsync(d.cellStart.get(), 0xff, d.tableSize * sizeof(int), s));
+  cellRangeKernel<<<blocksFor(n), kBlock, 0, s>>>(d.cellKeySorted.get(), n, largeKey, d.cellStart.get(), d.cellEnd.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  const GridView g{d.boxes.get(), d.invMass.get(), d.isLarge.get(), d.large.get(), d.largeCount, d.cellStart.get(),
+                   d.cellEnd.get(), d.slotSorted.get(), d.cell, d.tableSize - 1, n, capacity};
+  const int lanes = rowLanes(n);
+  const int rowBlocks = (lanes * (n + 1) + kBlock - 1) / kBlock;  // a tile per body, one more for count[n]
+  launchRows<false>(lanes, rowBlocks, s, g, d.partnerCount.get(), nullptr, nullptr, nullptr);
+  if (d.largeCount > 0) {
+    largeRowCountKernel<<<d.largeCount, kLargeBlock, 0, s>>>(g, d.partnerCount.get());
+    GEM_CUDA_CHECK_LAUNCH();
+  }
+  cubCalls.scanPartners(n);
+  launchRows<true>(lanes, rowBlocks, s, g, nullptr, d.partnerOffset.get(), d.candA.get(), d.candB.get());
+  if (d.largeCount > 0) {
+    largeRowWriteKernel<<<d.largeCount, kLargeBlock, 0, s>>>(g, d.partnerOffset.get(), d.candA.get(), d.candB.get());
+    GEM_CUDA_CHECK_LAUNCH();
+  }
+
+  // 3. Narrowphase, compaction in order (with padding), onset, the two sorts.
+  // computeContact is a long serial chain per pair with a 2.3 KB local-memory frame: while the
+  // pairs are few, blocks of one warp spread them over every multiprocessor's L1.
+  const int narrowBlock = capacity + 1 < 64 * 1024 ? 32 : kBlock;
+  narrowphaseKernel<<<(capacity + narrowBlock) / narrowBlock, narrowBlock, 0, s>>>(capacity, d.partnerOffset.get() + n, d.candA.get(), d.candB.get(),
+                                                                d.worldVertices.get(), d.vertexCount.get(), d.x.get(), d.y.get(),
+                                                                d.candContact.get(), d.flag.get(), stats);
+  GEM_CUDA_CHECK_LAUNCH();
+  cubCalls.scanFlags(capacity);
+  const unsigned long long padKey = d.idBits >= 32 ? ~0ull : (1ull << (2 * d.idBits)) - 1;
+  const CompactArgs c{capacity, n, d.idBits, padKey, d.candA.get(), d.candB.get(), d.candContact.get(), d.flag.get(),
+                      d.flagOffset.get(), d.id.get(), d.previousKeys.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(),
+                      d.slots.get(), d.contactKey.get(), d.bKey.get(), d.bIndex.get(), stats};
+  compactContactsKernel<<<blocksFor(capacity), kBlock, 0, s>>>(c);
+  GEM_CUDA_CHECK_LAUNCH();
+  cubCalls.sortKeys(capacity, std::min(64, 2 * d.idBits));
+  // The b side of every body, in contact order: a stable radix sort of (b, k) by b.
+  cubCalls.sortB(capacity, bitsFor(static_cast<unsigned long long>(n)));
+  commitContactsKernel<<<blocksFor(capacity), kBlock, 0, s>>>(capacity, d.sortedKeys.get(), d.previousKeys.get(), stats);
+  GEM_CUDA_CHECK_LAUNCH();
+
+  // 4. Two-body events write into each contact's slot; solo events from the start-of-step state.
+  const RecordSink sink{d.impacts.get(), capacity, &stats->impactCount, d.breaks.get(), capacity, &stats->breakCount};
+  const DevicePairData pairData{d.pairBodies.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(), d.slots.get(),
+                                capacity, &stats->contacts, d.ctx.get(), sink};
+  for (auto& e : d.pairEvents) e->launchPairs(pairData, s);
+  const DeviceSoloData soloData{d.soloBodies.get(), d.changes.get(), n, d.ctx.get()};
+  for (auto& e : d.soloEvents) e->launchSolo(soloData, s);
+
+  // 5. Gather, motion, write back; then the counters to the host.
+  gatherKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.vesselSlot, d.pairBodies.get(), d.changes.get(), capacity, d.contactA.get(),
+                                               d.bKeySorted.get(), d.bIndexSorted.get(), d.contacts.get(), d.slots.get(),
+                                               d.motionBodies.get(), stats);
+  GEM_CUDA_CHECK_LAUNCH();
+  const DeviceMotionData motionData{d.motionBodies.get(), n, d.ctx.get()};
+  for (auto& e : d.motionEvents) e->launchMotion(motionData, s);
+  writeBackKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.vesselSlot, d.motionBodies.get(), d.x.get(), d.y.get(), d.angle.get(),
+                                                  d.vx.get(), d.vy.get(), d.omega.get(), stats);
+  GEM_CUDA_CHECK_LAUNCH();
+  GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_stats, stats, sizeof(StepStats), cudaMemcpyDeviceToHost, s));
+}
+
+// Sizes every buffer for n and the capacity.
+void prepareBuffers(DeviceState& d) {
+  const size_t cap = static_cast<size_t>(d.capacity);
+  d.candA.ensure(cap), d.candB.ensure(cap), d.candContact.ensure(cap), d.flag.ensure(cap + 1), d.flagOffset.ensure(cap + 1);
+  d.contactA.ensure(cap), d.contactB.ensure(cap), d.contacts.ensure(cap), d.slots.ensure(cap), d.contactKey.ensure(cap);
+  d.sortedKeys.ensure(cap), d.bKey.ensure(cap), d.bKeySorted.ensure(cap), d.bIndex.ensure(cap), d.bIndexSorted.ensure(cap);
+  d.impacts.ensure(cap), d.breaks.ensure(cap);  // each contact yields at most one of each
+  d.previousKeys.ensureKeeping(cap, static_cast<size_t>(d.h_stats->previousContacts));
+
+  size_t bytes = 1;
+  CubCalls sizing{d, nullptr, bytes, true};
+  sizing.cellSort(d.n, bitsFor(d.tableSize));
+  sizing.scanPartners(d.n);
+  sizing.scanFlags(d.capacity);
+  sizing.sortKeys(d.capacity, std::min(64, 2 * d.idBits));
+  sizing.sortB(d.capacity, bitsFor(static_cast<unsigned long long>(d.n)));
+  d.temp.ensure(bytes);
+  d.tempBytes = bytes;
+}
+
+// Captures the step as a graph, replayed every step until n or the capacity changes.
+void captureStep(DeviceState& d) {
+  prepareBuffers(d);
+  d.dropGraph();
+  cudaGraph_t graph = nullptr;
+  GEM_CUDA_CHECK(cudaStreamBeginCapture(d.stream, cudaStreamCaptureModeThreadLocal));
+  try {
+    enqueueStep(d);
+  } catch (...) {
+    cudaStreamEndCapture(d.stream, &graph);
+    if (graph) cudaGraphDestroy(graph);
+    throw;
+  }
+  GEM_CUDA_CHECK(cudaStreamEndCapture(d.stream, &graph));
+  const cudaError_t status = cudaGraphInstantiate(&d.graph, graph, 0);
+  cudaGraphDestroy(graph);
+  GEM_CUDA_CHECK(status);
+}
+
+}  // namespace
+
+void DeviceWorld::step(const StepContext& ctx, DeviceStepResult& result) {
+  DeviceState& d = *m_state;
+  result = DeviceStepResult{};
+  if (d.n == 0) return;
+  *d.h_ctx = ctx;
+  static const bool useGraph = [] {
+    const char* v = std::getenv("GEM_CUDA_GRAPH");  // 0: launch the kernels one by one (debugging)
+    return !(v && v[0] == '0');
+  }();
+  for (;;) {
+    if (!useGraph) {
+      prepareBuffers(d);
+      enqueueStep(d);
+    } else {
+      if (!d.graph) captureStep(d);
+      GEM_CUDA_CHECK(cudaGraphLaunch(d.graph, d.stream));
+    }
+    GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
+    if (!d.h_stats->overflow) break;
+    // More candidate pairs than room: nothing was written back; grow, re-capture, run again.
+    d.capacity = d.h_stats->candidatesNeeded + d.h_stats->candidatesNeeded / 2 + 256;
+    d.dropGraph();
+  }
+  const StepStats stats = *d.h_stats;
+  result.candidates = stats.candidates;
+  result.contacts = stats.contacts;
+  const int impactCount = std::min(stats.impactCount, d.capacity);
+  const int breakCount = std::min(stats.breakCount, d.capacity);
+  result.impacts.resize(impactCount);
+  result.breaks.resize(breakCount);
+  if (impactCount) d.impacts.download(result.impacts.data(), impactCount);
+  if (breakCount) d.breaks.download(result.breaks.data(), breakCount);
+  result.vesselImpulse = stats.vesselImpulse;
+  result.vesselPosition = stats.vesselPosition;
+  result.vesselVelocity = stats.vesselVelocity;
+  result.vesselAngle = stats.vesselAngle;
+}
+
+}  // namespace gem::cuda

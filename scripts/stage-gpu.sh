@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Stages a build for the GPU machine (shared/GPU.md): builds here for compute capability 9.0, then
+# copies into .gpu-stage/ (git-ignored) the gem binary, the test binaries, the project's shared
+# libraries and every non-system, non-CUDA shared library they need, the scenarios, and a driver
+# script. On the GPU machine:  bash .gpu-stage/run.sh [OUT]   (OUT defaults to $OUT, else ./gpu-out)
+# It runs `gem info`, the CUDA tests, compute-sanitizer on them, the timings and a cuda run of
+# scenarios/thesis/random_50.toml, with every log under OUT. GEM_SKIP_SANITIZER=1 skips the
+# sanitizer; GEM_PROFILE=1 adds an nsys kernel summary of the 824-floe timing (where nsys exists).
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${GEM_STAGE_BUILD:-$root/build-cuda}"
+stage="$root/.gpu-stage"
+
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES=90 \
+  -DCMAKE_CUDA_COMPILER="${CUDACXX:-/usr/local/cuda/bin/nvcc}" -DGEM_BUILD_CGAL_TESTS=OFF >/dev/null
+cmake --build "$build" --target gem gem_tests gem_cuda_tests
+
+rm -rf "$stage"
+mkdir -p "$stage/lib"
+cp "$build/gem" "$build/tests/gem_cuda_tests" "$build/tests/gem_tests" "$stage/"
+cp "$build/libgem_core.so" "$build/libgem_cuda.so" "$stage/lib/"
+# Every library ldd resolves, except glibc's own, the C++ runtime the target has, and CUDA's.
+for bin in "$stage/gem" "$stage/gem_cuda_tests" "$stage/gem_tests" "$stage/lib/libgem_cuda.so"; do
+  ldd "$bin" | awk '/=> \//{print $3}' | while read -r lib; do
+    case "$(basename "$lib")" in
+      libc.so*|libm.so*|libdl.so*|librt.so*|libpthread.so*|ld-linux*|libgcc_s.so*|libstdc++.so*|libcuda.so*|libcudart.so*|libz.so*|libudev.so*) ;;
+      libgem_*) ;;
+      *) cp -nL "$lib" "$stage/lib/" ;;
+    esac
+  done
+done
+# The CUDA runtime of the build (13.0, as on the GPU machine) travels too: a match is then certain.
+cp -L "$(ldd "$stage/lib/libgem_cuda.so" | awk '/libcudart/{print $3}')" "$stage/lib/"
+cp -r "$root/scenarios" "$stage/scenarios"
+
+cat > "$stage/run.sh" <<'RUN'
+#!/usr/bin/env bash
+# Driver on the GPU machine: every result goes under OUT.
+stage="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+out="${1:-${OUT:-$PWD/gpu-out}}"
+mkdir -p "$out"
+export LD_LIBRARY_PATH="$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+# The tests find the gem binary and the scenarios here, not at the build's paths.
+export GEM_BINARY_DIR="$stage" GEM_SOURCE_DIR="$stage"
+status=0
+cd "$stage"
+{ date -u; nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv; } 2>&1 | tee "$out/device.txt"
+./gem info 2>&1 | tee "$out/gem-info.txt" | head -3
+echo "== CUDA tests"
+./gem_cuda_tests --gtest_color=no 2>&1 | tee "$out/cuda-tests.txt" | grep -E "^\[ +(OK|FAILED|SKIPPED|PASSED) |busy channel|CUDA device|Failure|Expected|Which|error" || true
+[ "${PIPESTATUS[0]}" = 0 ] || status=1
+if [ "${GEM_SKIP_SANITIZER:-0}" != 1 ]; then
+  echo "== compute-sanitizer (memcheck) on the CUDA tests (fast ones)"
+  sanitizer="$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)"
+  "$sanitizer" --tool memcheck --error-exitcode 9 ./gem_cuda_tests --gtest_color=no \
+    --gtest_filter='CudaBackend.TwoFloes*:CudaBackend.BusyChannelMatchesTheCpuAfter50Steps' > "$out/sanitizer.txt" 2>&1
+  rc=$?; tail -3 "$out/sanitizer.txt"; echo "compute-sanitizer exit $rc"; [ $rc = 0 ] || status=1
+fi
+echo "== timings (gem bench)"
+./gem bench --backend cpu cuda --cases 456 824 10000 --steps 2000 --csv "$out/bench-small.csv" 2>&1 | tee "$out/bench-small.txt"
+./gem bench --backend cuda --cases 100000 1000000 --steps 400 --csv "$out/bench-large-cuda.csv" 2>&1 | tee "$out/bench-large-cuda.txt"
+./gem bench --backend cpu --cases 100000 --steps 200 --csv "$out/bench-large-cpu.csv" 2>&1 | tee "$out/bench-large-cpu.txt"
+if command -v nsys >/dev/null && [ "${GEM_PROFILE:-0}" = 1 ]; then
+  echo "== nsys: kernel times of the 824-floe timing"
+  nsys profile -o "$out/profile" --force-overwrite true --stats=false ./gem_cuda_tests \
+    --gtest_filter='CudaBackend.BusyChannelSummary*' > "$out/nsys.txt" 2>&1
+  nsys stats --report cuda_gpu_kern_sum,cuda_api_sum --format csv "$out/profile.nsys-rep" > "$out/nsys-stats.txt" 2>&1
+  head -30 "$out/nsys-stats.txt" | cut -c1-200
+fi
+echo "== gem run --backend cuda scenarios/thesis/random_50.toml"
+./gem run scenarios/thesis/random_50.toml --backend cuda --out "$out/random_50" --set output.frame_every=0 > "$out/run-random_50.txt" 2>&1
+rc=$?; tail -4 "$out/run-random_50.txt"; [ $rc = 0 ] || status=1
+grep -E '"backend"|"device"|"impacts"|"steps"|"wall_time_s"' "$out/random_50/summary.json" || true
+exit $status
+RUN
+chmod +x "$stage/run.sh"
+du -sh "$stage"
