@@ -152,34 +152,11 @@ static int dofOf(const World& w, int i, int vesselDof) {
   }
 }
 
-// Re-sorts the bodies along a Morton (Z-order) curve so that neighbours sit near each other in
-// memory (DESIGN.md "Speed habits"). Every strategy sees the same order, so results stay identical.
+// Re-sorts the bodies along a Morton curve (World::curveOrder). Every strategy sees the same order,
+// so results stay identical.
 void Simulation::reorderAlongCurve() {
-  const int n = m_world.size();
-  if (n < 2) return;
-  Real x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (int i = 0; i < n; ++i) {
-    x0 = std::min(x0, m_world.x[i]); x1 = std::max(x1, m_world.x[i]);
-    y0 = std::min(y0, m_world.y[i]); y1 = std::max(y1, m_world.y[i]);
-  }
-  const Real scale = 65535 / std::max<Real>({x1 - x0, y1 - y0, Real(1e-9)});
-  auto spread = [](std::uint32_t v) {
-    v &= 0xffff;
-    v = (v | (v << 8)) & 0x00ff00ff;
-    v = (v | (v << 4)) & 0x0f0f0f0f;
-    v = (v | (v << 2)) & 0x33333333;
-    v = (v | (v << 1)) & 0x55555555;
-    return v;
-  };
-  std::vector<std::pair<std::uint32_t, int>> keys(n);
-  for (int i = 0; i < n; ++i) {
-    auto gx = static_cast<std::uint32_t>((m_world.x[i] - x0) * scale), gy = static_cast<std::uint32_t>((m_world.y[i] - y0) * scale);
-    keys[i] = {spread(gx) | (spread(gy) << 1), i};
-  }
-  std::sort(keys.begin(), keys.end());
-  std::vector<int> order(n);
-  for (int k = 0; k < n; ++k) order[k] = keys[k].second;
-  m_world.permute(order);
+  if (m_world.size() < 2) return;
+  m_world.permute(m_world.curveOrder());
   m_broadphase->invalidate();
 }
 

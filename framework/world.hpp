@@ -63,6 +63,9 @@ struct World {
   void removeBodies(const std::vector<char>& remove);
   // Reorders all arrays by the permutation (new slot k holds old slot order[k]).
   void permute(const std::vector<int>& order);
+  // The order of the bodies along a Morton (Z-order) curve through their centroids: neighbours in
+  // space become neighbours in memory (DESIGN.md "Speed habits"). Ties keep slot order.
+  std::vector<int> curveOrder() const;
   // Total mass of the floes, kg.
   double floeMass() const;
   int count(BodyKind k) const;

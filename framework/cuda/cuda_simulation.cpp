@@ -138,35 +138,11 @@ void CudaSimulation::step() {
   }
 }
 
-// A copy of Simulation::reorderAlongCurve (private there): the same order, so that both backends
-// sum each body's contacts in the same order.
+// The same order as Simulation::reorderAlongCurve, so that both backends sum each body's contacts
+// in the same order.
 void CudaSimulation::reorderAlongCurve() {
   World& w = world();
-  const int n = w.size();
-  if (n < 2) return;
-  Real x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (int i = 0; i < n; ++i) {
-    x0 = std::min(x0, w.x[i]), x1 = std::max(x1, w.x[i]);
-    y0 = std::min(y0, w.y[i]), y1 = std::max(y1, w.y[i]);
-  }
-  const Real scale = 65535 / std::max<Real>({x1 - x0, y1 - y0, Real(1e-9)});
-  auto spread = [](std::uint32_t v) {
-    v &= 0xffff;
-    v = (v | (v << 8)) & 0x00ff00ff;
-    v = (v | (v << 4)) & 0x0f0f0f0f;
-    v = (v | (v << 2)) & 0x33333333;
-    v = (v | (v << 1)) & 0x55555555;
-    return v;
-  };
-  std::vector<std::pair<std::uint32_t, int>> keys(n);
-  for (int i = 0; i < n; ++i) {
-    auto gx = static_cast<std::uint32_t>((w.x[i] - x0) * scale), gy = static_cast<std::uint32_t>((w.y[i] - y0) * scale);
-    keys[i] = {spread(gx) | (spread(gy) << 1), i};
-  }
-  std::sort(keys.begin(), keys.end());
-  std::vector<int> order(n);
-  for (int k = 0; k < n; ++k) order[k] = keys[k].second;
-  w.permute(order);
+  if (w.size() >= 2) w.permute(w.curveOrder());
 }
 
 // The backend's entry: listed by `gem info`, chosen by --backend cuda and by backend = "auto".
