@@ -67,6 +67,19 @@ if command -v nsys >/dev/null && [ "${GEM_PROFILE:-0}" = 1 ]; then
   nsys stats --report cuda_gpu_kern_sum,cuda_api_sum --format csv "$out/profile.nsys-rep" > "$out/nsys-stats.txt" 2>&1
   head -30 "$out/nsys-stats.txt" | cut -c1-200
 fi
+if [ "${GEM_LOAD_STUDY:-0}" = 1 ]; then
+  # The 70-run load study on the device: one CUDA run per sweep job, each on its own stream.
+  echo "== load study, backend cuda, --jobs ${GEM_LOAD_JOBS:-8}"
+  sed 's/^name = "load_study"/name = "load_study"\nset = { "simulation.backend" = "cuda" }/' scenarios/thesis/load_study.toml > scenarios/thesis/load_study_cuda.toml
+  start=$(date +%s.%N)
+  ./gem sweep scenarios/thesis/load_study_cuda.toml --out "$out/load_cuda" --jobs "${GEM_LOAD_JOBS:-8}" --quiet > "$out/load-cuda.txt" 2>&1
+  rc=$?
+  awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN{printf "load study on the device: %.1f s wall\n", b - a}' | tee -a "$out/load-cuda.txt"
+  tail -3 "$out/load-cuda.txt"; [ $rc = 0 ] || status=1
+  start=$(date +%s.%N)
+  ./gem sweep scenarios/thesis/load_study.toml --out "$out/load_cpu" --jobs "$(nproc)" --quiet > "$out/load-cpu.txt" 2>&1
+  awk -v a="$start" -v b="$(date +%s.%N)" -v j="$(nproc)" 'BEGIN{printf "load study on the CPU (%d jobs): %.1f s wall\n", j, b - a}' | tee -a "$out/load-cpu.txt"
+fi
 echo "== gem run --backend cuda scenarios/thesis/random_50.toml"
 ./gem run scenarios/thesis/random_50.toml --backend cuda --out "$out/random_50" --set output.frame_every=0 > "$out/run-random_50.txt" 2>&1
 rc=$?; tail -4 "$out/run-random_50.txt"; [ $rc = 0 ] || status=1
