@@ -86,6 +86,7 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   std::unique_ptr<Stepper> stepper = makeStepper(scenario);  // bad input throws here, before anything is written
   Stepper& sim = *stepper;
   summary.device = sim.device();
+  summary.backend = sim.backend();  // "auto" may have fallen back to the cpu
   summary.floesInitial = sim.hostWorld().count(BodyKind::Floe);
   summary.iceMassInitial = sim.hostWorld().floeMass();
 

@@ -44,6 +44,7 @@ class Simulation final : public Stepper {
   const World& hostWorld() override { return m_world; }
   VesselSample vessel() override;
   std::string device() const override { return "cpu"; }
+  std::string backend() const override { return "cpu"; }
   const std::vector<EnabledEvent>& events() const { return m_events; }
   Broadphase& broadphase() { return *m_broadphase; }
 

@@ -1,5 +1,6 @@
 #include "framework/stepper.hpp"
 
+#include <cstdio>
 #include <map>
 
 #include <fmt/format.h>
@@ -47,7 +48,14 @@ std::string resolveBackend(const std::string& requested) {
 }
 
 std::unique_ptr<Stepper> makeStepper(const Scenario& scenario) {
-  return findBackend(resolveBackend(scenario.backend))->make(scenario);
+  const std::string backend = resolveBackend(scenario.backend);
+  try {
+    return findBackend(backend)->make(scenario);
+  } catch (const BackendUnsupported& e) {
+    if (scenario.backend != "auto" || backend == "cpu") throw;
+    std::fprintf(stderr, "gem: backend auto: %s; running on the cpu\n", e.what());
+    return findBackend("cpu")->make(scenario);
+  }
 }
 
 }  // namespace gem

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "framework/errors.hpp"
 #include "framework/event_api.hpp"
 #include "framework/scenario.hpp"
 #include "framework/world.hpp"
@@ -37,6 +38,14 @@ class Stepper {
   virtual double rubbleMass() const = 0;
   virtual long floesBroken() const = 0;
   virtual std::string device() const = 0;
+  virtual std::string backend() const = 0;  // "cpu", "cuda"
+};
+
+// A backend that cannot run this scenario (e.g. an event without a driver for it). Bad input when
+// the backend was asked for by name; with "auto", makeStepper falls back to the CPU instead.
+class BackendUnsupported : public InputError {
+ public:
+  using InputError::InputError;
 };
 
 struct BackendEntry {
@@ -53,6 +62,8 @@ std::vector<std::string> backendNames();
 // "auto" is "cuda" when that backend is built and a device is present, else "cpu". Asking for a
 // backend that is not built, or has no device, is an InputError that says so.
 std::string resolveBackend(const std::string& requested);
+// The scenario's backend, made. With backend = "auto", a device backend that cannot run the
+// scenario (BackendUnsupported) gives way to the CPU, with a note on stderr.
 std::unique_ptr<Stepper> makeStepper(const Scenario& scenario);
 
 }  // namespace gem

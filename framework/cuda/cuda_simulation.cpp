@@ -10,7 +10,9 @@
 #include <unordered_map>
 
 #include "framework/cuda/device_world.hpp"
+#include "framework/registry.hpp"
 #include "framework/simulation.hpp"
+#include "framework/stepper.hpp"
 
 namespace gem {
 
@@ -47,8 +49,15 @@ CudaSimulation::CudaSimulation(const Scenario& scenario)
   // instances give the Params the device drivers are made from, in the same order.
   for (const EnabledEvent& e : m_cpu->events()) {
     if (e.phase == EventPhase::Topology) continue;  // runs on the host
+    // Device drivers are found by name and made from the CPU entry's Params: that is only right for
+    // the built-in entry of that name. A plugin's event (new, or overriding a built-in) has no
+    // device driver yet, and pairing it with the built-in's would read its Params wrongly.
+    const EventEntry* entry = Registry::global().findEvent(e.name);
+    if (entry && entry->origin != "built-in")
+      throw BackendUnsupported("event \"" + e.name + "\" comes from a plugin (" + entry->origin +
+                               "): plugin events have no CUDA driver yet; run it with --backend cpu");
     const cuda::CudaEventFactory* factory = cuda::findCudaEvent(e.name);
-    if (!factory) throw std::runtime_error("event \"" + e.name + "\" has no CUDA driver (an events/" + e.name + ".cu is missing)");
+    if (!factory) throw BackendUnsupported("event \"" + e.name + "\" has no CUDA driver (events/" + e.name + ".cu is missing)");
     auto driver = (*factory)(e.instance->params());
     if (e.phase == EventPhase::Pair) m_device->addPairEvent(std::move(driver));
     else if (e.phase == EventPhase::Solo) m_device->addSoloEvent(std::move(driver));

@@ -42,6 +42,7 @@ class CudaSimulation final : public Stepper {
   double rubbleMass() const override { return m_rubbleMass; }
   long floesBroken() const override { return m_floesBroken; }
   std::string device() const override { return m_deviceName; }
+  std::string backend() const override { return "cuda"; }
   int candidateCount() const { return m_candidateCount; }
 
  private:

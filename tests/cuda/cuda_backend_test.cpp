@@ -236,3 +236,32 @@ TEST(CudaBackend, CandidateOverflowIsRedoneBitIdentically) {
   EXPECT_EQ(a.impacts, b.impacts);
   EXPECT_GT(roomy.candidateCount(), 8);
 }
+
+// A plugin's event has no CUDA driver: asked for by name, cuda refuses it clearly; with "auto"
+// the run goes to the CPU. (Made here as an entry of a non-built-in origin, as a plugin's would be.)
+namespace {
+struct NudgeFromPlugin {
+  struct Params {
+    Real dv;
+  };
+  static void apply(const Params& p, const SoloBody&, VelocityChange& change, const StepContext&) { change.dv.x += p.dv; }
+};
+}  // namespace
+
+TEST(CudaBackend, PluginEventsRunOnTheCpuUnderAutoAndAreRefusedByCuda) {
+  GEM_SKIP_WITHOUT_CUDA();
+  if (!Registry::global().findEvent("nudge_from_plugin"))
+    Registry::global().addEvent(EventEntry{"nudge_from_plugin", "test", "libnudge.so (nudge 1.0)", EventPhase::Solo, false,
+                                           [](EventConfig&) -> std::unique_ptr<EventInstance> {
+                                             return std::make_unique<CpuSoloDriver<NudgeFromPlugin>>(NudgeFromPlugin::Params{0.1});
+                                           }});
+  TempDir dir;
+  const std::string scene = "[simulation]\nsteps = 5\n[events.nudge_from_plugin]\n[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
+  Scenario cuda = test::scenarioFromToml(dir, scene, {"simulation.backend=\"cuda\""});
+  EXPECT_THROW(makeStepper(cuda), BackendUnsupported);
+  Scenario automatic = test::scenarioFromToml(dir, scene, {"simulation.backend=\"auto\""});
+  auto stepper = makeStepper(automatic);
+  EXPECT_EQ(stepper->backend(), "cpu");
+  stepper->step();
+  EXPECT_NEAR(stepper->hostWorld().vx[0], 0.1, 1e-12);
+}
