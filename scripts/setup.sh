@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Installs what GEM needs from Debian's packages (only what is missing) and configures + builds it.
-# Usage: scripts/setup.sh [BUILD_DIR]   (default: build)
+# Usage: scripts/setup.sh [BUILD_DIR [TARGET ...]]   (default: build, every target)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${1:-$here/build}"
+shift || true
+targets=("$@")
 
 packages=(cmake ninja-build g++ pkg-config libeigen3-dev libboost-dev libboost-filesystem-dev
           libtomlplusplus-dev libfmt-dev libcgal-dev libgmp-dev libmpfr-dev libgtest-dev libgmock-dev
@@ -25,4 +27,8 @@ if [ -x /usr/local/cuda/bin/nvcc ] && [ "${GEM_CUDA:-auto}" != "off" ]; then
   cuda_args=(-DCMAKE_CUDA_COMPILER=/usr/local/cuda/bin/nvcc)
 fi
 cmake -S "$here" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${cuda_args[@]}" >/dev/null
-cmake --build "$build_dir" --parallel "$(nproc)"
+if ((${#targets[@]})); then
+  cmake --build "$build_dir" --parallel "$(nproc)" --target "${targets[@]}"
+else
+  cmake --build "$build_dir" --parallel "$(nproc)"
+fi
