@@ -1,7 +1,8 @@
 # cmake --install BUILD --prefix P: the SDK a plugin is built against (docs/plugins.md).
-#   P/bin/gem, P/lib/libgem_core.so, P/include/gem/{geometry,events,framework,broadphase}/*.hpp,
+#   P/bin/gem, P/lib/libgem_core.so (and libgem_cuda.so with the CUDA backend),
+#   P/include/gem/{geometry,events,framework,broadphase}/*.hpp,
 #   P/lib/cmake/gem/: gemConfig.cmake (find_package(gem)), gemTargets.cmake (gem::gem_core,
-#   gem::gem), GemPlugin.cmake (gem_add_plugin).
+#   gem::gem, gem::gem_cuda), GemPlugin.cmake (gem_add_plugin).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -25,8 +26,9 @@ install(TARGETS gem_core gem EXPORT gemTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 if(TARGET gem_cuda)
+  # Exported as gem::gem_cuda: a plugin's CUDA part links it (gem_add_plugin's CUDA_SOURCES).
   set_target_properties(gem_cuda PROPERTIES INSTALL_RPATH "$ORIGIN")
-  install(TARGETS gem_cuda LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(TARGETS gem_cuda EXPORT gemTargets LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endif()
 install(EXPORT gemTargets NAMESPACE gem:: DESTINATION ${GEM_INSTALL_CMAKEDIR} FILE gemTargets.cmake)
 

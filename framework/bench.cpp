@@ -10,6 +10,7 @@
 
 #include "framework/atomic_file.hpp"
 #include "framework/errors.hpp"
+#include "framework/geometry_bench.hpp"
 #include "framework/simulation.hpp"
 #include "framework/stepper.hpp"
 
@@ -53,6 +54,7 @@ Scenario largeField(int floes) {
 }  // namespace
 
 int runBench(const BenchOptions& options) {
+  if (options.table != "step") return runGeometryBench(GeometryBenchOptions{options.table, options.sizes, options.csv, options.reps});
   std::vector<BenchCase> cases;
   auto wanted = [&](const char* c, bool byDefault) {
     return options.cases.empty() ? byDefault : std::find(options.cases.begin(), options.cases.end(), c) != options.cases.end();

@@ -20,6 +20,7 @@
 #include "framework/runner.hpp"
 #include "framework/scenario.hpp"
 #include "framework/simulation.hpp"
+#include "framework/mpi_work.hpp"
 #include "framework/stepper.hpp"
 #include "framework/sweep.hpp"
 
@@ -105,6 +106,7 @@ int commandInfo(const std::vector<std::string>& plugins) {
               fmt::format("{}", fmt::join(backendNames(), ", ")).c_str(),
               cuda ? ", CUDA architectures " GEM_CUDA_ARCHITECTURES : " (no CUDA backend in this build)");
   std::printf("plugin ABI: version %d, compiler %s %s\n", GEM_PLUGIN_ABI_VERSION, GEM_COMPILER_ID, GEM_COMPILER_VERSION);
+  std::printf("sweeps across MPI ranks: %s\n", mpiBuilt() ? "yes" : "no (built without MPI)");
   std::printf("devices: cpu");
   if (cuda) std::printf(", %s", cuda->available() ? cuda->deviceName().c_str() : "no CUDA device found");
   std::printf("\n\nevents (phase, default, origin):\n");
@@ -149,7 +151,10 @@ int main(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "version, build, devices, registered events and broadphases");
   info->add_option("--plugin", infoPlugins, "load this plugin first (repeatable); GEM_PLUGIN_PATH's are loaded too");
   BenchOptions bench;
-  CLI::App* benchCommand = app.add_subcommand("bench", "time a backend per step on the thesis fields and on 10^4 to 10^6 floes");
+  CLI::App* benchCommand = app.add_subcommand("bench", "time a backend per step (thesis fields, 10^4 to 10^6 floes), or the geometry tables (--table)");
+  benchCommand->add_option("--table", bench.table, "step (time per step, default), intersection or triangulation (thesis 5.2, 5.3)");
+  benchCommand->add_option("--sizes", bench.sizes, "intersection/triangulation: N per row (default the thesis's sizes)");
+  benchCommand->add_option("--reps", bench.reps, "intersection/triangulation: timed repetitions, median (default 50)");
   benchCommand->add_option("--steps", bench.steps, "steps timed per case");
   benchCommand->add_option("--csv", bench.csv, "also write the table as CSV");
   benchCommand->add_option("--cases", bench.cases, "which cases: 456, 824, 10000, 100000, 1000000 (default the first three)");

@@ -13,6 +13,14 @@ bool launchedByMpi() {
   return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK");
 }
 
+bool mpiBuilt() {
+#if defined(GEM_HAVE_MPI)
+  return true;
+#else
+  return false;
+#endif
+}
+
 #if defined(GEM_HAVE_MPI)
 
 struct MpiWork::State {

@@ -32,5 +32,7 @@ class MpiWork {
 
 // True when the environment says this process was launched by an MPI starter.
 bool launchedByMpi();
+// True when this build of GEM has MPI (gem info says so; the MPI sweep test needs it).
+bool mpiBuilt();
 
 }  // namespace gem

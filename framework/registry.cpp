@@ -51,6 +51,8 @@ void Registry::beginPlugin(const std::string& origin, bool allowOverride) {
 
 void Registry::abortPlugin() { m_staging.reset(); }
 
+std::string Registry::pluginOrigin() const { return m_staging ? m_staging->origin : std::string("built-in"); }
+
 namespace {
 
 // A clash of a plugin's entry with one already there (or with another of its own entries).

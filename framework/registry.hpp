@@ -112,6 +112,9 @@ class Registry {
   void beginPlugin(const std::string& origin, bool allowOverride);
   void commitPlugin();
   void abortPlugin();
+  // The origin of the plugin registering now (between beginPlugin and commit/abort), else
+  // "built-in". A plugin's CUDA drivers are keyed by it (framework/cuda/cuda_events.hpp).
+  std::string pluginOrigin() const;
 
  private:
   std::map<std::string, EventEntry> m_events;

@@ -3,9 +3,10 @@
 # copies into .gpu-stage/ (git-ignored) the gem binary, the test binaries, the project's shared
 # libraries and every non-system, non-CUDA shared library they need, the scenarios, and a driver
 # script. On the GPU machine:  bash .gpu-stage/run.sh [OUT]   (OUT defaults to $OUT, else ./gpu-out)
-# It runs `gem info`, the CUDA tests, compute-sanitizer on them, the timings and a cuda run of
-# scenarios/thesis/random_50.toml, with every log under OUT. GEM_SKIP_SANITIZER=1 skips the
-# sanitizer; GEM_PROFILE=1 adds an nsys kernel summary of the 824-floe timing (where nsys exists).
+# It runs `gem info`, the CUDA tests (a plugin's event on the device among them), compute-sanitizer
+# on them, the timings and a cuda run of scenarios/thesis/random_50.toml, with every log under OUT.
+# GEM_SKIP_SANITIZER=1 skips the sanitizer; GEM_PROFILE=1 adds an nsys kernel summary of the
+# 824-floe timing (where nsys exists).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${GEM_STAGE_BUILD:-$root/build-cuda}"
@@ -13,7 +14,7 @@ stage="$root/.gpu-stage"
 
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES=90 \
   -DCMAKE_CUDA_COMPILER="${CUDACXX:-/usr/local/cuda/bin/nvcc}" -DGEM_BUILD_CGAL_TESTS=OFF >/dev/null
-cmake --build "$build" --target gem gem_tests gem_cuda_tests
+cmake --build "$build" --target gem gem_tests gem_cuda_tests  # gem_cuda_tests builds the CUDA test plugin too
 
 rm -rf "$stage"
 mkdir -p "$stage/lib"
@@ -32,6 +33,9 @@ done
 # The CUDA runtime of the build (13.0, as on the GPU machine) travels too: a match is then certain.
 cp -L "$(ldd "$stage/lib/libgem_cuda.so" | awk '/libcudart/{print $3}')" "$stage/lib/"
 cp -r "$root/scenarios" "$stage/scenarios"
+# The shear_current plugin with its CUDA part (tests/cuda/plugin_cuda_test.cpp runs it on the device).
+mkdir -p "$stage/cuda_plugins"
+cp "$build/tests/cuda_plugins/libshear_current.so" "$stage/cuda_plugins/"
 
 cat > "$stage/run.sh" <<'RUN'
 #!/usr/bin/env bash
@@ -41,7 +45,7 @@ out="${1:-${OUT:-$PWD/gpu-out}}"
 mkdir -p "$out"
 export LD_LIBRARY_PATH="$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 # The tests find the gem binary and the scenarios here, not at the build's paths.
-export GEM_BINARY_DIR="$stage" GEM_SOURCE_DIR="$stage"
+export GEM_BINARY_DIR="$stage" GEM_SOURCE_DIR="$stage" GEM_TEST_CUDA_PLUGIN_DIR="$stage/cuda_plugins"
 status=0
 cd "$stage"
 { date -u; nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv; } 2>&1 | tee "$out/device.txt"
@@ -60,6 +64,10 @@ echo "== timings (gem bench)"
 ./gem bench --backend cpu cuda --cases 456 824 10000 --steps 2000 --csv "$out/bench-small.csv" 2>&1 | tee "$out/bench-small.txt"
 ./gem bench --backend cuda --cases 100000 1000000 --steps 400 --csv "$out/bench-large-cuda.csv" 2>&1 | tee "$out/bench-large-cuda.txt"
 ./gem bench --backend cpu --cases 100000 --steps 200 --csv "$out/bench-large-cpu.csv" 2>&1 | tee "$out/bench-large-cpu.txt"
+./gem bench --table intersection --csv "$out/bench-intersection.csv" 2>&1 | tee "$out/bench-intersection.txt"
+[ "${PIPESTATUS[0]}" = 0 ] || status=1
+./gem bench --table triangulation --csv "$out/bench-triangulation.csv" 2>&1 | tee "$out/bench-triangulation.txt"
+[ "${PIPESTATUS[0]}" = 0 ] || status=1
 if command -v nsys >/dev/null && [ "${GEM_PROFILE:-0}" = 1 ]; then
   echo "== nsys: kernel times of the 824-floe timing"
   nsys profile -o "$out/profile" --force-overwrite true --stats=false ./gem_cuda_tests \

@@ -3,11 +3,13 @@
 
 #include <cstdlib>
 
+#include "framework/mpi_work.hpp"
 #include "test_support.hpp"
 
 using gem::test::TempDir;
 
 TEST(MpiSweep, TwoRanksShareTheCasesAndRankZeroGathersThem) {
+  if (!gem::mpiBuilt()) GTEST_SKIP() << "this build of GEM has no MPI";
   if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "mpirun is not installed";
   TempDir dir;
   dir.write("base.toml", R"([simulation]

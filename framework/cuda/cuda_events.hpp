@@ -4,6 +4,13 @@
 //   GEM_REGISTER_CUDA_SOLO_EVENT(Drag, "drag");
 // which registers, under the event's name, a factory that takes the parsed Params of the CPU
 // instance (EventInstance::params()), so both backends run from the very same values.
+//
+// Each driver is also keyed by its origin, as the registry's entries are: "built-in" for GEM's
+// own, the plugin's origin ("PATH (NAME VERSION)") for a plugin's. A plugin's .cu uses the same
+// macro; compiled with GEM_BUILDING_PLUGIN it defers, like the GEM_REGISTER_* macros, into the
+// plugin's own list, and gem_plugin_register adds it under the origin the loader is registering
+// (Registry::pluginOrigin). CudaSimulation pairs an event only with the driver of the same name
+// and the same origin as its registry entry: a plugin's event with its own plugin's driver.
 #pragma once
 #include <cuda_runtime.h>
 
@@ -58,9 +65,11 @@ class CudaEventDriver {
 };
 
 using CudaEventFactory = std::function<std::unique_ptr<CudaEventDriver>(const void* params)>;
-void addCudaEvent(const std::string& name, CudaEventFactory factory);
-// nullptr when the event has no CUDA driver.
-const CudaEventFactory* findCudaEvent(const std::string& name);
+// origin: "built-in", or the registering plugin's. A second driver of one (name, origin) replaces
+// the first.
+void addCudaEvent(const std::string& name, CudaEventFactory factory, const std::string& origin = "built-in");
+// nullptr when no driver of that name comes from that origin.
+const CudaEventFactory* findCudaEvent(const std::string& name, const std::string& origin = "built-in");
 
 #if defined(__CUDACC__)
 template <class Event, class Params>
@@ -142,11 +151,24 @@ struct RegisterCudaEvent {
 
 }  // namespace gem::cuda
 
+#if defined(GEM_BUILDING_PLUGIN)
+// A plugin: a node of the plugin's own list (registry.hpp's GEM_REGISTRATION, which needs
+// registry.hpp included), run by gem_plugin_register once the descriptor is accepted; it adds the
+// driver under the origin the loader is registering.
+#define GEM_REGISTER_CUDA_EVENT(DRIVER, EVENT, NAME)                                                       \
+  GEM_REGISTRATION(cuda_event_, ::gem::cuda::addCudaEvent(                                                \
+      NAME,                                                                                                \
+      [](const void* params) -> std::unique_ptr<::gem::cuda::CudaEventDriver> {                           \
+        return std::make_unique<DRIVER<EVENT>>(params);                                                   \
+      },                                                                                                   \
+      registry.pluginOrigin()))
+#else
 #define GEM_REGISTER_CUDA_EVENT(DRIVER, EVENT, NAME)                                                       \
   static const ::gem::cuda::RegisterCudaEvent GEM_CONCAT(gem_register_cuda_event_, __LINE__){            \
       NAME, [](const void* params) -> std::unique_ptr<::gem::cuda::CudaEventDriver> {                     \
         return std::make_unique<DRIVER<EVENT>>(params);                                                   \
       }}
+#endif
 #define GEM_REGISTER_CUDA_PAIR_EVENT(EVENT, NAME) GEM_REGISTER_CUDA_EVENT(::gem::cuda::CudaPairDriver, EVENT, NAME)
 #define GEM_REGISTER_CUDA_SOLO_EVENT(EVENT, NAME) GEM_REGISTER_CUDA_EVENT(::gem::cuda::CudaSoloDriver, EVENT, NAME)
 #define GEM_REGISTER_CUDA_MOTION_EVENT(EVENT, NAME) GEM_REGISTER_CUDA_EVENT(::gem::cuda::CudaMotionDriver, EVENT, NAME)

@@ -49,14 +49,16 @@ CudaSimulation::CudaSimulation(const Scenario& scenario)
   // instances give the Params the device drivers are made from, in the same order.
   for (const EnabledEvent& e : m_cpu->events()) {
     if (e.phase == EventPhase::Topology) continue;  // runs on the host
-    // Device drivers are found by name and made from the CPU entry's Params: that is only right for
-    // the built-in entry of that name. A plugin's event (new, or overriding a built-in) has no
-    // device driver yet, and pairing it with the built-in's would read its Params wrongly.
+    // Device drivers are found by name and origin: the registry entry's (built-in, or the plugin
+    // that registered it). A plugin's event runs only with its own plugin's driver, never with a
+    // built-in's of the same name (that would read its Params wrongly).
     const EventEntry* entry = Registry::global().findEvent(e.name);
-    if (entry && entry->origin != "built-in")
-      throw BackendUnsupported("event \"" + e.name + "\" comes from a plugin (" + entry->origin +
-                               "): plugin events have no CUDA driver yet; run it with --backend cpu");
-    const cuda::CudaEventFactory* factory = cuda::findCudaEvent(e.name);
+    const std::string origin = entry ? entry->origin : std::string("built-in");
+    const cuda::CudaEventFactory* factory = cuda::findCudaEvent(e.name, origin);
+    if (!factory && origin != "built-in")
+      throw BackendUnsupported("event \"" + e.name + "\" comes from a plugin (" + origin +
+                               ") that has no CUDA driver for it (a .cu with GEM_REGISTER_CUDA_*_EVENT, built by "
+                               "gem_add_plugin's CUDA_SOURCES); run it with --backend cpu");
     if (!factory) throw BackendUnsupported("event \"" + e.name + "\" has no CUDA driver (events/" + e.name + ".cu is missing)");
     auto driver = (*factory)(e.instance->params());
     if (e.phase == EventPhase::Pair) m_device->addPairEvent(std::move(driver));

@@ -1,0 +1,9 @@
+// shear_current: the CUDA driver, the same evaluator struct as the CPU's (docs/plugins.md "On the GPU").
+#include "shear_current.hpp"
+
+#include "framework/cuda/cuda_events.hpp"
+#include "framework/registry.hpp"
+
+namespace gem {
+GEM_REGISTER_CUDA_SOLO_EVENT(ShearCurrent, "shear_current");
+}  // namespace gem
