@@ -165,12 +165,14 @@ void Simulation::narrowphase() {
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
   m_boxes.resize(n);
   m_vertexPose.resize(n, Pose{-1, 0, 0, 0});
+  m_moved.assign(n, 0);
   for (int i = 0; i < n; ++i) {
     // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
     // vertices from an earlier step are still exact, so only bodies that moved are transformed.
     const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
     if (pose == m_vertexPose[i]) continue;
     m_vertexPose[i] = pose;
+    m_moved[i] = 1;
     Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
     const int count = m_world.worldVertices(i, v);
     Box& box = m_boxes[i];
@@ -191,12 +193,18 @@ void Simulation::narrowphase() {
     // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
     const Box &ba = m_boxes[a], &bb = m_boxes[b];
     if (ba.x0 > bb.x1 || bb.x0 > ba.x1 || ba.y0 > bb.y1 || bb.y0 > ba.y1) continue;
+    const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
+    // Two bodies that have not moved since the last step, and did not touch then, do not touch
+    // now: the same polygons give the same answer. Most of a pack rests ahead of the vessel.
+    // (A touching pair is always a candidate, whatever the broadphase, so "did not touch then"
+    // is exactly "not among the last step's contacts".)
+    const bool touchedBefore = std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
+    if (!m_moved[a] && !m_moved[b] && !touchedBefore) continue;
     const Contact c = computeContact(&m_worldVertices[static_cast<size_t>(a) * kMaxVertices], m_world.vertexCount[a],
                                      m_world.position(a), &m_worldVertices[static_cast<size_t>(b) * kMaxVertices],
                                      m_world.vertexCount[b], m_world.position(b));
     if (!c.touching) continue;
-    const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
-    const bool onset = !std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
+    const bool onset = !touchedBefore;
     m_contactA.push_back(a);
     m_contactB.push_back(b);
     m_contacts.push_back(PairContact{c, onset});

@@ -85,6 +85,7 @@ class Simulation final : public Stepper {
     bool operator==(const Pose&) const = default;
   };
   std::vector<Pose> m_vertexPose;  // the pose m_worldVertices and m_boxes were computed for, by slot
+  std::vector<char> m_moved;       // this step: the body's pose differs from the last step's
   std::vector<CandidatePair> m_pairs;
   std::vector<int> m_contactA, m_contactB;
   std::vector<PairContact> m_contacts;
