@@ -66,6 +66,32 @@ struct PairBody {
   int vertexCount;
 };
 
+// The PairBody view of body i of a structure of arrays with World's member names: World on the
+// host, the device arrays on the GPU. One definition, so both backends see identical bodies.
+template <class Arrays>
+GEM_HD inline PairBody pairBodyOf(const Arrays& a, int i, int dof, const Vec2* vertices, int vertexCount) {
+  PairBody b;
+  b.kind = a.kind[i];
+  b.dof = dof;
+  b.id = a.id[i];
+  b.position = Vec2{a.x[i], a.y[i]};
+  b.angle = a.angle[i];
+  b.velocity = Vec2{a.vx[i], a.vy[i]};
+  b.omega = a.omega[i];
+  b.mass = a.mass[i];
+  b.invMass = a.invMass[i];
+  b.invInertia = a.invInertia[i];
+  b.gyration2 = a.gyration2[i];
+  b.gyrationX2 = a.gyrationX2[i];
+  b.gyrationY2 = a.gyrationY2[i];
+  b.principalAngle = a.angle[i] + a.principalAngle[i];  // world angle of the principal x axis
+  b.area = a.area[i];
+  b.thickness = a.thickness[i];
+  b.vertices = vertices;
+  b.vertexCount = vertexCount;
+  return b;
+}
+
 // A contact between bodies a and b (a's slot < b's slot); geometry.normal points from a into b.
 struct PairContact {
   Contact geometry;

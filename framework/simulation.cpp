@@ -174,13 +174,7 @@ void Simulation::narrowphase() {
     m_vertexPose[i] = pose;
     m_moved[i] = 1;
     Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
-    const int count = m_world.worldVertices(i, v);
-    Box& box = m_boxes[i];
-    box = {v[0].x, v[0].y, v[0].x, v[0].y};
-    for (int k = 1; k < count; ++k) {
-      box.x0 = std::min(box.x0, v[k].x), box.x1 = std::max(box.x1, v[k].x);
-      box.y0 = std::min(box.y0, v[k].y), box.y1 = std::max(box.y1, v[k].y);
-    }
+    m_boxes[i] = boundingBox(v, m_world.worldVertices(i, v));
   }
 
   m_contactA.clear();
@@ -191,8 +185,7 @@ void Simulation::narrowphase() {
     const int a = pair.a, b = pair.b;
     if (m_world.invMass[a] == 0 && m_world.invMass[b] == 0) continue;
     // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
-    const Box &ba = m_boxes[a], &bb = m_boxes[b];
-    if (ba.x0 > bb.x1 || bb.x0 > ba.x1 || ba.y0 > bb.y1 || bb.y0 > ba.y1) continue;
+    if (!boxesOverlap(m_boxes[a], m_boxes[b])) continue;
     const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
     // Two bodies that have not moved since the last step, and did not touch then, do not touch
     // now: the same polygons give the same answer. Most of a pack rests ahead of the vessel.
@@ -225,27 +218,9 @@ void Simulation::step() {
 
   // 3. Two-body events write into each contact's slot.
   m_pairBodies.resize(n);
-  for (int i = 0; i < n; ++i) {
-    PairBody& b = m_pairBodies[i];
-    b.kind = m_world.kind[i];
-    b.dof = dofOf(m_world, i, vesselDof);
-    b.id = m_world.id[i];
-    b.position = m_world.position(i);
-    b.angle = m_world.angle[i];
-    b.velocity = m_world.velocity(i);
-    b.omega = m_world.omega[i];
-    b.mass = m_world.mass[i];
-    b.invMass = m_world.invMass[i];
-    b.invInertia = m_world.invInertia[i];
-    b.gyration2 = m_world.gyration2[i];
-    b.gyrationX2 = m_world.gyrationX2[i];
-    b.gyrationY2 = m_world.gyrationY2[i];
-    b.principalAngle = m_world.angle[i] + m_world.principalAngle[i];
-    b.area = m_world.area[i];
-    b.thickness = m_world.thickness[i];
-    b.vertices = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
-    b.vertexCount = m_world.vertexCount[i];
-  }
+  for (int i = 0; i < n; ++i)
+    m_pairBodies[i] = pairBodyOf(m_world, i, dofOf(m_world, i, vesselDof), &m_worldVertices[static_cast<size_t>(i) * kMaxVertices],
+                                 m_world.vertexCount[i]);
   const int contacts = static_cast<int>(m_contacts.size());
   m_slots.assign(contacts, PairSlot{{0, 0}});
   // Each contact yields at most one impact and one break: the buffers can never overflow.

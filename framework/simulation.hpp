@@ -75,9 +75,6 @@ class Simulation final : public Stepper {
 
   // Per-step buffers, kept to avoid allocation.
   std::vector<Vec2> m_worldVertices;  // kMaxVertices per body
-  struct Box {
-    Real x0, y0, x1, y1;
-  };
   std::vector<Box> m_boxes;  // world-aligned bounding box of each body, this step
   struct Pose {
     std::int64_t id;

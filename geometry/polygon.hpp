@@ -106,6 +106,24 @@ GEM_HD inline void toWorld(const Vec2* local, int n, Vec2 position, Real angle, 
   for (int i = 0; i < n; ++i) world[i] = position + rotate(local[i], c, s);
 }
 
+// World-aligned bounding box: the narrowphase's first, cheapest rejection.
+struct Box {
+  Real x0, y0, x1, y1;
+};
+
+GEM_HD inline Box boundingBox(const Vec2* v, int n) {
+  Box box{v[0].x, v[0].y, v[0].x, v[0].y};
+  for (int k = 1; k < n; ++k) {
+    box.x0 = v[k].x < box.x0 ? v[k].x : box.x0, box.x1 = v[k].x > box.x1 ? v[k].x : box.x1;
+    box.y0 = v[k].y < box.y0 ? v[k].y : box.y0, box.y1 = v[k].y > box.y1 ? v[k].y : box.y1;
+  }
+  return box;
+}
+
+GEM_HD inline bool boxesOverlap(const Box& a, const Box& b) {
+  return !(a.x0 > b.x1 || b.x0 > a.x1 || a.y0 > b.y1 || b.y0 > a.y1);
+}
+
 // Farthest vertex distance from the body origin: the bounding radius of MODEL.md 9.
 GEM_HD inline Real boundingRadius(const Vec2* local, int n) {
   Real r2 = 0;

@@ -65,10 +65,6 @@ class DeviceBuffer {
   size_t m_capacity = 0;
 };
 
-struct Box {
-  Real x0, y0, x1, y1;
-};
-
 // The step's counters, on the device (kernels read and write them), copied to pinned host memory
 // at the end of every step: the one host sync of a step.
 struct StepStats {
@@ -204,31 +200,9 @@ __global__ void prepareKernel(PrepareArgs a) {
   const int count = a.vertexCount[i];
   const Vec2 position{a.x[i], a.y[i]};
   toWorld(a.local + static_cast<size_t>(i) * kMaxVertices, count, position, a.angle[i], v);
-  Box box{v[0].x, v[0].y, v[0].x, v[0].y};
-  for (int k = 1; k < count; ++k) {
-    box.x0 = fmin(box.x0, v[k].x), box.x1 = fmax(box.x1, v[k].x);
-    box.y0 = fmin(box.y0, v[k].y), box.y1 = fmax(box.y1, v[k].y);
-  }
+  const Box box = boundingBox(v, count);
   a.boxes[i] = box;
-  PairBody b;
-  b.kind = a.kind[i];
-  b.dof = a.dof[i];
-  b.id = a.id[i];
-  b.position = position;
-  b.angle = a.angle[i];
-  b.velocity = Vec2{a.vx[i], a.vy[i]};
-  b.omega = a.omega[i];
-  b.mass = a.mass[i];
-  b.invMass = a.invMass[i];
-  b.invInertia = a.invInertia[i];
-  b.gyration2 = a.gyration2[i];
-  b.gyrationX2 = a.gyrationX2[i];
-  b.gyrationY2 = a.gyrationY2[i];
-  b.principalAngle = a.angle[i] + a.principalAngle[i];
-  b.area = a.area[i];
-  b.thickness = a.thickness[i];
-  b.vertices = v;
-  b.vertexCount = count;
+  const PairBody b = pairBodyOf(a, i, a.dof[i], v, count);
   a.pairBodies[i] = b;
   a.soloBodies[i] = SoloBody{b.kind, b.dof, b.position, b.angle, b.velocity, b.omega, b.mass, b.area, b.thickness};
   a.changes[i] = VelocityChange{{0, 0}, 0};
@@ -247,8 +221,7 @@ __global__ void cellRangeKernel(const unsigned* key, int n, unsigned largeKey, i
 // The pair test of Simulation::narrowphase's prefilter: not two immovable bodies, boxes overlap.
 __device__ inline bool accept(const GridView& g, int i, int j) {
   if (g.invMass[i] == 0 && g.invMass[j] == 0) return false;
-  const Box &ba = g.boxes[i], &bb = g.boxes[j];
-  return !(ba.x0 > bb.x1 || bb.x0 > ba.x1 || ba.y0 > bb.y1 || bb.y0 > ba.y1);
+  return boxesOverlap(g.boxes[i], g.boxes[j]);
 }
 
 // A tile of Lanes threads per small body: its lanes test Lanes candidates at a time, so the
