@@ -201,3 +201,23 @@ TEST(PluginSdk, InstallBuildEachExampleOutOfTreeRunItAndSeeItInGemInfo) {
     EXPECT_TRUE(contains(readFile(dir.path() / "run_sweep_and_prune" / "summary.json"), "sweep_and_prune"));
   }
 }
+
+// Nothing lost when a run fails: an event that fails mid-run (exit 1) leaves the whole rows
+// written so far under their final names, and no summary.json (a run that failed is not complete).
+TEST(PluginRun, ARunThatFailsMidwayKeepsItsRowsAndWritesNoSummary) {
+  gem::test::TempDir dir;
+  const auto scenario = dir.write("fail.toml", "[simulation]\nsteps = 50\n[vessel]\nposition = [0.0, 0.0]\n"
+                                               "[events.fail_midway]\nat_step = 5\n[[plugins]]\npath = \"" +
+                                                   plugin("fail_midway") + "\"\n");
+  const auto out = dir.path() / "run";
+  const int status = gem::test::runGem("run " + scenario.string() + " --quiet --out " + out.string(), dir.path() / "log.txt");
+  const std::string log = gem::test::readFile(dir.path() / "log.txt");
+  EXPECT_EQ(status, 1) << log;
+  EXPECT_NE(log.find("failing on purpose at step 5"), std::string::npos) << log;
+  EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
+  const std::string series = gem::test::readFile(out / "timeseries.csv");
+  EXPECT_EQ(std::count(series.begin(), series.end(), '\n'), 1 + 5) << series;  // header + steps 0..4
+  EXPECT_TRUE(std::filesystem::exists(out / "impacts.csv"));
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(out))
+    EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
+}
