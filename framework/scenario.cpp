@@ -259,6 +259,9 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
     s.broadphaseSettings.fixedRadius = t.getNonNegative("fixed_radius", 0);
     s.broadphaseSettings.cellSize = t.getNonNegative("cell_size", 0);
     s.mortonSort = t.getBool("morton_sort", true);
+    s.copyBackEvery = static_cast<int>(t.getInt("copy_back_every", s.copyBackEvery, 1, 100000));
+    s.cudaBlockSize = static_cast<int>(t.getInt("cuda_block_size", s.cudaBlockSize, 32, 1024));
+    if (s.cudaBlockSize % 32 != 0) t.fail("cuda_block_size", "must be a multiple of 32 (a whole number of warps)");
     t.finish();
   }
   if (const toml::table* d = top.findTable("domain")) {

@@ -57,6 +57,11 @@ struct Scenario {
   BroadphaseSettings broadphaseSettings;
   std::uint64_t seed = 1;
   bool mortonSort = true;  // re-sort bodies along a space-filling curve at each list rebuild
+  // CUDA backend only (thesis 5.7): steps run on the device between two copies of results to the
+  // host (frames, re-sorts, breaks and the run's end still come exactly on time), and the threads
+  // per block of the per-body and per-contact kernels.
+  int copyBackEvery = 16;
+  int cudaBlockSize = 128;
 
   // [domain]
   bool hasDomain = false;
