@@ -125,6 +125,17 @@ struct BreakRequest {
   Real cuspLength; // m, distance of the cut from c along the normal
 };
 
+// A row that an event logs for its own output (a plugin's detector, say): the channel it was given
+// when its Params were parsed (framework/log_channel.hpp), the two bodies and up to six numbers.
+// Records are plain data so that device code can push them too; the host hands each one to its
+// channel's writer after the step, in contact order, on either backend.
+struct LogRecord {
+  int channel;
+  Real time;
+  std::int64_t idA, idB;
+  Real value[6];
+};
+
 // Where events append records. The CPU driver points these at host buffers; a device driver
 // points them at device buffers. Records past capacity are counted but dropped (the driver
 // grows the buffers and reports it), so a step never writes out of bounds.
@@ -135,6 +146,9 @@ struct RecordSink {
   BreakRequest* breaks;
   int breakCapacity;
   int* breakCount;
+  LogRecord* logs;
+  int logCapacity;
+  int* logCount;
 
   // On the device many contacts push at once: an integer atomic counter (the CUDA driver then
   // orders the records deterministically by floe slot, which is the CPU's contact order).
@@ -145,6 +159,10 @@ struct RecordSink {
   GEM_HD void push(const BreakRequest& r) const {
     const int k = next(breakCount);
     if (k < breakCapacity) breaks[k] = r;
+  }
+  GEM_HD void push(const LogRecord& r) const {
+    const int k = next(logCount);
+    if (k < logCapacity) logs[k] = r;
   }
   GEM_HD static int next(int* counter) {
 #if defined(__CUDA_ARCH__)

@@ -7,6 +7,7 @@
 
 #include "framework/errors.hpp"
 #include "framework/ice_file.hpp"
+#include "framework/log_channel.hpp"
 #include "framework/table_reader.hpp"
 #include "framework/vessel.hpp"
 #include "geometry/contact.hpp"
@@ -224,16 +225,29 @@ void Simulation::step() {
   const int contacts = static_cast<int>(m_contacts.size());
   m_slots.assign(contacts, PairSlot{{0, 0}});
   // Each contact yields at most one impact and one break: the buffers can never overflow.
+  // Logs: an event may log more than one row per contact; the buffer grows and the phase runs
+  // again in the rare step that passes it (pair events only write their slots and records).
   m_impacts.resize(contacts);
   m_breaks.resize(contacts);
-  int impactCount = 0, breakCount = 0;
-  const RecordSink sink{m_impacts.data(), contacts, &impactCount, m_breaks.data(), contacts, &breakCount};
-  const PairPhaseData pairData{m_pairBodies.data(), m_contactA.data(), m_contactB.data(), m_contacts.data(),
-                               m_slots.data(), contacts, ctx, sink};
-  for (auto& e : m_events)
-    if (e.phase == EventPhase::Pair) e.instance->runPairs(pairData);
-  m_impacts.resize(impactCount);
-  m_breaks.resize(breakCount);
+  if (m_logs.size() < static_cast<size_t>(contacts)) m_logs.resize(static_cast<size_t>(contacts));
+  for (;;) {
+    int impactCount = 0, breakCount = 0, logCount = 0;
+    const RecordSink sink{m_impacts.data(), contacts, &impactCount, m_breaks.data(), contacts, &breakCount,
+                          m_logs.data(), static_cast<int>(m_logs.size()), &logCount};
+    const PairPhaseData pairData{m_pairBodies.data(), m_contactA.data(), m_contactB.data(), m_contacts.data(),
+                                 m_slots.data(), contacts, ctx, sink};
+    for (auto& e : m_events)
+      if (e.phase == EventPhase::Pair) e.instance->runPairs(pairData);
+    if (logCount > static_cast<int>(m_logs.size())) {
+      m_logs.resize(static_cast<size_t>(logCount));
+      m_slots.assign(contacts, PairSlot{{0, 0}});
+      continue;
+    }
+    m_impacts.resize(impactCount);
+    m_breaks.resize(breakCount);
+    deliverLogs(m_logs.data(), logCount);
+    break;
+  }
 
   // 4. Solo events, from the state at the start of the step.
   m_soloBodies.resize(n);

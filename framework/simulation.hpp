@@ -94,6 +94,7 @@ class Simulation final : public Stepper {
   std::vector<std::pair<std::int64_t, std::int64_t>> m_previousContacts, m_currentContacts;
   std::vector<ImpactRecord> m_impacts;
   std::vector<BreakRequest> m_breaks;
+  std::vector<LogRecord> m_logs;
   Vec2 m_vesselIceForce{0, 0};
   double m_rubbleMass = 0;
   long m_floesBroken = 0;

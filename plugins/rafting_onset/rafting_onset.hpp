@@ -7,7 +7,9 @@
 //                       and  min(h_a, h_b) <= max_thickness           [m]
 //
 // V_c is the closing speed of the contact points along the normal (MODEL.md 4). Each onset is a
-// row of rafting.csv in the run folder, written by the plugin itself on the host (CPU backend).
+// LogRecord on the event's log channel (framework/log_channel.hpp): apply() is the same code on
+// the CPU and the GPU, and the host writes each record as a row of rafting.csv in the run folder,
+// in contact order, after the step.
 #pragma once
 #include <cmath>
 
@@ -15,25 +17,20 @@
 
 namespace gem {
 
-class RaftingLog;  // host side, rafting_onset.cpp
-void recordRafting(RaftingLog* log, Real time, const PairBody& a, const PairBody& b, Vec2 point, Real closing);
-
 struct RaftingOnset {
   struct Params {
     Real minClosingSpeed;  // m/s (0.05)
     Real maxThickness;     // m (0.5)
-    RaftingLog* log;       // host: where onsets go (a plain pointer keeps Params trivially copyable)
+    int logChannel;        // where onsets go: this run's rafting.csv
   };
 
   GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact,
-                           PairSlot&, const StepContext& ctx, const RecordSink&) {
+                           PairSlot&, const StepContext& ctx, const RecordSink& sink) {
     if (!contact.onset || a.kind != BodyKind::Floe || b.kind != BodyKind::Floe) return;
     const Real closing = closingSpeed(a, b, contact);
     const Real thinner = a.thickness < b.thickness ? a.thickness : b.thickness;
     if (!(closing >= p.minClosingSpeed) || thinner > p.maxThickness) return;
-#if !defined(__CUDA_ARCH__)
-    recordRafting(p.log, ctx.time, a, b, contact.geometry.point, closing);
-#endif
+    sink.push(LogRecord{p.logChannel, ctx.time, a.id, b.id, {contact.geometry.point.x, contact.geometry.point.y, closing, thinner, 0, 0}});
   }
 };
 
