@@ -35,6 +35,7 @@ struct DevicePairData {
   const PairContact* contacts;
   PairSlot* slots;
   int count;              // capacity covered by the launch
+  int block;              // threads per block (simulation.cuda_block_size)
   const int* liveCount;   // device: this step's contacts
   const StepContext* ctx; // device
   RecordSink sink;        // device buffers, integer atomic counters
@@ -44,17 +45,19 @@ struct DeviceSoloData {
   const SoloBody* bodies;
   VelocityChange* changes;
   int count;
+  int block;
   const StepContext* ctx;  // device
 };
 
 struct DeviceMotionData {
   MotionBody* bodies;
   int count;
+  int block;
   const StepContext* ctx;  // device
 };
 
-constexpr int kBlock = 128;
-inline int blocksFor(int n) { return (n + kBlock - 1) / kBlock; }
+constexpr int kBlock = 128;  // the default of simulation.cuda_block_size
+inline int blocksFor(int n, int block = kBlock) { return (n + block - 1) / block; }
 
 class CudaEventDriver {
  public:
@@ -104,7 +107,7 @@ class CudaPairDriver final : public CudaEventDriver {
   explicit CudaPairDriver(const void* p) : m_params(*static_cast<const Params*>(p)) {}
   void launchPairs(const DevicePairData& d, cudaStream_t stream) override {
     if (d.count == 0) return;
-    pairEventKernel<Event, Params><<<blocksFor(d.count), kBlock, 0, stream>>>(m_params, d);
+    pairEventKernel<Event, Params><<<blocksFor(d.count, d.block), d.block, 0, stream>>>(m_params, d);
     GEM_CUDA_CHECK_LAUNCH();
   }
 
@@ -120,7 +123,7 @@ class CudaSoloDriver final : public CudaEventDriver {
   explicit CudaSoloDriver(const void* p) : m_params(*static_cast<const Params*>(p)) {}
   void launchSolo(const DeviceSoloData& d, cudaStream_t stream) override {
     if (d.count == 0) return;
-    soloEventKernel<Event, Params><<<blocksFor(d.count), kBlock, 0, stream>>>(m_params, d);
+    soloEventKernel<Event, Params><<<blocksFor(d.count, d.block), d.block, 0, stream>>>(m_params, d);
     GEM_CUDA_CHECK_LAUNCH();
   }
 
@@ -136,7 +139,7 @@ class CudaMotionDriver final : public CudaEventDriver {
   explicit CudaMotionDriver(const void* p) : m_params(*static_cast<const Params*>(p)) {}
   void launchMotion(const DeviceMotionData& d, cudaStream_t stream) override {
     if (d.count == 0) return;
-    motionKernel<Event, Params><<<blocksFor(d.count), kBlock, 0, stream>>>(m_params, d);
+    motionKernel<Event, Params><<<blocksFor(d.count, d.block), d.block, 0, stream>>>(m_params, d);
     GEM_CUDA_CHECK_LAUNCH();
   }
 

@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "framework/cuda/device_world.hpp"
+#include "framework/log_channel.hpp"
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 #include "framework/stepper.hpp"
@@ -42,9 +43,9 @@ const Scenario& CudaSimulation::scenario() const { return m_cpu->scenario(); }
 CudaSimulation::CudaSimulation(const Scenario& scenario)
     : m_cpu(std::make_unique<Simulation>(scenario)),
       m_device(std::make_unique<cuda::DeviceWorld>()),
-      m_resultStore(std::make_unique<cuda::DeviceStepResult>()),
+      m_batch(std::make_unique<cuda::DeviceBatchResult>()),
       m_deviceName(cudaDeviceName()) {
-  m_result = m_resultStore.get();
+  m_device->configure(scenario.copyBackEvery, scenario.cudaBlockSize);
   // The CPU simulation parsed every event (strictly) and sorted the world along the curve; its
   // instances give the Params the device drivers are made from, in the same order.
   for (const EnabledEvent& e : m_cpu->events()) {
@@ -84,11 +85,16 @@ void CudaSimulation::upload() {
 
 void CudaSimulation::downloadState() {
   if (m_hostCurrent) return;
+  if (deviceAhead()) throw std::logic_error("CUDA backend: the world was asked for in the middle of a copy-back batch");
   m_device->download(world());
   m_hostCurrent = true;
 }
 
+bool CudaSimulation::deviceAhead() const { return m_batchNext < m_batch->steps.size(); }
+
 const World& CudaSimulation::hostWorld() {
+  // Batches end where the runner needs the state (frames, the last step): downloadState refuses a
+  // caller that asks elsewhere, who would get a later state than the step it is at.
   downloadState();
   return world();
 }
@@ -102,34 +108,61 @@ VesselSample CudaSimulation::vessel() {
   return m_vessel;
 }
 
-void CudaSimulation::step() {
-  const StepContext ctx{scenario().dt, m_time, m_step};
-  cuda::DeviceStepResult& r = *m_result;
-  m_device->step(ctx, r);
+// Up to copy_back_every steps, ending where the host needs the state: the next frame, the next
+// re-sort along the curve (every 200 steps), the scenario's last step.
+void CudaSimulation::runBatch() {
+  const Scenario& s = scenario();
+  long end = m_step + s.copyBackEvery;
+  auto stopAtMultipleOf = [&](long every) {
+    if (every > 0) end = std::min(end, (m_step / every + 1) * every);
+  };
+  if (s.output.frameEvery > 0) stopAtMultipleOf(s.output.frameEvery);
+  if (s.mortonSort) stopAtMultipleOf(200);
+  if (m_step < s.steps) end = std::min(end, s.steps);
+  m_device->run(m_step, s.dt, static_cast<int>(end - m_step), *m_batch);
+  m_batchNext = 0;
   m_hostCurrent = false;
+}
+
+void CudaSimulation::step() {
+  if (!deviceAhead()) runBatch();
+  const cuda::DeviceBatchResult& batch = *m_batch;
+  const cuda::StepRecord& r = batch.steps[m_batchNext];
+  const cuda::StepRecord before = m_batchNext > 0 ? batch.steps[m_batchNext - 1] : cuda::StepRecord{};
+  ++m_batchNext;
   m_candidateCount = r.candidates;
   m_contactCount = r.contacts;
 
-  // Records: the device appends in any order; the CPU's order is contact order, which for one
-  // vessel is ascending floe slot (contacts are sorted by (a, b) and the vessel is one side of each).
-  m_impacts.swap(r.impacts);
-  m_breaks.swap(r.breaks);
-  if (m_impacts.size() > 1 || m_breaks.size() > 1) {
+  // Records: the device appends in any order; the CPU's order is contact order, sorted by slot
+  // pair (a, b). Impacts and breaks have the vessel as one side, so ascending floe slot is that
+  // order; logs are sorted by the slots of both bodies. Slots do not change within a batch.
+  m_impacts.assign(batch.impacts.begin() + before.impactEnd, batch.impacts.begin() + r.impactEnd);
+  m_breaks.assign(batch.breaks.begin() + before.breakEnd, batch.breaks.begin() + r.breakEnd);
+  m_logs.assign(batch.logs.begin() + before.logEnd, batch.logs.begin() + r.logEnd);
+  if (m_impacts.size() > 1 || m_breaks.size() > 1 || !m_logs.empty()) {
     const World& w = world();
     std::unordered_map<std::int64_t, int> slotOf;
     for (const auto& x : m_impacts) slotOf[x.floeId] = 0;
     for (const auto& x : m_breaks) slotOf[x.floeId] = 0;
+    for (const auto& x : m_logs) slotOf[x.idA] = 0, slotOf[x.idB] = 0;
     for (int i = 0; i < w.size(); ++i)
       if (auto it = slotOf.find(w.id[i]); it != slotOf.end()) it->second = i;
     std::stable_sort(m_impacts.begin(), m_impacts.end(),
                      [&](const ImpactRecord& a, const ImpactRecord& b) { return slotOf[a.floeId] < slotOf[b.floeId]; });
     std::stable_sort(m_breaks.begin(), m_breaks.end(),
                      [&](const BreakRequest& a, const BreakRequest& b) { return slotOf[a.floeId] < slotOf[b.floeId]; });
+    auto pairOf = [&](const LogRecord& x) {
+      const int a = slotOf[x.idA], b = slotOf[x.idB];
+      return std::pair<int, int>{std::min(a, b), std::max(a, b)};
+    };
+    std::stable_sort(m_logs.begin(), m_logs.end(), [&](const LogRecord& a, const LogRecord& b) { return pairOf(a) < pairOf(b); });
+    deliverLogs(m_logs.data(), static_cast<int>(m_logs.size()));
   }
   m_vesselIceForce = (Real(1) / scenario().dt) * r.vesselImpulse;
   if (m_vesselSlot >= 0) m_vessel = VesselSample{true, r.vesselPosition, r.vesselAngle, r.vesselVelocity};
 
-  // 6. Topology on the host, only in a step that asked for a break (rare): the world goes back and forth.
+  // 6. Topology on the host, only in a step that asked for a break (rare; the device stopped the
+  // batch there): the world goes back and forth.
   if (!m_breaks.empty()) {
     downloadState();
     TopologyData topology{&world(), m_breaks.data(), static_cast<int>(m_breaks.size()), m_time};

@@ -8,8 +8,11 @@
 //   4 pair events, solo events (the same evaluator structs as the CPU, templated kernels)
 //   5 gather: each body sums its contacts in contact order (no floating-point atomics), motion
 //   6 topology on the host (flexural_breaking), only in the rare steps that asked for a break.
-// The whole step is one captured CUDA graph (re-captured when the body count or the candidate
-// capacity changes); the host syncs once per step, on a small pinned record of counters.
+// The whole step is one captured CUDA graph, the body of a device-side loop: copy_back_every steps
+// run as one launch, and their results (a small record per step, the impacts and logs) are copied
+// off once, through pinned buffers (thesis 5.7). step() then hands them out one step at a time.
+// A batch never runs past a step whose state the host needs: a frame, a re-sort, the run's last
+// step, or a break (the device stops itself there).
 #pragma once
 #include <memory>
 #include <string>
@@ -23,7 +26,7 @@ class Simulation;
 
 namespace cuda {
 class DeviceWorld;
-struct DeviceStepResult;
+struct DeviceBatchResult;
 }
 
 class CudaSimulation final : public Stepper {
@@ -49,6 +52,8 @@ class CudaSimulation final : public Stepper {
   void upload();          // host world -> device (all arrays), after set-up, breaks and re-sorts
   void downloadState();   // device kinematics -> host world
   void reorderAlongCurve();
+  void runBatch();        // the next batch of steps on the device
+  bool deviceAhead() const;  // the device has run steps that step() has not handed out yet
 
   World& world();                     // the host mirror (the CPU simulation's world, never stepped there)
   const Scenario& scenario() const;
@@ -56,8 +61,8 @@ class CudaSimulation final : public Stepper {
   std::unique_ptr<Simulation> m_cpu;  // parses the events (and runs the topology ones) and holds the host world
   bool m_hostCurrent = true;
   std::unique_ptr<cuda::DeviceWorld> m_device;
-  cuda::DeviceStepResult* m_result = nullptr;  // owned by m_resultStore
-  std::unique_ptr<cuda::DeviceStepResult> m_resultStore;
+  std::unique_ptr<cuda::DeviceBatchResult> m_batch;
+  size_t m_batchNext = 0;  // the batch's next step to hand out
   std::string m_deviceName;
   long m_step = 0;
   Real m_time = 0;
@@ -66,6 +71,7 @@ class CudaSimulation final : public Stepper {
   int m_contactCount = 0, m_candidateCount = 0;
   std::vector<ImpactRecord> m_impacts;
   std::vector<BreakRequest> m_breaks;
+  std::vector<LogRecord> m_logs;
   Vec2 m_vesselIceForce{0, 0};
   VesselSample m_vessel{false, {0, 0}, 0, {0, 0}};
   double m_rubbleMass = 0;

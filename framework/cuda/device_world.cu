@@ -65,14 +65,26 @@ class DeviceBuffer {
   size_t m_capacity = 0;
 };
 
-// The step's counters, on the device (kernels read and write them), copied to pinned host memory
-// at the end of every step: the one host sync of a step.
+// What the host sets before each launch of the step graph (pinned; the graph's first node copies it).
+struct BatchControl {
+  long firstStep;  // index of the batch's first step
+  Real dt;
+  int steps;       // steps to run, at most the ring's length
+};
+
+// Why the batch's loop stopped (StepStats::halt).
+enum : int { kRunning = 0, kHaltDone = 1, kHaltBreak = 2, kHaltOverflow = 3 };
+
+// The batch's counters, on the device (kernels read and write them), copied to pinned host memory
+// at the end of the batch: the one host sync of a batch of steps.
 struct StepStats {
-  int impactCount, breakCount;  // RecordSink's counters
+  int impactCount, breakCount, logCount;  // RecordSink's counters, over the whole batch
+  int impactBegin, breakBegin, logBegin;  // at the start of the step: a step that fails rewinds to them
   int candidatesNeeded;         // the broadphase's pair count, even past the capacity
   int candidates;               // min(needed, capacity)
   int contacts, previousContacts;
-  int overflow;                 // 1: candidates past the capacity: the step left the state alone
+  int overflow;                 // 1: candidates or records past their capacity: the step left the state alone
+  int stepsDone, halt;          // completed steps of the batch, and why it stopped
   Vec2 vesselImpulse;
   Vec2 vesselPosition, vesselVelocity;
   Real vesselAngle;
@@ -129,13 +141,20 @@ struct DeviceState {
   DeviceBuffer<PairSlot> slots;
   DeviceBuffer<unsigned long long> contactKey, previousKeys, sortedKeys;
   int idBits = 0;  // a contact's id pair is keyed (lo << idBits) | hi: a short radix sort
-  // Records.
+  // Records, over a batch of steps.
   DeviceBuffer<ImpactRecord> impacts;
   DeviceBuffer<BreakRequest> breaks;
+  DeviceBuffer<LogRecord> logs;
+  int recordCapacity = 0;  // of each record buffer (grows when a single step needs more)
   DeviceBuffer<StepStats> stats;
-  DeviceBuffer<StepContext> ctx;
-  StepStats* h_stats = nullptr;   // pinned
-  StepContext* h_ctx = nullptr;   // pinned: the graph's first node copies it to ctx
+  DeviceBuffer<StepContext> ctx;  // written on the device at the start of each step
+  DeviceBuffer<BatchControl> control;
+  DeviceBuffer<StepRecord> ring;  // one record per step of the batch
+  int ringSize = 16;              // simulation.copy_back_every
+  int block = kBlock;             // simulation.cuda_block_size
+  StepStats* h_stats = nullptr;       // pinned
+  BatchControl* h_control = nullptr;  // pinned: the graph's first node copies it to control
+  StepRecord* h_ring = nullptr;       // pinned, ringSize records
   DeviceBuffer<unsigned char> temp;  // CUB scratch, sized before capture
   size_t tempBytes = 0;
   int capacity = 0;  // candidate (and contact) capacity the graph was captured for
@@ -146,17 +165,28 @@ struct DeviceState {
   DeviceState() {
     GEM_CUDA_CHECK(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking));
     GEM_CUDA_CHECK(cudaMallocHost(&h_stats, sizeof(StepStats)));
-    GEM_CUDA_CHECK(cudaMallocHost(&h_ctx, sizeof(StepContext)));
+    GEM_CUDA_CHECK(cudaMallocHost(&h_control, sizeof(BatchControl)));
     *h_stats = StepStats{};  // pinned memory starts undefined; previousContacts is read before a first step
     stats.ensure(1);
     ctx.ensure(1);
+    control.ensure(1);
+    setRingSize(ringSize);
     GEM_CUDA_CHECK(cudaMemset(stats.get(), 0, sizeof(StepStats)));
   }
   ~DeviceState() {
     if (graph) cudaGraphExecDestroy(graph);
     if (h_stats) cudaFreeHost(h_stats);
-    if (h_ctx) cudaFreeHost(h_ctx);
+    if (h_control) cudaFreeHost(h_control);
+    if (h_ring) cudaFreeHost(h_ring);
     if (stream) cudaStreamDestroy(stream);
+  }
+  void setRingSize(int size) {
+    if (h_ring) GEM_CUDA_CHECK(cudaFreeHost(h_ring));
+    h_ring = nullptr;
+    ringSize = size;
+    GEM_CUDA_CHECK(cudaMallocHost(&h_ring, sizeof(StepRecord) * static_cast<size_t>(size)));
+    ring.ensure(static_cast<size_t>(size));
+    dropGraph();
   }
   void dropGraph() {
     if (graph) GEM_CUDA_CHECK(cudaGraphExecDestroy(graph));
@@ -305,14 +335,14 @@ static int rowLanes(int n) {
 }
 
 template <bool Write>
-static void launchRows(int lanes, int blocks, cudaStream_t s, const GridView& g, int* count, const int* offset, int* candA, int* candB) {
+static void launchRows(int lanes, int blocks, int block, cudaStream_t s, const GridView& g, int* count, const int* offset, int* candA, int* candB) {
   switch (lanes) {
-    case 1: partnerRowsKernel<Write, 1><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
-    case 2: partnerRowsKernel<Write, 2><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
-    case 4: partnerRowsKernel<Write, 4><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
-    case 8: partnerRowsKernel<Write, 8><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
-    case 16: partnerRowsKernel<Write, 16><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
-    default: partnerRowsKernel<Write, 32><<<blocks, kBlock, 0, s>>>(g, count, offset, candA, candB); break;
+    case 1: partnerRowsKernel<Write, 1><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
+    case 2: partnerRowsKernel<Write, 2><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
+    case 4: partnerRowsKernel<Write, 4><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
+    case 8: partnerRowsKernel<Write, 8><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
+    case 16: partnerRowsKernel<Write, 16><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
+    default: partnerRowsKernel<Write, 32><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
   }
   GEM_CUDA_CHECK_LAUNCH();
 }
@@ -430,6 +460,7 @@ __global__ void compactContactsKernel(CompactArgs a) {
 }
 
 // This step's sorted id pairs become the next step's "previous" (not when the step overflowed).
+// Run at the end of the step, once nothing can overflow any more.
 __global__ void commitContactsKernel(int capacity, const unsigned long long* sorted, unsigned long long* previous, StepStats* stats) {
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k >= capacity || stats->overflow) return;
@@ -495,6 +526,44 @@ __global__ void gatherKernel(int n, int vessel, const PairBody* bodies, const Ve
   }
   if (i == vessel) stats->vesselImpulse = vesselImpulse;
   motion[i] = MotionBody{b.kind, b.dof, b.position, b.angle, b.velocity + total.dv, b.omega + total.domega};
+}
+
+// The batch's start: its record counters and step count (previousContacts carries over).
+__global__ void beginBatchKernel(StepStats* s) {
+  s->impactCount = s->breakCount = s->logCount = 0;
+  s->stepsDone = 0;
+  s->halt = kRunning;
+}
+
+// A step's start: its context (the host's formula, time = index x dt) and the counters it may rewind to.
+__global__ void beginStepKernel(const BatchControl* c, StepStats* s, StepContext* ctx) {
+  const long step = c->firstStep + s->stepsDone;
+  *ctx = StepContext{c->dt, static_cast<Real>(step) * c->dt, step};
+  s->impactBegin = s->impactCount, s->breakBegin = s->breakCount, s->logBegin = s->logCount;
+  s->overflow = 0;
+  s->vesselImpulse = Vec2{0, 0};
+}
+
+// After the pair events: records past a buffer's end fail the step like too many candidates do.
+__global__ void checkRecordsKernel(StepStats* s, int capacity) {
+  if (s->impactCount > capacity || s->breakCount > capacity || s->logCount > capacity) s->overflow = 1;
+}
+
+// A step's end: its record into the ring, and whether the loop goes on. It stops when the batch is
+// done, after a step that asked for a break (the host's topology phase comes next), or at a step
+// that overflowed (rewound: the host grows the buffers and runs it again).
+__global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, const BatchControl* c, StepStats* s, StepRecord* ring) {
+  if (s->overflow) {
+    s->impactCount = s->impactBegin, s->breakCount = s->breakBegin, s->logCount = s->logBegin;
+    s->halt = kHaltOverflow;
+  } else {
+    ring[s->stepsDone] = StepRecord{s->candidates, s->contacts, s->impactCount, s->breakCount, s->logCount,
+                                    s->vesselImpulse, s->vesselPosition, s->vesselVelocity, s->vesselAngle};
+    ++s->stepsDone;
+    if (s->breakCount > s->breakBegin) s->halt = kHaltBreak;
+    else if (s->stepsDone >= c->steps) s->halt = kHaltDone;
+  }
+  if (inGraph) cudaGraphSetConditional(loop, s->halt == kRunning ? 1u : 0u);
 }
 
 // The only write of the state; skipped when the step overflowed, so it can simply be run again.
@@ -646,17 +715,18 @@ struct CubCalls {
   }
 };
 
-// Enqueues one whole step on d.stream (captured into the graph, never run outside it).
-void enqueueStep(DeviceState& d) {
+// Enqueues one whole step on d.stream: captured as the body of the batch graph's loop (inGraph),
+// or launched directly when graphs are off (GEM_CUDA_GRAPH=0, for debugging).
+void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) {
   cudaStream_t s = d.stream;
-  const int n = d.n, capacity = d.capacity;
+  const int n = d.n, capacity = d.capacity, block = d.block;
   const unsigned largeKey = d.tableSize;  // past every cell: large bodies sort to the end
   size_t bytes = d.tempBytes;
   CubCalls cubCalls{d, d.temp.get(), bytes, false};
   StepStats* stats = d.stats.get();
 
-  GEM_CUDA_CHECK(cudaMemcpyAsync(d.ctx.get(), d.h_ctx, sizeof(StepContext), cudaMemcpyHostToDevice, s));
-  GEM_CUDA_CHECK(cudaMemsetAsync(stats, 0, 2 * sizeof(int), s));  // the record counters
+  beginStepKernel<<<1, 1, 0, s>>>(d.control.get(), stats, d.ctx.get());
+  GEM_CUDA_CHECK_LAUNCH();
 
   // 1. World vertices, boxes, views, cell keys.
   PrepareArgs a{n, d.vesselSlot, d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.local.get(), d.x.get(), d.y.get(),
@@ -664,25 +734,25 @@ void enqueueStep(DeviceState& d) {
                 d.invMass.get(), d.invInertia.get(), d.gyration2.get(), d.gyrationX2.get(), d.gyrationY2.get(),
                 d.principalAngle.get(), d.isLarge.get(), d.cell, d.tableSize - 1, largeKey, d.worldVertices.get(), d.boxes.get(),
                 d.pairBodies.get(), d.soloBodies.get(), d.changes.get(), d.cellKey.get(), d.slot.get()};
-  prepareKernel<<<blocksFor(n), kBlock, 0, s>>>(a);
+  prepareKernel<<<blocksFor(n, block), block, 0, s>>>(a);
   GEM_CUDA_CHECK_LAUNCH();
 
   // 2. Broadphase: sort by cell, cell ranges, count, scan, write (rows sorted: pairs by (a, b)).
   cubCalls.cellSort(n, bitsFor(largeKey));
   GEM_CUDA_CHECK(cudaMemsetAsync(d.cellStart.get(), 0xff, d.tableSize * sizeof(int), s));
-  cellRangeKernel<<<blocksFor(n), kBlock, 0, s>>>(d.cellKeySorted.get(), n, largeKey, d.cellStart.get(), d.cellEnd.get());
+  cellRangeKernel<<<blocksFor(n, block), block, 0, s>>>(d.cellKeySorted.get(), n, largeKey, d.cellStart.get(), d.cellEnd.get());
   GEM_CUDA_CHECK_LAUNCH();
   const GridView g{d.boxes.get(), d.invMass.get(), d.isLarge.get(), d.large.get(), d.largeCount, d.cellStart.get(),
                    d.cellEnd.get(), d.slotSorted.get(), d.cell, d.tableSize - 1, n, capacity};
   const int lanes = rowLanes(n);
-  const int rowBlocks = (lanes * (n + 1) + kBlock - 1) / kBlock;  // a tile per body, one more for count[n]
-  launchRows<false>(lanes, rowBlocks, s, g, d.partnerCount.get(), nullptr, nullptr, nullptr);
+  const int rowBlocks = (lanes * (n + 1) + block - 1) / block;  // a tile per body, one more for count[n]
+  launchRows<false>(lanes, rowBlocks, block, s, g, d.partnerCount.get(), nullptr, nullptr, nullptr);
   if (d.largeCount > 0) {
     largeRowCountKernel<<<d.largeCount, kLargeBlock, 0, s>>>(g, d.partnerCount.get());
     GEM_CUDA_CHECK_LAUNCH();
   }
   cubCalls.scanPartners(n);
-  launchRows<true>(lanes, rowBlocks, s, g, nullptr, d.partnerOffset.get(), d.candA.get(), d.candB.get());
+  launchRows<true>(lanes, rowBlocks, block, s, g, nullptr, d.partnerOffset.get(), d.candA.get(), d.candB.get());
   if (d.largeCount > 0) {
     largeRowWriteKernel<<<d.largeCount, kLargeBlock, 0, s>>>(g, d.partnerOffset.get(), d.candA.get(), d.candB.get());
     GEM_CUDA_CHECK_LAUNCH();
@@ -691,7 +761,7 @@ void enqueueStep(DeviceState& d) {
   // 3. Narrowphase, compaction in order (with padding), onset, the two sorts.
   // computeContact is a long serial chain per pair with a 2.3 KB local-memory frame: while the
   // pairs are few, blocks of one warp spread them over every multiprocessor's L1.
-  const int narrowBlock = capacity + 1 < 64 * 1024 ? 32 : kBlock;
+  const int narrowBlock = capacity + 1 < 64 * 1024 ? 32 : block;
   narrowphaseKernel<<<(capacity + narrowBlock) / narrowBlock, narrowBlock, 0, s>>>(capacity, d.partnerOffset.get() + n, d.candA.get(), d.candB.get(),
                                                                 d.worldVertices.get(), d.vertexCount.get(), d.x.get(), d.y.get(),
                                                                 d.candContact.get(), d.flag.get(), stats);
@@ -701,33 +771,38 @@ void enqueueStep(DeviceState& d) {
   const CompactArgs c{capacity, n, d.idBits, padKey, d.candA.get(), d.candB.get(), d.candContact.get(), d.flag.get(),
                       d.flagOffset.get(), d.id.get(), d.previousKeys.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(),
                       d.slots.get(), d.contactKey.get(), d.bKey.get(), d.bIndex.get(), stats};
-  compactContactsKernel<<<blocksFor(capacity), kBlock, 0, s>>>(c);
+  compactContactsKernel<<<blocksFor(capacity, block), block, 0, s>>>(c);
   GEM_CUDA_CHECK_LAUNCH();
   cubCalls.sortKeys(capacity, std::min(64, 2 * d.idBits));
   // The b side of every body, in contact order: a stable radix sort of (b, k) by b.
   cubCalls.sortB(capacity, bitsFor(static_cast<unsigned long long>(n)));
-  commitContactsKernel<<<blocksFor(capacity), kBlock, 0, s>>>(capacity, d.sortedKeys.get(), d.previousKeys.get(), stats);
-  GEM_CUDA_CHECK_LAUNCH();
 
   // 4. Two-body events write into each contact's slot; solo events from the start-of-step state.
-  const RecordSink sink{d.impacts.get(), capacity, &stats->impactCount, d.breaks.get(), capacity, &stats->breakCount};
+  const int records = d.recordCapacity;
+  const RecordSink sink{d.impacts.get(), records, &stats->impactCount, d.breaks.get(), records, &stats->breakCount,
+                        d.logs.get(), records, &stats->logCount};
   const DevicePairData pairData{d.pairBodies.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(), d.slots.get(),
-                                capacity, &stats->contacts, d.ctx.get(), sink};
+                                capacity, block, &stats->contacts, d.ctx.get(), sink};
   for (auto& e : d.pairEvents) e->launchPairs(pairData, s);
-  const DeviceSoloData soloData{d.soloBodies.get(), d.changes.get(), n, d.ctx.get()};
+  checkRecordsKernel<<<1, 1, 0, s>>>(stats, records);
+  GEM_CUDA_CHECK_LAUNCH();
+  const DeviceSoloData soloData{d.soloBodies.get(), d.changes.get(), n, block, d.ctx.get()};
   for (auto& e : d.soloEvents) e->launchSolo(soloData, s);
 
   // 5. Gather, motion, write back; then the counters to the host.
-  gatherKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.vesselSlot, d.pairBodies.get(), d.changes.get(), capacity, d.contactA.get(),
+  gatherKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.vesselSlot, d.pairBodies.get(), d.changes.get(), capacity, d.contactA.get(),
                                                d.bKeySorted.get(), d.bIndexSorted.get(), d.contacts.get(), d.slots.get(),
                                                d.motionBodies.get(), stats);
   GEM_CUDA_CHECK_LAUNCH();
-  const DeviceMotionData motionData{d.motionBodies.get(), n, d.ctx.get()};
+  const DeviceMotionData motionData{d.motionBodies.get(), n, block, d.ctx.get()};
   for (auto& e : d.motionEvents) e->launchMotion(motionData, s);
-  writeBackKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.vesselSlot, d.motionBodies.get(), d.x.get(), d.y.get(), d.angle.get(),
-                                                  d.vx.get(), d.vy.get(), d.omega.get(), stats);
+  writeBackKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.vesselSlot, d.motionBodies.get(), d.x.get(), d.y.get(), d.angle.get(),
+                                                        d.vx.get(), d.vy.get(), d.omega.get(), stats);
   GEM_CUDA_CHECK_LAUNCH();
-  GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_stats, stats, sizeof(StepStats), cudaMemcpyDeviceToHost, s));
+  commitContactsKernel<<<blocksFor(capacity, block), block, 0, s>>>(capacity, d.sortedKeys.get(), d.previousKeys.get(), stats);
+  GEM_CUDA_CHECK_LAUNCH();
+  endStepKernel<<<1, 1, 0, s>>>(loop, inGraph, d.control.get(), stats, d.ring.get());
+  GEM_CUDA_CHECK_LAUNCH();
 }
 
 // Sizes every buffer for n and the capacity.
@@ -736,7 +811,11 @@ void prepareBuffers(DeviceState& d) {
   d.candA.ensure(cap), d.candB.ensure(cap), d.candContact.ensure(cap), d.flag.ensure(cap + 1), d.flagOffset.ensure(cap + 1);
   d.contactA.ensure(cap), d.contactB.ensure(cap), d.contacts.ensure(cap), d.slots.ensure(cap), d.contactKey.ensure(cap);
   d.sortedKeys.ensure(cap), d.bKey.ensure(cap), d.bKeySorted.ensure(cap), d.bIndex.ensure(cap), d.bIndexSorted.ensure(cap);
-  d.impacts.ensure(cap), d.breaks.ensure(cap);  // each contact yields at most one of each
+  // Records of a whole batch: a step needs one impact and one break per contact at most, and
+  // a batch that fills the buffers stops there (the next batch starts them empty).
+  d.recordCapacity = std::max(d.recordCapacity, d.capacity);
+  const size_t records = static_cast<size_t>(d.recordCapacity);
+  d.impacts.ensure(records), d.breaks.ensure(records), d.logs.ensure(records);
   d.previousKeys.ensureKeeping(cap, static_cast<size_t>(d.h_stats->previousContacts));
 
   size_t bytes = 1;
@@ -750,63 +829,132 @@ void prepareBuffers(DeviceState& d) {
   d.tempBytes = bytes;
 }
 
-// Captures the step as a graph, replayed every step until n or the capacity changes.
+// Captures a batch as one graph, replayed every batch until n, a capacity or the ring changes:
+//   copy the control in -> reset the batch's counters -> WHILE (a step; its last kernel sets the
+//   condition) -> copy the ring and the counters out to pinned memory.
+// So a batch of up to copy_back_every steps is one launch and one host sync (thesis 5.7).
 void captureStep(DeviceState& d) {
   prepareBuffers(d);
   d.dropGraph();
   cudaGraph_t graph = nullptr;
-  GEM_CUDA_CHECK(cudaStreamBeginCapture(d.stream, cudaStreamCaptureModeThreadLocal));
+  GEM_CUDA_CHECK(cudaGraphCreate(&graph, 0));
+  struct Owned {
+    cudaGraph_t g;
+    ~Owned() { cudaGraphDestroy(g); }
+  } owned{graph};
+  cudaGraphNode_t controlIn, begin, loop, ringOut, statsOut;
+  GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&controlIn, graph, nullptr, 0, d.control.get(), d.h_control, sizeof(BatchControl),
+                                          cudaMemcpyHostToDevice));
+  StepStats* stats = d.stats.get();
+  void* beginArgs[] = {&stats};
+  cudaKernelNodeParams beginParams{};
+  beginParams.func = reinterpret_cast<void*>(beginBatchKernel);
+  beginParams.gridDim = dim3(1);
+  beginParams.blockDim = dim3(1);
+  beginParams.kernelParams = beginArgs;
+  GEM_CUDA_CHECK(cudaGraphAddKernelNode(&begin, graph, &controlIn, 1, &beginParams));
+
+  cudaGraphConditionalHandle handle;
+  GEM_CUDA_CHECK(cudaGraphConditionalHandleCreate(&handle, graph, 1, cudaGraphCondAssignDefault));
+  cudaGraphNodeParams loopParams{};
+  loopParams.type = cudaGraphNodeTypeConditional;
+  loopParams.conditional.handle = handle;
+  loopParams.conditional.type = cudaGraphCondTypeWhile;
+  loopParams.conditional.size = 1;
+  GEM_CUDA_CHECK(cudaGraphAddNode(&loop, graph, &begin, nullptr, 1, &loopParams));
+  cudaGraph_t body = loopParams.conditional.phGraph_out[0];
+  GEM_CUDA_CHECK(cudaStreamBeginCaptureToGraph(d.stream, body, nullptr, nullptr, 0, cudaStreamCaptureModeThreadLocal));
   try {
-    enqueueStep(d);
+    enqueueStep(d, handle, true);
   } catch (...) {
-    cudaStreamEndCapture(d.stream, &graph);
-    if (graph) cudaGraphDestroy(graph);
+    cudaStreamEndCapture(d.stream, &body);
     throw;
   }
-  GEM_CUDA_CHECK(cudaStreamEndCapture(d.stream, &graph));
-  const cudaError_t status = cudaGraphInstantiate(&d.graph, graph, 0);
-  cudaGraphDestroy(graph);
-  GEM_CUDA_CHECK(status);
+  GEM_CUDA_CHECK(cudaStreamEndCapture(d.stream, &body));
+
+  GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&ringOut, graph, &loop, 1, d.h_ring, d.ring.get(),
+                                          sizeof(StepRecord) * static_cast<size_t>(d.ringSize), cudaMemcpyDeviceToHost));
+  GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&statsOut, graph, &loop, 1, d.h_stats, stats, sizeof(StepStats), cudaMemcpyDeviceToHost));
+  GEM_CUDA_CHECK(cudaGraphInstantiate(&d.graph, graph, 0));
+}
+
+// The same batch with every kernel launched from the host, a sync per step (GEM_CUDA_GRAPH=0).
+void runBatchUncaptured(DeviceState& d) {
+  prepareBuffers(d);
+  GEM_CUDA_CHECK(cudaMemcpyAsync(d.control.get(), d.h_control, sizeof(BatchControl), cudaMemcpyHostToDevice, d.stream));
+  beginBatchKernel<<<1, 1, 0, d.stream>>>(d.stats.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  do {
+    enqueueStep(d, cudaGraphConditionalHandle{}, false);
+    GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_stats, d.stats.get(), sizeof(StepStats), cudaMemcpyDeviceToHost, d.stream));
+    GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
+  } while (d.h_stats->halt == kRunning);
+  GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_ring, d.ring.get(), sizeof(StepRecord) * static_cast<size_t>(d.ringSize), cudaMemcpyDeviceToHost, d.stream));
 }
 
 }  // namespace
 
-void DeviceWorld::step(const StepContext& ctx, DeviceStepResult& result) {
+void DeviceWorld::configure(int copyBackEvery, int blockSize) {
   DeviceState& d = *m_state;
-  result = DeviceStepResult{};
-  if (d.n == 0) return;
-  *d.h_ctx = ctx;
+  if (copyBackEvery < 1 || blockSize < 32 || blockSize > 1024 || blockSize % 32)
+    throw std::invalid_argument("DeviceWorld::configure: copy_back_every >= 1, block size a multiple of 32 up to 1024");
+  if (copyBackEvery != d.ringSize) d.setRingSize(copyBackEvery);
+  if (blockSize != d.block) d.dropGraph();
+  d.block = blockSize;
+}
+
+void DeviceWorld::run(long firstStep, Real dt, int steps, DeviceBatchResult& result) {
+  DeviceState& d = *m_state;
+  result.steps.clear(), result.impacts.clear(), result.breaks.clear(), result.logs.clear();
+  if (d.n == 0) {
+    for (int k = 0; k < steps; ++k) result.steps.push_back(StepRecord{});
+    return;
+  }
   static const bool useGraph = [] {
     const char* v = std::getenv("GEM_CUDA_GRAPH");  // 0: launch the kernels one by one (debugging)
     return !(v && v[0] == '0');
   }();
-  for (;;) {
+  long next = firstStep;
+  int remaining = steps;
+  while (remaining > 0) {
+    *d.h_control = BatchControl{next, dt, std::min(remaining, d.ringSize)};
     if (!useGraph) {
-      prepareBuffers(d);
-      enqueueStep(d);
+      runBatchUncaptured(d);
     } else {
       if (!d.graph) captureStep(d);
       GEM_CUDA_CHECK(cudaGraphLaunch(d.graph, d.stream));
     }
     GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
-    if (!d.h_stats->overflow) break;
-    // More candidate pairs than room: nothing was written back; grow, re-capture, run again.
-    d.capacity = d.h_stats->candidatesNeeded + d.h_stats->candidatesNeeded / 2 + 256;
+    const StepStats stats = *d.h_stats;
+    const int done = stats.stepsDone;
+
+    // The completed steps' records, appended; their ends shifted past what earlier batches added.
+    const int impactBase = static_cast<int>(result.impacts.size()), breakBase = static_cast<int>(result.breaks.size()),
+              logBase = static_cast<int>(result.logs.size());
+    const StepRecord last = done > 0 ? d.h_ring[done - 1] : StepRecord{};
+    result.impacts.resize(static_cast<size_t>(impactBase + last.impactEnd));
+    result.breaks.resize(static_cast<size_t>(breakBase + last.breakEnd));
+    result.logs.resize(static_cast<size_t>(logBase + last.logEnd));
+    d.impacts.download(result.impacts.data() + impactBase, static_cast<size_t>(last.impactEnd));
+    d.breaks.download(result.breaks.data() + breakBase, static_cast<size_t>(last.breakEnd));
+    d.logs.download(result.logs.data() + logBase, static_cast<size_t>(last.logEnd));
+    for (int k = 0; k < done; ++k) {
+      StepRecord r = d.h_ring[k];
+      r.impactEnd += impactBase, r.breakEnd += breakBase, r.logEnd += logBase;
+      result.steps.push_back(r);
+    }
+    next += done;
+    remaining -= done;
+    if (stats.halt == kHaltBreak) break;
+    if (stats.halt != kHaltOverflow) continue;
+    // A step overflowed and left the state alone: grow what it passed, re-capture, run it again.
+    if (stats.candidatesNeeded > d.capacity) {
+      d.capacity = stats.candidatesNeeded + stats.candidatesNeeded / 2 + 256;
+    } else if (done == 0) {
+      d.recordCapacity *= 4;  // one step's records alone passed the buffers (a batch that filled them just stops)
+    }
     d.dropGraph();
   }
-  const StepStats stats = *d.h_stats;
-  result.candidates = stats.candidates;
-  result.contacts = stats.contacts;
-  const int impactCount = std::min(stats.impactCount, d.capacity);
-  const int breakCount = std::min(stats.breakCount, d.capacity);
-  result.impacts.resize(impactCount);
-  result.breaks.resize(breakCount);
-  if (impactCount) d.impacts.download(result.impacts.data(), impactCount);
-  if (breakCount) d.breaks.download(result.breaks.data(), breakCount);
-  result.vesselImpulse = stats.vesselImpulse;
-  result.vesselPosition = stats.vesselPosition;
-  result.vesselVelocity = stats.vesselVelocity;
-  result.vesselAngle = stats.vesselAngle;
 }
 
 }  // namespace gem::cuda

@@ -13,14 +13,23 @@ namespace gem::cuda {
 
 struct DeviceState;
 
-// What a step hands back to the host (small; the records only when there are some).
-struct DeviceStepResult {
-  int candidates = 0, contacts = 0;
-  std::vector<ImpactRecord> impacts;  // device order (atomic counter): the caller orders them
+// One completed step's results, as the device's step graph writes them into its ring. The record
+// ends index the batch's record arrays: step s's impacts are [steps[s-1].impactEnd, steps[s].impactEnd).
+struct StepRecord {
+  int candidates, contacts;
+  int impactEnd, breakEnd, logEnd;
+  Vec2 vesselImpulse;                    // N s, this step's contact impulses on the vessel
+  Vec2 vesselPosition, vesselVelocity;   // after the step
+  Real vesselAngle;
+};
+
+// What a run of steps hands back: copied off the device once, through pinned buffers, at its end
+// (thesis 5.7). Records of a step are in device order (atomic counters): the caller orders them.
+struct DeviceBatchResult {
+  std::vector<StepRecord> steps;
+  std::vector<ImpactRecord> impacts;
   std::vector<BreakRequest> breaks;
-  Vec2 vesselImpulse{0, 0};           // N s, this step's contact impulses on the vessel
-  Vec2 vesselPosition{0, 0}, vesselVelocity{0, 0};
-  Real vesselAngle = 0;
+  std::vector<LogRecord> logs;
 };
 
 class DeviceWorld {
@@ -39,7 +48,13 @@ class DeviceWorld {
   void upload(const World& world, int vesselDof, int vesselSlot);
   // Positions, angles and velocities back into the host world (the rest never changes on the device).
   void download(World& world) const;
-  void step(const StepContext& ctx, DeviceStepResult& result);
+  // Steps kept on the device between two copies to the host (the ring's length), and threads per
+  // block of the per-body and per-contact kernels. Before the first run.
+  void configure(int copyBackEvery, int blockSize);
+  // Runs `steps` steps from step index firstStep (time = index x dt) without the host, and then
+  // copies their results off. Stops early after a step that asked for a break (the host's topology
+  // phase comes next). A step that overflowed a buffer is redone, bit-identically, with more room.
+  void run(long firstStep, Real dt, int steps, DeviceBatchResult& result);
 
  private:
   std::unique_ptr<DeviceState> m_state;

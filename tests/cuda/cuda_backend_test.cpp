@@ -265,3 +265,62 @@ TEST(CudaBackend, PluginEventsRunOnTheCpuUnderAutoAndAreRefusedByCuda) {
   stepper->step();
   EXPECT_NEAR(stepper->hostWorld().vx[0], 0.1, 1e-12);
 }
+
+// Copying results back only every k steps (thesis 5.7) changes nothing a run sees: each step's
+// impacts, vessel force, contact count, and the final state, bit for bit, for k = 1, 7 and 64,
+// over 300 steps of the busy channel (breaks stop a batch early; the re-sort at step 200 and the
+// run's end bound them).
+TEST(CudaBackend, CopyBackIntervalChangesNothing) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  struct PerStep {
+    std::vector<double> values;  // per step: contacts, ice force x, y, then each impact's time, floe id, force
+  };
+  auto runWith = [&](int every, State& final) {
+    Scenario s = test::scenarioFromToml(dir, kBusyScene);
+    s.copyBackEvery = every;
+    CudaSimulation sim(s);
+    PerStep seen;
+    long impacts = 0;
+    for (int k = 0; k < 300; ++k) {
+      sim.step();
+      seen.values.insert(seen.values.end(), {double(sim.contactCount()), sim.vesselIceForce().x, sim.vesselIceForce().y,
+                                             sim.vessel().position.x, sim.vessel().velocity.x});
+      for (const ImpactRecord& r : sim.impacts()) seen.values.insert(seen.values.end(), {r.time, double(r.floeId), r.force});
+      impacts += static_cast<long>(sim.impacts().size());
+    }
+    final = capture(sim, impacts);
+    return seen;
+  };
+  State one, seven, many;
+  const PerStep a = runWith(1, one), b = runWith(7, seven), c = runWith(64, many);
+  EXPECT_GT(one.broken, 0);
+  EXPECT_GT(one.impacts, 0);
+  for (const auto* other : {&b, &c}) {
+    ASSERT_EQ(a.values.size(), other->values.size());
+    EXPECT_EQ(0, std::memcmp(a.values.data(), other->values.data(), a.values.size() * sizeof(double)));
+  }
+  for (const State* other : {&seven, &many}) {
+    ASSERT_EQ(one.ids, other->ids);
+    ASSERT_EQ(one.values.size(), other->values.size());
+    EXPECT_EQ(0, std::memcmp(one.values.data(), other->values.data(), one.values.size() * sizeof(Real)));
+  }
+}
+
+// The block size (simulation.cuda_block_size, swept by gem bench) changes nothing either.
+TEST(CudaBackend, BlockSizeChangesNothing) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  Scenario s = test::scenarioFromToml(dir, kBusyScene);
+  CudaSimulation standard(s);
+  s.cudaBlockSize = 256;
+  CudaSimulation wide(s);
+  s.cudaBlockSize = 32;
+  CudaSimulation narrow(s);
+  const State a = run(standard, 120), b = run(wide, 120), c = run(narrow, 120);
+  for (const State* other : {&b, &c}) {
+    ASSERT_EQ(a.ids, other->ids);
+    EXPECT_EQ(0, std::memcmp(a.values.data(), other->values.data(), a.values.size() * sizeof(Real)));
+    EXPECT_EQ(a.impacts, other->impacts);
+  }
+}
