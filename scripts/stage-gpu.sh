@@ -33,9 +33,10 @@ done
 # The CUDA runtime of the build (13.0, as on the GPU machine) travels too: a match is then certain.
 cp -L "$(ldd "$stage/lib/libgem_cuda.so" | awk '/libcudart/{print $3}')" "$stage/lib/"
 cp -r "$root/scenarios" "$stage/scenarios"
-# The shear_current plugin with its CUDA part (tests/cuda/plugin_cuda_test.cpp runs it on the device).
+# The shear_current and rafting_onset plugins with their CUDA parts (tests/cuda/plugin_cuda_test.cpp
+# runs them on the device).
 mkdir -p "$stage/cuda_plugins"
-cp "$build/tests/cuda_plugins/libshear_current.so" "$stage/cuda_plugins/"
+cp "$build/tests/cuda_plugins/libshear_current.so" "$build/tests/cuda_plugins/librafting_onset.so" "$stage/cuda_plugins/"
 
 cat > "$stage/run.sh" <<'RUN'
 #!/usr/bin/env bash
@@ -60,13 +61,9 @@ if [ "${GEM_SKIP_SANITIZER:-0}" != 1 ]; then
     --gtest_filter='CudaBackend.TwoFloes*:CudaBackend.BusyChannelMatchesTheCpuAfter50Steps' > "$out/sanitizer.txt" 2>&1
   rc=$?; tail -3 "$out/sanitizer.txt"; echo "compute-sanitizer exit $rc"; [ $rc = 0 ] || status=1
 fi
-echo "== timings (gem bench)"
-./gem bench --backend cpu cuda --cases 456 824 10000 --steps 2000 --csv "$out/bench-small.csv" 2>&1 | tee "$out/bench-small.txt"
-./gem bench --backend cuda --cases 100000 1000000 --steps 400 --csv "$out/bench-large-cuda.csv" 2>&1 | tee "$out/bench-large-cuda.txt"
-./gem bench --backend cpu --cases 100000 --steps 200 --csv "$out/bench-large-cpu.csv" 2>&1 | tee "$out/bench-large-cpu.txt"
-./gem bench --table intersection --csv "$out/bench-intersection.csv" 2>&1 | tee "$out/bench-intersection.txt"
-[ "${PIPESTATUS[0]}" = 0 ] || status=1
-./gem bench --table triangulation --csv "$out/bench-triangulation.csv" 2>&1 | tee "$out/bench-triangulation.txt"
+echo "== timings (gem bench --table all: the thesis's Chapter 5 tables, one CSV per table under bench/)"
+mkdir -p "$out/bench"
+./gem bench --table all --csv "$out/bench" 2>&1 | tee "$out/bench.txt"
 [ "${PIPESTATUS[0]}" = 0 ] || status=1
 if command -v nsys >/dev/null && [ "${GEM_PROFILE:-0}" = 1 ]; then
   echo "== nsys: kernel times of the 824-floe timing"

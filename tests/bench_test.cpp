@@ -1,0 +1,57 @@
+// gem bench's time-per-step tables (framework/bench.hpp) through the gem binary, tiny runs on the
+// CPU: the CSV's header and rows, the --csv directory rule, and bad input (exit 2). The CUDA rows
+// are timed on a GPU machine (scripts/stage-gpu.sh runs gem bench --table all).
+#include <gtest/gtest.h>
+
+#include "test_support.hpp"
+
+using namespace gem;
+using gem::test::TempDir;
+
+namespace {
+
+int countLines(const std::string& text) { return static_cast<int>(std::count(text.begin(), text.end(), '\n')); }
+
+}  // namespace
+
+TEST(GemBench, FieldsTableOnTheCpuWritesOneRowPerBroadphase) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  // A path ending in '/' is a directory: the table goes to fields.csv in it.
+  const std::string out = (dir.path() / "bench").string() + "/";
+  ASSERT_EQ(test::runGem("bench --table fields --backend cpu --cases 456 --steps 10 --csv " + out, log), 0) << test::readFile(log);
+  const std::string rows = test::readFile(dir.path() / "bench" / "fields.csv");
+  EXPECT_EQ(rows.rfind("case,backend,broadphase,bodies,floes,ms_per_step,steps_per_s,floe_steps_per_s,real_time_factor,device\n", 0), 0u)
+      << rows;
+  for (const char* b : {"variable_radius", "fixed_radius", "uniform_grid", "triangulation_mesh", "all_pairs"})
+    EXPECT_NE(rows.find(std::string("\"456 hexagons (46 %)\",cpu,") + b + ","), std::string::npos) << b << "\n" << rows;
+  EXPECT_EQ(countLines(rows), 6) << rows;
+  const std::string text = test::readFile(log);
+  EXPECT_NE(text.find("against variable_radius, 456 hexagons (46 %) on cpu"), std::string::npos) << text;
+  EXPECT_NE(text.find("(one core)"), std::string::npos) << text;
+}
+
+TEST(GemBench, StepTableKeepsItsCsvAndTakesAFloeCount) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt", csv = dir.path() / "step.csv";
+  ASSERT_EQ(test::runGem("bench --cases 824 300 --steps 10 --csv " + csv.string(), log), 0) << test::readFile(log);
+  const std::string rows = test::readFile(csv);
+  EXPECT_EQ(rows.rfind("case,backend,broadphase,bodies,floes,ms_per_step", 0), 0u) << rows;
+  EXPECT_NE(rows.find("\"824 random (50 %)\",cpu,variable_radius,"), std::string::npos) << rows;
+  EXPECT_NE(rows.find("\"300 random (40 %)\",cpu,variable_radius,"), std::string::npos) << rows;
+  EXPECT_EQ(countLines(rows), 3) << rows;
+}
+
+TEST(GemBench, BadTablesAndOptionsAreBadInput) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  EXPECT_EQ(test::runGem("bench --table nonsense", log), 2);
+  EXPECT_NE(test::readFile(log).find("valid tables are step, fields, blocks, copyback, scaling"), std::string::npos) << test::readFile(log);
+  // The block-size sweep is a CUDA setting.
+  EXPECT_EQ(test::runGem("bench --table blocks --backend cpu", log), 2);
+  EXPECT_NE(test::readFile(log).find("cuda only"), std::string::npos) << test::readFile(log);
+  EXPECT_EQ(test::runGem("bench --table blocks --blocks 48", log), 2);
+  EXPECT_EQ(test::runGem("bench --table fields --copy-back 4", log), 2);
+  EXPECT_EQ(test::runGem("bench --table fields --cases 12x", log), 2);
+  EXPECT_EQ(test::runGem("bench --table all --cases 456", log), 2);
+}
