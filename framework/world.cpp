@@ -98,21 +98,9 @@ std::vector<int> World::curveOrder() const {
     x0 = std::min(x0, x[i]), x1 = std::max(x1, x[i]);
     y0 = std::min(y0, y[i]), y1 = std::max(y1, y[i]);
   }
-  const Real scale = 65535 / std::max<Real>({x1 - x0, y1 - y0, Real(1e-9)});
-  // Spreads the 16 bits of v to the even bits of the result, so that x and y interleave.
-  auto spread = [](std::uint32_t v) {
-    v &= 0xffff;
-    v = (v | (v << 8)) & 0x00ff00ff;
-    v = (v | (v << 4)) & 0x0f0f0f0f;
-    v = (v | (v << 2)) & 0x33333333;
-    v = (v | (v << 1)) & 0x55555555;
-    return v;
-  };
+  const Real scale = curveScale(x0, y0, x1, y1);
   std::vector<std::pair<std::uint32_t, int>> keys(n);
-  for (int i = 0; i < n; ++i) {
-    const auto gx = static_cast<std::uint32_t>((x[i] - x0) * scale), gy = static_cast<std::uint32_t>((y[i] - y0) * scale);
-    keys[i] = {spread(gx) | (spread(gy) << 1), i};
-  }
+  for (int i = 0; i < n; ++i) keys[i] = {curveKey(x[i], y[i], x0, y0, scale), i};
   std::sort(keys.begin(), keys.end());
   for (int k = 0; k < n; ++k) order[k] = keys[k].second;
   return order;

@@ -65,10 +65,31 @@ struct World {
   void permute(const std::vector<int>& order);
   // The order of the bodies along a Morton (Z-order) curve through their centroids: neighbours in
   // space become neighbours in memory (DESIGN.md "Speed habits"). Ties keep slot order.
-  std::vector<int> curveOrder() const;
+  std::vector<int> curveOrder() const;  // sorted by curveKey, ties by slot
   // Total mass of the floes, kg.
   double floeMass() const;
   int count(BodyKind k) const;
 };
+
+// The Morton key of World::curveOrder, written once for the host and the device (the CUDA backend
+// re-sorts on the device and must get the very same order): the centroid's place in the box of all
+// centroids [x0, x1] x [y0, y1], on a 65536 x 65536 grid, x and y bits interleaved.
+GEM_HD inline Real curveScale(Real x0, Real y0, Real x1, Real y1) {
+  Real extent = x1 - x0 > y1 - y0 ? x1 - x0 : y1 - y0;
+  if (!(extent > Real(1e-9))) extent = Real(1e-9);
+  return 65535 / extent;
+}
+GEM_HD inline std::uint32_t curveKey(Real x, Real y, Real x0, Real y0, Real scale) {
+  auto spread = [](std::uint32_t v) {  // the 16 bits of v to the even bits of the result
+    v &= 0xffff;
+    v = (v | (v << 8)) & 0x00ff00ff;
+    v = (v | (v << 4)) & 0x0f0f0f0f;
+    v = (v | (v << 2)) & 0x33333333;
+    v = (v | (v << 1)) & 0x55555555;
+    return v;
+  };
+  const auto gx = static_cast<std::uint32_t>((x - x0) * scale), gy = static_cast<std::uint32_t>((y - y0) * scale);
+  return spread(gx) | (spread(gy) << 1);
+}
 
 }  // namespace gem

@@ -86,6 +86,10 @@ void CudaSimulation::upload() {
 void CudaSimulation::downloadState() {
   if (m_hostCurrent) return;
   if (deviceAhead()) throw std::logic_error("CUDA backend: the world was asked for in the middle of a copy-back batch");
+  if (!m_pendingOrder.empty()) {
+    world().permute(m_pendingOrder);
+    m_pendingOrder.clear();
+  }
   m_device->download(world());
   m_hostCurrent = true;
 }
@@ -145,8 +149,10 @@ void CudaSimulation::step() {
     for (const auto& x : m_impacts) slotOf[x.floeId] = 0;
     for (const auto& x : m_breaks) slotOf[x.floeId] = 0;
     for (const auto& x : m_logs) slotOf[x.idA] = 0, slotOf[x.idB] = 0;
-    for (int i = 0; i < w.size(); ++i)
-      if (auto it = slotOf.find(w.id[i]); it != slotOf.end()) it->second = i;
+    for (int i = 0; i < w.size(); ++i) {
+      const int body = m_pendingOrder.empty() ? i : m_pendingOrder[static_cast<size_t>(i)];
+      if (auto it = slotOf.find(w.id[body]); it != slotOf.end()) it->second = i;
+    }
     std::stable_sort(m_impacts.begin(), m_impacts.end(),
                      [&](const ImpactRecord& a, const ImpactRecord& b) { return slotOf[a.floeId] < slotOf[b.floeId]; });
     std::stable_sort(m_breaks.begin(), m_breaks.end(),
@@ -176,17 +182,24 @@ void CudaSimulation::step() {
   ++m_step;
   m_time = static_cast<Real>(m_step) * scenario().dt;
   if (scenario().mortonSort && m_step % 200 == 0) {
-    downloadState();
-    reorderAlongCurve();
-    upload();
+    // On the device, and the mirror follows lazily: at 10^6 floes a round trip through the host
+    // (download, sort, permute, upload) cost more than the 200 steps it serves.
+    const std::vector<int> order = m_device->reorderAlongCurve();
+    if (m_pendingOrder.empty()) {
+      m_pendingOrder = order;
+    } else {
+      std::vector<int> composed(order.size());
+      for (size_t k = 0; k < order.size(); ++k) composed[k] = m_pendingOrder[static_cast<size_t>(order[k])];
+      m_pendingOrder.swap(composed);
+    }
+    m_hostCurrent = false;
+    if (m_vesselSlot >= 0)
+      for (size_t k = 0; k < order.size(); ++k)
+        if (order[k] == m_vesselSlot) {
+          m_vesselSlot = static_cast<int>(k);
+          break;
+        }
   }
-}
-
-// The same order as Simulation::reorderAlongCurve, so that both backends sum each body's contacts
-// in the same order.
-void CudaSimulation::reorderAlongCurve() {
-  World& w = world();
-  if (w.size() >= 2) w.permute(w.curveOrder());
 }
 
 // The backend's entry: listed by `gem info`, chosen by --backend cuda and by backend = "auto".

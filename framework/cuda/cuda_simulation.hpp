@@ -51,7 +51,6 @@ class CudaSimulation final : public Stepper {
  private:
   void upload();          // host world -> device (all arrays), after set-up, breaks and re-sorts
   void downloadState();   // device kinematics -> host world
-  void reorderAlongCurve();
   void runBatch();        // the next batch of steps on the device
   bool deviceAhead() const;  // the device has run steps that step() has not handed out yet
 
@@ -60,6 +59,9 @@ class CudaSimulation final : public Stepper {
 
   std::unique_ptr<Simulation> m_cpu;  // parses the events (and runs the topology ones) and holds the host world
   bool m_hostCurrent = true;
+  // Re-sorts on the device leave the host mirror in the old slot order: device slot k holds the
+  // mirror's body m_pendingOrder[k]. Applied (World::permute) when the host next needs its world.
+  std::vector<int> m_pendingOrder;
   std::unique_ptr<cuda::DeviceWorld> m_device;
   std::unique_ptr<cuda::DeviceBatchResult> m_batch;
   size_t m_batchNext = 0;  // the batch's next step to hand out

@@ -7,10 +7,13 @@
 #include <cub/block/block_reduce.cuh>
 #include <cub/block/block_scan.cuh>
 #include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_reduce.cuh>
 #include <cub/device/device_scan.cuh>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <tuple>
 #include <cstddef>
 #include <cstdlib>
 #include <stdexcept>
@@ -19,6 +22,10 @@
 #include "geometry/contact.hpp"
 
 namespace gem::cuda {
+
+// Counts the reallocations of every DeviceBuffer: a captured graph holds the buffers' addresses,
+// so a change of this count means the graph must be captured again.
+static std::atomic<unsigned long> g_reallocations{0};
 
 // A device array that only grows (steps reuse it; no allocation in the steady state).
 template <class T>
@@ -38,6 +45,7 @@ class DeviceBuffer {
     if (m_data) GEM_CUDA_CHECK(cudaFree(m_data));
     m_data = data;
     m_capacity = capacity;
+    ++g_reallocations;
   }
   // Grows keeping the first `keep` elements (the previous step's contact keys survive a regrowth).
   void ensureKeeping(size_t n, size_t keep) {
@@ -119,6 +127,7 @@ struct DeviceState {
   int largeCount = 0;
   int n = 0;
   int vesselSlot = -1;
+  DeviceBuffer<int> vessel;  // vesselSlot on the device: a re-sort moves it without a new graph
   Real cell = 1;
   unsigned tableSize = 64;
   int tableBits = 6;
@@ -203,7 +212,7 @@ __device__ inline unsigned cellHash(long long cx, long long cy, unsigned mask) {
 }
 
 struct PrepareArgs {
-  int n, vessel;
+  int n;
   const std::int64_t* id;
   const BodyKind* kind;
   const int *vertexCount, *dof;
@@ -503,11 +512,12 @@ __device__ inline void addImpulse(const PairBody& b, Vec2 ji, Vec2 c, VelocityCh
 // body's contacts as b (a < i) all come before its contacts as a (sorted by a). No atomics.
 // contactA and bKeySorted are sorted with the padding (slot n) last, so searching the whole
 // capacity finds only real contacts.
-__global__ void gatherKernel(int n, int vessel, const PairBody* bodies, const VelocityChange* changes, int capacity,
+__global__ void gatherKernel(int n, const int* vesselSlot, const PairBody* bodies, const VelocityChange* changes, int capacity,
                              const int* contactA, const int* bKeySorted, const int* bIndexSorted, const PairContact* contacts,
                              const PairSlot* slots, MotionBody* motion, StepStats* stats) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
+  const int vessel = *vesselSlot;
   const PairBody& b = bodies[i];
   VelocityChange total = changes[i];
   Vec2 vesselImpulse{0, 0};
@@ -567,7 +577,7 @@ __global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, con
 }
 
 // The only write of the state; skipped when the step overflowed, so it can simply be run again.
-__global__ void writeBackKernel(int n, int vessel, const MotionBody* motion, Real* x, Real* y, Real* angle, Real* vx, Real* vy,
+__global__ void writeBackKernel(int n, const int* vesselSlot, const MotionBody* motion, Real* x, Real* y, Real* angle, Real* vx, Real* vy,
                                 Real* omega, StepStats* stats) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n || stats->overflow) return;
@@ -578,7 +588,7 @@ __global__ void writeBackKernel(int n, int vessel, const MotionBody* motion, Rea
   vx[i] = b.velocity.x;
   vy[i] = b.velocity.y;
   omega[i] = b.omega;
-  if (i == vessel) {
+  if (i == *vesselSlot) {
     stats->vesselPosition = b.position;
     stats->vesselVelocity = b.velocity;
     stats->vesselAngle = b.angle;
@@ -601,10 +611,16 @@ void DeviceWorld::addMotionEvent(std::unique_ptr<CudaEventDriver> driver) { m_st
 
 void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
   DeviceState& d = *m_state;
-  d.dropGraph();
+  // What the captured graph baked in: the same after the upload (a re-sort along the curve every
+  // 200 steps changes only the arrays' contents) and the graph is kept, not captured again.
+  auto baked = [&d] {
+    return std::make_tuple(d.n, d.cell, d.tableSize, d.largeCount, d.idBits, d.capacity, g_reallocations.load());
+  };
+  const auto before = baked();
   const int n = w.size();
   d.n = n;
   d.vesselSlot = vesselSlot;
+  d.vessel.upload(&vesselSlot, 1);
   d.id.upload(w.id.data(), n);
   d.kind.upload(w.kind.data(), n);
   d.vertexCount.upload(w.vertexCount.data(), n);
@@ -665,6 +681,109 @@ void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
     const char* start = std::getenv("GEM_CUDA_CAPACITY");
     d.capacity = start ? std::max(1, std::atoi(start)) : 4 * n + 256;
   }
+  if (baked() != before) d.dropGraph();
+}
+
+namespace {
+
+// Scratch for the re-sort, outside the DeviceBuffers: growing it must not look like a change of
+// the graph's buffers.
+struct ReorderScratch {
+  void* data = nullptr;
+  size_t bytes = 0;
+  ~ReorderScratch() {
+    if (data) cudaFree(data);
+  }
+  void* get(size_t need) {
+    if (need > bytes) {
+      if (data) GEM_CUDA_CHECK(cudaFree(data));
+      data = nullptr;
+      GEM_CUDA_CHECK(cudaMalloc(&data, need));
+      bytes = need;
+    }
+    return data;
+  }
+};
+
+__global__ void curveKeyKernel(int n, const Real* x, const Real* y, const Real* bounds, unsigned* key, int* slot) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const Real x0 = bounds[0], y0 = bounds[1], scale = curveScale(bounds[0], bounds[1], bounds[2], bounds[3]);
+  key[i] = curveKey(x[i], y[i], x0, y0, scale);
+  slot[i] = i;
+}
+
+template <class T>
+__global__ void gatherRowsKernel(int n, int width, const int* order, const T* from, T* to) {
+  const size_t k = static_cast<size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (k >= static_cast<size_t>(n) * width) return;
+  const size_t row = k / width, column = k % width;
+  to[k] = from[static_cast<size_t>(order[row]) * width + column];
+}
+
+template <class T>
+void permuteOnDevice(DeviceBuffer<T>& buffer, int n, int width, const int* order, ReorderScratch& scratch, cudaStream_t s) {
+  const size_t count = static_cast<size_t>(n) * width;
+  T* copy = static_cast<T*>(scratch.get(count * sizeof(T)));
+  GEM_CUDA_CHECK(cudaMemcpyAsync(copy, buffer.get(), count * sizeof(T), cudaMemcpyDeviceToDevice, s));
+  gatherRowsKernel<T><<<static_cast<unsigned>((count + kBlock - 1) / kBlock), kBlock, 0, s>>>(n, width, order, copy, buffer.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  GEM_CUDA_CHECK(cudaStreamSynchronize(s));  // the scratch is reused by the next array
+}
+
+}  // namespace
+
+std::vector<int> DeviceWorld::reorderAlongCurve() {
+  DeviceState& d = *m_state;
+  const int n = d.n;
+  std::vector<int> order(static_cast<size_t>(n));
+  if (n < 2) {
+    for (int i = 0; i < n; ++i) order[static_cast<size_t>(i)] = i;
+    return order;
+  }
+  cudaStream_t s = d.stream;
+  static thread_local ReorderScratch scratch, sortScratch;
+  // The centroids' box: exact (min and max round nothing), as the host's loop.
+  DeviceBuffer<Real> bounds;
+  bounds.ensure(4);
+  size_t bytes = 0;
+  GEM_CUDA_CHECK(cub::DeviceReduce::Min(nullptr, bytes, d.x.get(), bounds.get(), n, s));
+  void* temp = sortScratch.get(bytes);
+  GEM_CUDA_CHECK(cub::DeviceReduce::Min(temp, bytes, d.x.get(), bounds.get() + 0, n, s));
+  GEM_CUDA_CHECK(cub::DeviceReduce::Min(temp, bytes, d.y.get(), bounds.get() + 1, n, s));
+  GEM_CUDA_CHECK(cub::DeviceReduce::Max(temp, bytes, d.x.get(), bounds.get() + 2, n, s));
+  GEM_CUDA_CHECK(cub::DeviceReduce::Max(temp, bytes, d.y.get(), bounds.get() + 3, n, s));
+  // Keys, then a stable radix sort: ties keep slot order, as the host's sort of (key, slot) pairs.
+  DeviceBuffer<unsigned> keys, sortedKeys;
+  DeviceBuffer<int> slots, sortedSlots;
+  keys.ensure(n), sortedKeys.ensure(n), slots.ensure(n), sortedSlots.ensure(n);
+  curveKeyKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.x.get(), d.y.get(), bounds.get(), keys.get(), slots.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  bytes = 0;
+  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, 32, s));
+  temp = sortScratch.get(bytes);
+  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, 32, s));
+  const int* o = sortedSlots.get();
+  permuteOnDevice(d.id, n, 1, o, scratch, s), permuteOnDevice(d.kind, n, 1, o, scratch, s);
+  permuteOnDevice(d.vertexCount, n, 1, o, scratch, s), permuteOnDevice(d.dof, n, 1, o, scratch, s);
+  permuteOnDevice(d.local, n, kMaxVertices, o, scratch, s), permuteOnDevice(d.isLarge, n, 1, o, scratch, s);
+  for (DeviceBuffer<Real>* r : {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.area, &d.thickness, &d.mass, &d.invMass,
+                                &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle})
+    permuteOnDevice(*r, n, 1, o, scratch, s);
+  sortedSlots.download(order.data(), static_cast<size_t>(n));
+
+  // The large bodies' and the vessel's new slots (their count is unchanged: the graph stays valid).
+  std::vector<int> large;
+  std::vector<unsigned char> isLarge(static_cast<size_t>(n));
+  d.isLarge.download(isLarge.data(), static_cast<size_t>(n));
+  const int vesselBefore = d.vesselSlot;
+  for (int k = 0; k < n; ++k) {
+    if (isLarge[static_cast<size_t>(k)]) large.push_back(k);
+    if (order[static_cast<size_t>(k)] == vesselBefore) d.vesselSlot = k;
+  }
+  d.large.upload(large.data(), large.size());
+  d.vessel.upload(&d.vesselSlot, 1);
+  return order;
 }
 
 void DeviceWorld::download(World& w) const {
@@ -729,7 +848,7 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   GEM_CUDA_CHECK_LAUNCH();
 
   // 1. World vertices, boxes, views, cell keys.
-  PrepareArgs a{n, d.vesselSlot, d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.local.get(), d.x.get(), d.y.get(),
+  PrepareArgs a{n, d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.local.get(), d.x.get(), d.y.get(),
                 d.angle.get(), d.vx.get(), d.vy.get(), d.omega.get(), d.area.get(), d.thickness.get(), d.mass.get(),
                 d.invMass.get(), d.invInertia.get(), d.gyration2.get(), d.gyrationX2.get(), d.gyrationY2.get(),
                 d.principalAngle.get(), d.isLarge.get(), d.cell, d.tableSize - 1, largeKey, d.worldVertices.get(), d.boxes.get(),
@@ -790,13 +909,13 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   for (auto& e : d.soloEvents) e->launchSolo(soloData, s);
 
   // 5. Gather, motion, write back; then the counters to the host.
-  gatherKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.vesselSlot, d.pairBodies.get(), d.changes.get(), capacity, d.contactA.get(),
+  gatherKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.vessel.get(), d.pairBodies.get(), d.changes.get(), capacity, d.contactA.get(),
                                                d.bKeySorted.get(), d.bIndexSorted.get(), d.contacts.get(), d.slots.get(),
                                                d.motionBodies.get(), stats);
   GEM_CUDA_CHECK_LAUNCH();
   const DeviceMotionData motionData{d.motionBodies.get(), n, block, d.ctx.get()};
   for (auto& e : d.motionEvents) e->launchMotion(motionData, s);
-  writeBackKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.vesselSlot, d.motionBodies.get(), d.x.get(), d.y.get(), d.angle.get(),
+  writeBackKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.vessel.get(), d.motionBodies.get(), d.x.get(), d.y.get(), d.angle.get(),
                                                         d.vx.get(), d.vy.get(), d.omega.get(), stats);
   GEM_CUDA_CHECK_LAUNCH();
   commitContactsKernel<<<blocksFor(capacity, block), block, 0, s>>>(capacity, d.sortedKeys.get(), d.previousKeys.get(), stats);

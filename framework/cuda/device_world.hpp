@@ -46,6 +46,10 @@ class DeviceWorld {
 
   // The whole host world to the device (set-up, after breaks and re-sorts).
   void upload(const World& world, int vesselDof, int vesselSlot);
+  // Re-sorts the bodies along the curve on the device, as World::curveOrder + World::permute do on
+  // the host, bit for bit. Returns the order (new slot k holds old slot order[k]) so that the host
+  // can apply it to its mirror when it next needs it. The captured graph stays valid.
+  std::vector<int> reorderAlongCurve();
   // Positions, angles and velocities back into the host world (the rest never changes on the device).
   void download(World& world) const;
   // Steps kept on the device between two copies to the host (the ring's length), and threads per

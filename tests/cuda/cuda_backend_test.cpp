@@ -324,3 +324,19 @@ TEST(CudaBackend, BlockSizeChangesNothing) {
     EXPECT_EQ(a.impacts, other->impacts);
   }
 }
+
+// The re-sort along the curve runs on the device (every 200 steps) and must give the host's order
+// (the two backends then sum contacts in the same order): right after it, the world handed back is
+// sorted by World::curveOrder's key, ties by slot, so that order is the identity.
+TEST(CudaBackend, ReSortOnTheDeviceGivesTheHostsCurveOrder) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  const Scenario s = test::scenarioFromToml(dir, kBusyScene);
+  CudaSimulation gpu(s);
+  const std::vector<std::int64_t> before = gpu.hostWorld().id;
+  run(gpu, 200);
+  const World& w = gpu.hostWorld();
+  const std::vector<int> order = w.curveOrder();
+  for (int k = 0; k < static_cast<int>(order.size()); ++k) ASSERT_EQ(order[k], k) << "slot " << k;
+  EXPECT_NE(before, w.id);  // the re-sort moved bodies (the pack moved in 200 steps)
+}
