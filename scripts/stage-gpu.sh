@@ -33,9 +33,10 @@ done
 # The CUDA runtime of the build (13.0, as on the GPU machine) travels too: a match is then certain.
 cp -L "$(ldd "$stage/lib/libgem_cuda.so" | awk '/libcudart/{print $3}')" "$stage/lib/"
 cp -r "$root/scenarios" "$stage/scenarios"
-# The shear_current plugin with its CUDA part (tests/cuda/plugin_cuda_test.cpp runs it on the device).
+# The shear_current and sweep_and_prune plugins with their CUDA parts (tests/cuda/plugin_cuda_test.cpp and
+# broadphase_cuda_test.cpp run them on the device).
 mkdir -p "$stage/cuda_plugins"
-cp "$build/tests/cuda_plugins/libshear_current.so" "$stage/cuda_plugins/"
+cp "$build/tests/cuda_plugins/libshear_current.so" "$build/tests/cuda_plugins/libsweep_and_prune.so" "$stage/cuda_plugins/"
 
 cat > "$stage/run.sh" <<'RUN'
 #!/usr/bin/env bash
