@@ -728,7 +728,8 @@ void enqueueStep(DeviceState& d) {
     GEM_CUDA_CHECK_LAUNCH();
     candidatesNeeded = count;
   } else {
-  // The built-in grid (left at its old indentation, to keep this branch's diff small): sort by cell, cell ranges, count, scan, write (rows sorted: pairs by (a, b)).
+  // The built-in grid, uniform_grid (left at its old indentation to keep the diff small): sort by
+  // cell, cell ranges, count, scan, write (rows sorted: pairs by (a, b), no sort of the pairs).
   cubCalls.cellSort(n, bitsFor(largeKey));
   GEM_CUDA_CHECK(cudaMemsetAsync(d.cellStart.get(), 0xff, d.tableSize * sizeof(int), s));
   cellRangeKernel<<<blocksFor(n), kBlock, 0, s>>>(d.cellKeySorted.get(), n, largeKey, d.cellStart.get(), d.cellEnd.get());
