@@ -8,10 +8,6 @@
 
 namespace gem {
 
-// The rebuild fires a hair before d_1st + d_2nd reaches the skin, so that rounding in the distances
-// of the build and of this check can never let a pair on the very edge of the list slip out.
-constexpr Real kTrigger = Real(1) - Real(1e-6);
-
 bool NeighbourList::update(const World& world) {
   if (!m_valid) return true;
   const int n = world.size();
@@ -21,7 +17,7 @@ bool NeighbourList::update(const World& world) {
   const Real* angle = world.angle.data();
   const Real* radius = world.radius.data();
   const std::int64_t* id = world.id.data();
-  const Real limit = kTrigger * m_skin / 2;
+  const Real limit = kRebuildTrigger * m_skin / 2;
   for (int i = 0; i < n; ++i) {
     // A reorder or an in-place replacement without invalidate() would make the list point at the
     // wrong bodies: the ids guard against it for the price of one load per body.

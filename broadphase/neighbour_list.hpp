@@ -25,6 +25,11 @@
 
 namespace gem {
 
+// The rebuild fires a hair before d_1st + d_2nd reaches the skin, so that rounding in the distances
+// of the build and of the check can never let a pair on the very edge of the list slip out. Shared
+// with the device lists (device_neighbour_list.cuh).
+constexpr Real kRebuildTrigger = Real(1) - Real(1e-6);
+
 // A listed pair: the two slots and the square of R_a + R_b, fixed between builds (a body keeps its
 // shape while it keeps its id), so the per-step filter streams one array and gathers only x, y.
 struct ListedPair {

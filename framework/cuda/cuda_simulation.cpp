@@ -40,6 +40,26 @@ std::string cudaDeviceName() {
 World& CudaSimulation::world() { return m_cpu->world(); }
 const Scenario& CudaSimulation::scenario() const { return m_cpu->scenario(); }
 
+// The scenario's broadphase on the device, found by name and origin as the events' drivers are: a
+// plugin's broadphase runs on the device only with its own plugin's device part. nullptr is the
+// step's built-in grid (uniform_grid).
+static std::unique_ptr<cuda::CudaBroadphase> deviceBroadphase(const Scenario& scenario) {
+  const std::string& name = scenario.broadphase;
+  const std::string origin = Registry::global().broadphase(name).origin;
+  const cuda::CudaBroadphaseFactory* factory = cuda::findCudaBroadphase(name, origin);
+  if (!factory && origin != "built-in")
+    throw BackendUnsupported("broadphase \"" + name + "\" comes from a plugin (" + origin +
+                             ") that has no CUDA part for it (a .cu with GEM_REGISTER_CUDA_BROADPHASE, built by "
+                             "gem_add_plugin's CUDA_SOURCES); run it with --backend cpu");
+  if (!factory) throw BackendUnsupported("broadphase \"" + name + "\" has no CUDA part (broadphase/" + name + ".cu is missing)");
+  return (*factory)(scenario.broadphaseSettings);
+}
+
+long CudaSimulation::broadphaseRebuilds() const {
+  const cuda::CudaBroadphase* b = m_device->broadphase();
+  return b ? b->rebuilds() : 0;
+}
+
 CudaSimulation::CudaSimulation(const Scenario& scenario)
     : m_cpu(std::make_unique<Simulation>(scenario)),
       m_device(std::make_unique<cuda::DeviceWorld>()),
@@ -66,6 +86,7 @@ CudaSimulation::CudaSimulation(const Scenario& scenario)
     else if (e.phase == EventPhase::Solo) m_device->addSoloEvent(std::move(driver));
     else m_device->addMotionEvent(std::move(driver));
   }
+  m_device->setBroadphase(deviceBroadphase(scenario));
   const World& w = world();
   for (int i = 0; i < w.size(); ++i)
     if (w.kind[i] == BodyKind::Vessel) m_vesselId = w.id[i];
@@ -181,9 +202,16 @@ void CudaSimulation::step() {
 
   ++m_step;
   m_time = static_cast<Real>(m_step) * scenario().dt;
-  if (scenario().mortonSort && m_step % 200 == 0) {
-    // On the device, and the mirror follows lazily: at 10^6 floes a round trip through the host
-    // (download, sort, permute, upload) cost more than the 200 steps it serves.
+  if (scenario().mortonSort && m_step % 200 == 0 && m_device->broadphase()) {
+    // A device strategy keeps per-body structures made from the host world (CudaBroadphase::upload):
+    // the re-sort goes through the host, and the strategy rebuilds from the new order.
+    downloadState();
+    world().permute(world().curveOrder());
+    upload();
+  } else if (scenario().mortonSort && m_step % 200 == 0) {
+    // The built-in grid keeps nothing between steps: the re-sort runs on the device, and the mirror
+    // follows lazily. At 10^6 floes a round trip through the host (download, sort, permute, upload,
+    // re-capture) cost more than the 200 steps it serves.
     const std::vector<int> order = m_device->reorderAlongCurve();
     if (m_pendingOrder.empty()) {
       m_pendingOrder = order;

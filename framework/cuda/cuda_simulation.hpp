@@ -1,8 +1,9 @@
 // The CUDA backend: the scheduler of framework/simulation.cpp (MODEL.md 8) with the world on the
 // device for the whole run. Per step, on one stream:
 //   1 prepare: world vertices, boxes, the pair/solo views of every body
-//   2 broadphase: a hashed uniform grid (cell key per body, CUB radix sort, 3 x 3 search, each body's
-//     partners j > i sorted, counts -> scan -> write), so pairs come sorted by (a, b) as on the CPU
+//   2 broadphase: the scenario's, on the device (device_broadphase.hpp; broadphase/NAME.cu), its pairs
+//     radix-sorted by (a, b) as on the CPU; uniform_grid is the step's own hashed grid (cell key per
+//     body, CUB radix sort, 3 x 3 search, each body's partners j > i sorted, counts -> scan -> write)
 //   3 narrowphase (box prefilter, computeContact), compacted in order by a scan; onset by binary
 //     search in the previous step's sorted contact id pairs
 //   4 pair events, solo events (the same evaluator structs as the CPU, templated kernels)
@@ -47,6 +48,8 @@ class CudaSimulation final : public Stepper {
   std::string device() const override { return m_deviceName; }
   std::string backend() const override { return "cuda"; }
   int candidateCount() const { return m_candidateCount; }
+  // Rebuilds of the device broadphase's kept list (0 for one that keeps none): reads the device.
+  long broadphaseRebuilds() const;
 
  private:
   void upload();          // host world -> device (all arrays), after set-up, breaks and re-sorts

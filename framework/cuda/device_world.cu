@@ -122,6 +122,7 @@ struct DeviceState {
   DeviceBuffer<Vec2> local;
   DeviceBuffer<Real> x, y, angle, vx, vy, omega, area, thickness, mass, invMass, invInertia, gyration2, gyrationX2,
       gyrationY2, principalAngle;
+  DeviceBuffer<Real> radius;  // bounding radius: what a device broadphase tests (MODEL.md 9)
   DeviceBuffer<unsigned char> isLarge;
   DeviceBuffer<int> large;
   int largeCount = 0;
@@ -142,6 +143,11 @@ struct DeviceState {
   DeviceBuffer<unsigned> cellKey, cellKeySorted;
   DeviceBuffer<int> slot, slotSorted, cellStart, cellEnd;
   DeviceBuffer<int> partnerCount, partnerOffset;
+  // A device broadphase (nullptr: the grid above): its pairs as keys, sorted into candA/candB.
+  std::unique_ptr<CudaBroadphase> broadphase;
+  DeviceBuffer<unsigned long long> candKey, candKeySorted;
+  DeviceBuffer<int> candCount;
+  int slotBits = 1;
   // Candidates and contacts.
   DeviceBuffer<int> candA, candB, flag, flagOffset;
   DeviceBuffer<Contact> candContact;
@@ -387,10 +393,29 @@ __global__ void largeRowWriteKernel(GridView g, const int* offset, int* candA, i
   }
 }
 
+// A device broadphase's pairs (device_broadphase.hpp) come as keys in any order. The sort has a
+// fixed length (captured in the graph), so the entries past this step's count get a key larger
+// than any pair's and sort last.
+__global__ void padCandidateKeysKernel(int capacity, const int* count, unsigned long long* keys, unsigned long long padKey) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k < capacity && k >= *count) keys[k] = padKey;
+}
+
+// Sorted keys back to (a, b), the grid's layout, in the CPU's order.
+__global__ void unpackCandidatesKernel(int capacity, const int* count, const unsigned long long* sorted, int slotBits, int* candA,
+                                       int* candB) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= capacity || k >= *count) return;
+  const unsigned long long key = sorted[k];
+  candA[k] = static_cast<int>(key >> slotBits);
+  candB[k] = static_cast<int>(key & ((1ull << slotBits) - 1));
+}
+
 // Over the capacity + 1 entries: candidates past this step's count get flag 0, so the scan of a
 // fixed length (captured in the graph) counts exactly this step's contacts.
 __global__ void narrowphaseKernel(int capacity, const int* needed, const int* candA, const int* candB, const Vec2* worldVertices,
-                                  const int* vertexCount, const Real* x, const Real* y, Contact* out, int* flag, StepStats* stats) {
+                                  const int* vertexCount, const Real* x, const Real* y, const Box* boxes, const Real* invMass,
+                                  Contact* out, int* flag, StepStats* stats) {
   const int p = blockIdx.x * blockDim.x + threadIdx.x;
   if (p > capacity) return;
   const int total = *needed, count = total < capacity ? total : capacity;
@@ -404,6 +429,12 @@ __global__ void narrowphaseKernel(int capacity, const int* needed, const int* ca
     return;
   }
   const int a = candA[p], b = candB[p];
+  // Simulation::narrowphase's prefilter: a device broadphase may propose more than the grid's
+  // accept() lets through; dropping the same pairs here keeps the contacts bit-identical.
+  if ((invMass[a] == 0 && invMass[b] == 0) || !boxesOverlap(boxes[a], boxes[b])) {
+    flag[p] = 0;
+    return;
+  }
   const Contact c = computeContact(worldVertices + static_cast<size_t>(a) * kMaxVertices, vertexCount[a], Vec2{x[a], y[a]},
                                    worldVertices + static_cast<size_t>(b) * kMaxVertices, vertexCount[b], Vec2{x[b], y[b]});
   out[p] = c;
@@ -608,6 +639,11 @@ DeviceWorld::~DeviceWorld() = default;
 void DeviceWorld::addPairEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->pairEvents.push_back(std::move(driver)); }
 void DeviceWorld::addSoloEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->soloEvents.push_back(std::move(driver)); }
 void DeviceWorld::addMotionEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->motionEvents.push_back(std::move(driver)); }
+void DeviceWorld::setBroadphase(std::unique_ptr<CudaBroadphase> broadphase) {
+  m_state->dropGraph();
+  m_state->broadphase = std::move(broadphase);
+}
+const CudaBroadphase* DeviceWorld::broadphase() const { return m_state->broadphase.get(); }
 
 void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
   DeviceState& d = *m_state;
@@ -631,6 +667,9 @@ void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
   d.invMass.upload(w.invMass.data(), n), d.invInertia.upload(w.invInertia.data(), n);
   d.gyration2.upload(w.gyration2.data(), n), d.gyrationX2.upload(w.gyrationX2.data(), n);
   d.gyrationY2.upload(w.gyrationY2.data(), n), d.principalAngle.upload(w.principalAngle.data(), n);
+  d.radius.upload(w.radius.data(), n);
+  d.slotBits = bitsFor(static_cast<unsigned long long>(n));
+  if (d.broadphase) d.broadphase->upload(w);
 
   // dof as Simulation's dofOf. The grid cell is the largest floe diameter, so a floe's box spans at
   // most one cell; bodies larger than that (walls, the vessel) are "large" and tested against all.
@@ -681,7 +720,8 @@ void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
     const char* start = std::getenv("GEM_CUDA_CAPACITY");
     d.capacity = start ? std::max(1, std::atoi(start)) : 4 * n + 256;
   }
-  if (baked() != before) d.dropGraph();
+  // A strategy's own storage (device_broadphase.hpp) may move in its upload(): always re-capture then.
+  if (baked() != before || d.broadphase) d.dropGraph();
 }
 
 namespace {
@@ -767,7 +807,7 @@ std::vector<int> DeviceWorld::reorderAlongCurve() {
   permuteOnDevice(d.id, n, 1, o, scratch, s), permuteOnDevice(d.kind, n, 1, o, scratch, s);
   permuteOnDevice(d.vertexCount, n, 1, o, scratch, s), permuteOnDevice(d.dof, n, 1, o, scratch, s);
   permuteOnDevice(d.local, n, kMaxVertices, o, scratch, s), permuteOnDevice(d.isLarge, n, 1, o, scratch, s);
-  for (DeviceBuffer<Real>* r : {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.area, &d.thickness, &d.mass, &d.invMass,
+  for (DeviceBuffer<Real>* r : {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.radius, &d.area, &d.thickness, &d.mass, &d.invMass,
                                 &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle})
     permuteOnDevice(*r, n, 1, o, scratch, s);
   sortedSlots.download(order.data(), static_cast<size_t>(n));
@@ -818,6 +858,11 @@ struct CubCalls {
     size_t need = sizing ? 0 : bytes;
     check(cub::DeviceScan::ExclusiveSum(temp, need, d.partnerCount.get(), d.partnerOffset.get(), n + 1, d.stream), need, "cub ExclusiveSum (partners)");
   }
+  void sortCandidates(int capacity, int bits) {
+    size_t need = sizing ? 0 : bytes;
+    check(cub::DeviceRadixSort::SortKeys(temp, need, d.candKey.get(), d.candKeySorted.get(), capacity, 0, bits, d.stream), need,
+          "cub SortKeys (device broadphase pairs)");
+  }
   void scanFlags(int capacity) {
     size_t need = sizing ? 0 : bytes;
     check(cub::DeviceScan::ExclusiveSum(temp, need, d.flag.get(), d.flagOffset.get(), capacity + 1, d.stream), need, "cub ExclusiveSum (flags)");
@@ -856,7 +901,25 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   prepareKernel<<<blocksFor(n, block), block, 0, s>>>(a);
   GEM_CUDA_CHECK_LAUNCH();
 
-  // 2. Broadphase: sort by cell, cell ranges, count, scan, write (rows sorted: pairs by (a, b)).
+  // 2. Broadphase. A device strategy (device_broadphase.hpp) emits keys in any order; they are
+  // sorted by (a, b) here, so the pairs come in the CPU's order whatever found them.
+  const int* candidatesNeeded = d.partnerOffset.get() + n;
+  if (d.broadphase) {
+    int* count = d.candCount.get();
+    GEM_CUDA_CHECK(cudaMemsetAsync(count, 0, sizeof(int), s));
+    const BroadphaseBodies bodies{n, d.x.get(), d.y.get(), d.angle.get(), d.radius.get(), d.boxes.get(), d.invMass.get(),
+                                  d.kind.get(), d.worldVertices.get(), d.vertexCount.get()};
+    d.broadphase->enqueue(bodies, CandidateSink{d.candKey.get(), capacity, count, d.slotBits}, s);
+    padCandidateKeysKernel<<<blocksFor(capacity), kBlock, 0, s>>>(capacity, count, d.candKey.get(), (1ull << (2 * d.slotBits)) - 1);
+    GEM_CUDA_CHECK_LAUNCH();
+    cubCalls.sortCandidates(capacity, 2 * d.slotBits);
+    unpackCandidatesKernel<<<blocksFor(capacity), kBlock, 0, s>>>(capacity, count, d.candKeySorted.get(), d.slotBits, d.candA.get(),
+                                                                  d.candB.get());
+    GEM_CUDA_CHECK_LAUNCH();
+    candidatesNeeded = count;
+  } else {
+  // The built-in grid, uniform_grid (left at its old indentation to keep the diff small): sort by
+  // cell, cell ranges, count, scan, write (rows sorted: pairs by (a, b), no sort of the pairs).
   cubCalls.cellSort(n, bitsFor(largeKey));
   GEM_CUDA_CHECK(cudaMemsetAsync(d.cellStart.get(), 0xff, d.tableSize * sizeof(int), s));
   cellRangeKernel<<<blocksFor(n, block), block, 0, s>>>(d.cellKeySorted.get(), n, largeKey, d.cellStart.get(), d.cellEnd.get());
@@ -876,14 +939,15 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
     largeRowWriteKernel<<<d.largeCount, kLargeBlock, 0, s>>>(g, d.partnerOffset.get(), d.candA.get(), d.candB.get());
     GEM_CUDA_CHECK_LAUNCH();
   }
+  }
 
   // 3. Narrowphase, compaction in order (with padding), onset, the two sorts.
   // computeContact is a long serial chain per pair with a 2.3 KB local-memory frame: while the
   // pairs are few, blocks of one warp spread them over every multiprocessor's L1.
   const int narrowBlock = capacity + 1 < 64 * 1024 ? 32 : block;
-  narrowphaseKernel<<<(capacity + narrowBlock) / narrowBlock, narrowBlock, 0, s>>>(capacity, d.partnerOffset.get() + n, d.candA.get(), d.candB.get(),
+  narrowphaseKernel<<<(capacity + narrowBlock) / narrowBlock, narrowBlock, 0, s>>>(capacity, candidatesNeeded, d.candA.get(), d.candB.get(),
                                                                 d.worldVertices.get(), d.vertexCount.get(), d.x.get(), d.y.get(),
-                                                                d.candContact.get(), d.flag.get(), stats);
+                                                                d.boxes.get(), d.invMass.get(), d.candContact.get(), d.flag.get(), stats);
   GEM_CUDA_CHECK_LAUNCH();
   cubCalls.scanFlags(capacity);
   const unsigned long long padKey = d.idBits >= 32 ? ~0ull : (1ull << (2 * d.idBits)) - 1;
@@ -944,6 +1008,11 @@ void prepareBuffers(DeviceState& d) {
   sizing.scanFlags(d.capacity);
   sizing.sortKeys(d.capacity, std::min(64, 2 * d.idBits));
   sizing.sortB(d.capacity, bitsFor(static_cast<unsigned long long>(d.n)));
+  if (d.broadphase) {
+    d.candKey.ensure(cap), d.candKeySorted.ensure(cap), d.candCount.ensure(1);
+    d.broadphase->reserve(d.stream);
+    sizing.sortCandidates(d.capacity, 2 * d.slotBits);
+  }
   d.temp.ensure(bytes);
   d.tempBytes = bytes;
 }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "framework/cuda/cuda_events.hpp"
+#include "framework/cuda/device_broadphase.hpp"
 #include "framework/world.hpp"
 
 namespace gem::cuda {
@@ -43,6 +44,9 @@ class DeviceWorld {
   void addPairEvent(std::unique_ptr<CudaEventDriver> driver);
   void addSoloEvent(std::unique_ptr<CudaEventDriver> driver);
   void addMotionEvent(std::unique_ptr<CudaEventDriver> driver);
+  // Phase 2's strategy (device_broadphase.hpp); nullptr (the default) is the step's own hashed grid.
+  void setBroadphase(std::unique_ptr<CudaBroadphase> broadphase);
+  const CudaBroadphase* broadphase() const;
 
   // The whole host world to the device (set-up, after breaks and re-sorts).
   void upload(const World& world, int vesselDof, int vesselSlot);

@@ -1,0 +1,152 @@
+// The kept list's check and build kernels and its storage (device_neighbour_list.cuh says what each
+// step does and why).
+#include "broadphase/device_neighbour_list.cuh"
+
+#include <cub/device/device_radix_sort.cuh>
+
+#include <algorithm>
+#include <cmath>
+
+namespace gem::cuda {
+
+// 1. NeighbourList::update on the device: a listed body past half the skin becomes direct; past
+// the room for direct bodies, or when the list is stale, the step rebuilds.
+__global__ void listCheckKernel(ListView list, BroadphaseBodies b) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= b.n) return;
+  if (!list.control->valid) {
+    if (i == 0) list.control->rebuild = 1;
+    return;
+  }
+  if (list.direct[i]) return;  // its pairs are found afresh every step
+  const Real dx = b.x[i] - list.x0[i], dy = b.y[i] - list.y0[i];
+  // A point at distance R from the centroid moves at most R |turn| under a turn (the turn wrapped
+  // to [-pi, pi], as in NeighbourList::update).
+  Real turn = fabs(b.angle[i] - list.angle0[i]);
+  if (turn > kPi) turn = fabs(remainder(turn, Real(2) * kPi));
+  if (sqrt(dx * dx + dy * dy) + b.radius[i] * turn <= list.limit) return;
+  const int k = atomicAdd(&list.control->directCount, 1);
+  if (k < list.directRoom) {
+    list.directList[k] = i;
+    list.direct[i] = 1;
+  } else {
+    list.control->rebuild = 1;
+  }
+}
+
+// 2. The sweep's order: the low end of each body's x span.
+__global__ void listSpanKernel(ListView list, BroadphaseBodies b) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= b.n) return;
+  list.lo[i] = b.x[i] - max(list.floor / 2, list.half[i]);
+  list.slot[i] = i;
+}
+
+// 3a. A rebuild's reference state, as NeighbourList::finish.
+__global__ void listResetKernel(ListView list, BroadphaseBodies b) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= b.n || !list.control->rebuild) return;
+  list.x0[i] = b.x[i];
+  list.y0[i] = b.y[i];
+  list.angle0[i] = b.angle[i];
+  list.direct[i] = list.alwaysDirect[i];
+  if (i == 0) {
+    list.control->count = 0;
+    list.control->directCount = list.alwaysDirectCount;
+    list.control->valid = 1;
+    ++list.control->rebuilds;
+  }
+}
+
+// 3b. SweepAndPrune::build's rule: |c_a - c_b| <= max(floor, h_a + h_b), found by walking forward
+// from each body while the next span starts before this one ends. The always-direct bodies are
+// left out (the direct pass covers them); each pair keeps (R_a + R_b)^2 for the filter.
+__global__ void listSweepKernel(ListView list, BroadphaseBodies b) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= b.n || !list.control->rebuild) return;
+  const int i = list.slotSorted[k];
+  if (list.alwaysDirect[i]) return;
+  const Real hi = b.x[i] + max(list.floor / 2, list.half[i]), xi = b.x[i], yi = b.y[i], hin = list.half[i], ri = b.radius[i];
+  for (int q = k + 1; q < b.n && list.loSorted[q] <= hi; ++q) {
+    const int j = list.slotSorted[q];
+    if (list.alwaysDirect[j]) continue;
+    const Real dx = xi - b.x[j], dy = yi - b.y[j], reach = max(list.floor, hin + list.half[j]);
+    if (dx * dx + dy * dy > reach * reach) continue;
+    const int at = atomicAdd(&list.control->count, 1);
+    if (at >= list.capacity) continue;  // counted: the filter asks for a redo with more room
+    const Real touch = ri + b.radius[j];
+    list.pairs[at] = ListedPair{i < j ? i : j, i < j ? j : i, touch * touch};
+  }
+}
+
+void enqueueListBuild(const ListView& list, const BroadphaseBodies& bodies, void* temp, size_t tempBytes, cudaStream_t s) {
+  const int n = bodies.n;
+  GEM_CUDA_CHECK(cudaMemsetAsync(&list.control->rebuild, 0, sizeof(int), s));
+  listCheckKernel<<<blocksFor(n), kBlock, 0, s>>>(list, bodies);
+  GEM_CUDA_CHECK_LAUNCH();
+  listSpanKernel<<<blocksFor(n), kBlock, 0, s>>>(list, bodies);
+  GEM_CUDA_CHECK_LAUNCH();
+  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp, tempBytes, list.lo, list.loSorted, list.slot, list.slotSorted, n, 0,
+                                                 static_cast<int>(sizeof(Real) * 8), s));
+  listResetKernel<<<blocksFor(n), kBlock, 0, s>>>(list, bodies);
+  GEM_CUDA_CHECK_LAUNCH();
+  listSweepKernel<<<blocksFor(n), kBlock, 0, s>>>(list, bodies);
+  GEM_CUDA_CHECK_LAUNCH();
+}
+
+void DeviceNeighbourList::upload(const World& world, const std::vector<Real>& half, Real floor) {
+  const int n = world.size();
+  m_n = n;
+  m_floor = floor;
+  const size_t nn = static_cast<size_t>(std::max(n, 1));
+  std::vector<unsigned char> always(nn, 0);
+  std::vector<int> alwaysList;
+  for (int i = 0; i < n; ++i)
+    if (world.kind[i] != BodyKind::Floe) always[i] = 1, alwaysList.push_back(i);
+  m_alwaysDirectCount = static_cast<int>(alwaysList.size());
+  m_half.upload(half.data(), half.size());
+  m_alwaysDirect.upload(always.data(), nn);
+  m_directList.ensure(static_cast<size_t>(m_alwaysDirectCount + NeighbourList::kMaxDirect));
+  if (!alwaysList.empty())
+    GEM_CUDA_CHECK(cudaMemcpy(m_directList.get(), alwaysList.data(), alwaysList.size() * sizeof(int), cudaMemcpyHostToDevice));
+  m_direct.ensure(nn), m_x0.ensure(nn), m_y0.ensure(nn), m_angle0.ensure(nn);
+  m_lo.ensure(nn), m_loSorted.ensure(nn), m_slot.ensure(nn), m_slotSorted.ensure(nn);
+  if (m_capacity == 0) m_capacity = 8 * n + 1024;  // grows in reserve() when a build needs more
+  m_pairs.ensure(static_cast<size_t>(m_capacity));
+  size_t bytes = 0;
+  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, m_lo.get(), m_loSorted.get(), m_slot.get(), m_slotSorted.get(),
+                                                 n, 0, static_cast<int>(sizeof(Real) * 8)));
+  m_temp.ensure(std::max<size_t>(bytes, 1));
+  m_tempBytes = bytes;
+  if (m_control.ensure(1)) GEM_CUDA_CHECK(cudaMemset(m_control.get(), 0, sizeof(ListControl)));
+  markStale();  // slots may name other bodies now (NeighbourList::invalidate)
+}
+
+void DeviceNeighbourList::markStale() { GEM_CUDA_CHECK(cudaMemset(&m_control.get()->valid, 0, sizeof(int))); }
+
+// Outside the graph (before a capture): a build that found the list too small asked for a redo
+// (listFilterKernel); make room for what it counted.
+void DeviceNeighbourList::reserve() {
+  if (!m_control.get()) return;
+  ListControl control{};
+  GEM_CUDA_CHECK(cudaMemcpy(&control, m_control.get(), sizeof(ListControl), cudaMemcpyDeviceToHost));
+  if (control.count <= m_capacity) return;
+  m_capacity = control.count + control.count / 2 + 1024;
+  m_pairs.ensure(static_cast<size_t>(m_capacity));
+  markStale();
+}
+
+long DeviceNeighbourList::rebuilds() const {
+  if (!m_control.get()) return 0;
+  ListControl control{};
+  GEM_CUDA_CHECK(cudaMemcpy(&control, m_control.get(), sizeof(ListControl), cudaMemcpyDeviceToHost));
+  return static_cast<long>(control.rebuilds);
+}
+
+ListView DeviceNeighbourList::view() {
+  return ListView{m_control.get(), m_half.get(), m_floor, kRebuildTrigger * m_skin / 2, m_alwaysDirect.get(), m_direct.get(),
+                  m_directList.get(), m_alwaysDirectCount + NeighbourList::kMaxDirect, m_alwaysDirectCount, m_x0.get(), m_y0.get(),
+                  m_angle0.get(), m_pairs.get(), m_capacity, m_lo.get(), m_loSorted.get(), m_slot.get(), m_slotSorted.get()};
+}
+
+}  // namespace gem::cuda

@@ -1,0 +1,88 @@
+// triangulation_mesh on the device. What runs where:
+//   host, at each upload (set-up, breaks, re-sorts): every polygon is ear-clipped in its body frame
+//     (geometry/triangulate.hpp, the CPU's very function) and the index triples are copied over;
+//   device, every step: the variable_radius kept list of device_neighbour_list.cuh (same skin, same
+//     rebuild rule, as triangulation_mesh.cpp), and on each pair whose circles overlap the
+//     triangle test of triangulation_mesh.cpp: boxes within eps, then any triangle of one whose box
+//     meets the other's box overlapping any such triangle of the other (trianglesOverlap, GEM_HD),
+//     the world vertices being the step's own (phase 1).
+// The eps is the CPU's: conservative within kEpsRel x (size + distance from the origin).
+#include "broadphase/device_neighbour_list.cuh"
+#include "framework/registry.hpp"
+#include "geometry/triangulate.hpp"
+
+namespace gem::cuda {
+namespace {
+
+constexpr int kMaxTriangles = kMaxVertices - 2;
+#if defined(GEM_REAL_FLOAT)
+constexpr Real kEpsRel = Real(1e-5);
+#else
+constexpr Real kEpsRel = Real(1e-9);
+#endif
+
+__device__ inline bool boxesMeet(const Box& p, const Box& q, Real eps) {
+  return p.x0 <= q.x1 + eps && q.x0 <= p.x1 + eps && p.y0 <= q.y1 + eps && q.y0 <= p.y1 + eps;
+}
+
+struct TrianglesOverlap {
+  const int* triangleCount;  // per body
+  const int* triangles;      // kMaxTriangles x 3 vertex indices per body
+
+#if defined(__CUDACC__)
+  __device__ void place(const BroadphaseBodies& b, int body, int t, Vec2 out[3]) const {
+    const int* k = triangles + (static_cast<size_t>(body) * kMaxTriangles + t) * 3;
+    const Vec2* v = b.worldVertices + static_cast<size_t>(body) * kMaxVertices;
+    out[0] = v[k[0]], out[1] = v[k[1]], out[2] = v[k[2]];
+  }
+  __device__ bool operator()(const BroadphaseBodies& b, int i, int j) const {
+    const int p = i < j ? i : j, q = i < j ? j : i;  // the CPU's eps is taken at the pair's a
+    const Real eps = kEpsRel * (b.radius[p] + b.radius[q] + fabs(b.x[p]) + fabs(b.y[p]));
+    if (!boxesMeet(b.boxes[p], b.boxes[q], eps)) return false;
+    for (int s = 0; s < triangleCount[p]; ++s) {
+      Vec2 tp[3];
+      place(b, p, s, tp);
+      if (!boxesMeet(boundingBox(tp, 3), b.boxes[q], eps)) continue;
+      for (int t = 0; t < triangleCount[q]; ++t) {
+        Vec2 tq[3];
+        place(b, q, t, tq);
+        if (!boxesMeet(boundingBox(tq, 3), b.boxes[p], eps)) continue;
+        if (trianglesOverlap(tp, tq, eps)) return true;
+      }
+    }
+    return false;
+  }
+#endif
+};
+
+class DeviceTriangulationMesh final : public CudaBroadphase {
+ public:
+  explicit DeviceTriangulationMesh(const BroadphaseSettings& s) : m_list(checkedSettings(s).skin) {}
+  void upload(const World& world) override {
+    const int n = world.size();
+    std::vector<Real> half(world.radius.begin(), world.radius.end());
+    for (Real& h : half) h += m_list.skin() / 2;
+    m_list.upload(world, half, 0);
+    std::vector<int> count(static_cast<size_t>(std::max(n, 1)), 0);
+    std::vector<int> triangles(static_cast<size_t>(std::max(n, 1)) * kMaxTriangles * 3, 0);
+    for (int i = 0; i < n; ++i)
+      count[i] = earClip(world.local(i), world.vertexCount[i], reinterpret_cast<int(*)[3]>(&triangles[static_cast<size_t>(i) * kMaxTriangles * 3]));
+    m_count.upload(count.data(), count.size());
+    m_triangles.upload(triangles.data(), triangles.size());
+  }
+  void reserve(cudaStream_t) override { m_list.reserve(); }
+  void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
+    m_list.enqueue(bodies, sink, stream, TrianglesOverlap{m_count.get(), m_triangles.get()});
+  }
+  long rebuilds() const override { return m_list.rebuilds(); }
+
+ private:
+  DeviceNeighbourList m_list;
+  DeviceArray<int> m_count, m_triangles;
+};
+
+}  // namespace
+
+GEM_REGISTER_CUDA_BROADPHASE(DeviceTriangulationMesh, "triangulation_mesh");
+
+}  // namespace gem::cuda

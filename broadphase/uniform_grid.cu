@@ -1,0 +1,12 @@
+// uniform_grid on the device is the step's own hashed grid (framework/cuda/device_world.cu, phase
+// 2): a loose grid rebuilt every step from the boxes, each body's partners written already sorted
+// by (a, b), so it needs no kept list and no sort of its pairs. Its entry here is a factory that
+// returns no strategy object, which DeviceWorld reads as "use the built-in grid".
+#include "framework/cuda/device_broadphase.hpp"
+
+namespace gem::cuda {
+
+static const RegisterCudaBroadphase kUniformGrid{
+    "uniform_grid", [](const BroadphaseSettings&) -> std::unique_ptr<CudaBroadphase> { return nullptr; }};
+
+}  // namespace gem::cuda
