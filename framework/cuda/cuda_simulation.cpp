@@ -101,6 +101,7 @@ void CudaSimulation::upload() {
   for (int i = 0; i < w.size(); ++i)
     if (w.id[i] == m_vesselId) m_vesselSlot = i;
   m_device->upload(w, scenario().vessel.dof, m_vesselSlot);
+  m_slotOfId.clear();
   m_hostCurrent = true;
 }
 
@@ -165,21 +166,21 @@ void CudaSimulation::step() {
   m_breaks.assign(batch.breaks.begin() + before.breakEnd, batch.breaks.begin() + r.breakEnd);
   m_logs.assign(batch.logs.begin() + before.logEnd, batch.logs.begin() + r.logEnd);
   if (m_impacts.size() > 1 || m_breaks.size() > 1 || !m_logs.empty()) {
-    const World& w = world();
-    std::unordered_map<std::int64_t, int> slotOf;
-    for (const auto& x : m_impacts) slotOf[x.floeId] = 0;
-    for (const auto& x : m_breaks) slotOf[x.floeId] = 0;
-    for (const auto& x : m_logs) slotOf[x.idA] = 0, slotOf[x.idB] = 0;
-    for (int i = 0; i < w.size(); ++i) {
-      const int body = m_pendingOrder.empty() ? i : m_pendingOrder[static_cast<size_t>(i)];
-      if (auto it = slotOf.find(w.id[body]); it != slotOf.end()) it->second = i;
+    // Slots of the ids, built once per world order (not per step: at 10^6 floes a pass over every
+    // body for each step with impacts was most of a step).
+    if (m_slotOfId.empty()) {
+      const World& w = world();
+      m_slotOfId.reserve(static_cast<size_t>(w.size()));
+      for (int i = 0; i < w.size(); ++i)
+        m_slotOfId[w.id[m_pendingOrder.empty() ? i : m_pendingOrder[static_cast<size_t>(i)]]] = i;
     }
+    auto slotOf = [this](std::int64_t id) { return m_slotOfId.at(id); };
     std::stable_sort(m_impacts.begin(), m_impacts.end(),
-                     [&](const ImpactRecord& a, const ImpactRecord& b) { return slotOf[a.floeId] < slotOf[b.floeId]; });
+                     [&](const ImpactRecord& a, const ImpactRecord& b) { return slotOf(a.floeId) < slotOf(b.floeId); });
     std::stable_sort(m_breaks.begin(), m_breaks.end(),
-                     [&](const BreakRequest& a, const BreakRequest& b) { return slotOf[a.floeId] < slotOf[b.floeId]; });
+                     [&](const BreakRequest& a, const BreakRequest& b) { return slotOf(a.floeId) < slotOf(b.floeId); });
     auto pairOf = [&](const LogRecord& x) {
-      const int a = slotOf[x.idA], b = slotOf[x.idB];
+      const int a = slotOf(x.idA), b = slotOf(x.idB);
       return std::pair<int, int>{std::min(a, b), std::max(a, b)};
     };
     std::stable_sort(m_logs.begin(), m_logs.end(), [&](const LogRecord& a, const LogRecord& b) { return pairOf(a) < pairOf(b); });
@@ -213,6 +214,7 @@ void CudaSimulation::step() {
     // follows lazily. At 10^6 floes a round trip through the host (download, sort, permute, upload,
     // re-capture) cost more than the 200 steps it serves.
     const std::vector<int> order = m_device->reorderAlongCurve();
+    m_slotOfId.clear();
     if (m_pendingOrder.empty()) {
       m_pendingOrder = order;
     } else {

@@ -17,6 +17,7 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "framework/stepper.hpp"
@@ -65,6 +66,7 @@ class CudaSimulation final : public Stepper {
   // Re-sorts on the device leave the host mirror in the old slot order: device slot k holds the
   // mirror's body m_pendingOrder[k]. Applied (World::permute) when the host next needs its world.
   std::vector<int> m_pendingOrder;
+  std::unordered_map<std::int64_t, int> m_slotOfId;  // device slot of each body id, for ordering records
   std::unique_ptr<cuda::DeviceWorld> m_device;
   std::unique_ptr<cuda::DeviceBatchResult> m_batch;
   size_t m_batchNext = 0;  // the batch's next step to hand out
