@@ -39,8 +39,9 @@ frame_every = 0
   const int status = std::system(command.c_str());
   const std::string text = gem::test::readFile(log);
   ASSERT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0) << text;
-  EXPECT_NE(text.find("rank 0 ["), std::string::npos) << text;
-  EXPECT_NE(text.find("rank 1 ["), std::string::npos) << text;  // both ranks ran cases
+  // A worker rank ran cases (they were handed out). Whether rank 0 also ran one depends on timing:
+  // these cases take milliseconds, and on a loaded 2-core machine rank 1 can take all six.
+  EXPECT_NE(text.find("rank 1 ["), std::string::npos) << text;
   const std::string csv = gem::test::readFile(dir.path() / "out" / "summary.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7) << csv;  // header + every case once
   for (const char* name : {"bollard_thrust=23000", "bollard_thrust=740000"})
