@@ -48,7 +48,10 @@ struct MotionPhaseData {
   StepContext ctx;
 };
 
-// Topology events run on the host after motion (MODEL.md 8, phase 6).
+// Topology events run on the host after motion (MODEL.md 8, phase 6). The contract, which lets the
+// CUDA backend keep its world on the device: an event reads the state of the bodies its requests
+// name (breaks[k].floeId) and only theirs (the CUDA backend fetches just those rows), and changes
+// the bodies only through World::removeBodies and World::addBody (the device then replays the edit).
 struct TopologyData {
   struct World* world;
   const BreakRequest* breaks;

@@ -5,8 +5,8 @@
 # script. On the GPU machine:  bash .gpu-stage/run.sh [OUT]   (OUT defaults to $OUT, else ./gpu-out)
 # It runs `gem info`, the CUDA tests (a plugin's event on the device among them), compute-sanitizer
 # on them, the timings and a cuda run of scenarios/thesis/random_50.toml, with every log under OUT.
-# GEM_SKIP_SANITIZER=1 skips the sanitizer; GEM_PROFILE=1 adds an nsys kernel summary of the
-# 824-floe timing (where nsys exists).
+# GEM_SKIP_SANITIZER=1 skips the sanitizer; GEM_BENCH_TABLE=NAME runs that bench table only and
+# stops there; GEM_PROFILE=1 adds an nsys kernel summary of the 824-floe timing (where nsys exists).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${GEM_STAGE_BUILD:-$root/build-cuda}"
@@ -56,15 +56,22 @@ echo "== CUDA tests"
 ./gem_cuda_tests --gtest_color=no 2>&1 | tee "$out/cuda-tests.txt" | grep -E "^\[ +(OK|FAILED|SKIPPED|PASSED) |busy channel|CUDA device|Failure|Expected|Which|error" || true
 [ "${PIPESTATUS[0]}" = 0 ] || status=1
 if [ "${GEM_SKIP_SANITIZER:-0}" != 1 ]; then
-  echo "== compute-sanitizer (memcheck) on the CUDA tests (fast ones)"
+  echo "== compute-sanitizer (memcheck) on the CUDA tests (fast ones), with the step graph and without"
   sanitizer="$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)"
-  # GEM_CUDA_GRAPH=0: the same kernels launched one by one (memcheck reports an unattributed illegal
-  # address with the WHILE-node graph that a plain run, and a minimal WHILE graph, do not show).
-  export GEM_CUDA_GRAPH=0
-  "$sanitizer" --tool memcheck --error-exitcode 9 ./gem_cuda_tests --gtest_color=no \
-    --gtest_filter='CudaBackend.TwoFloes*:CudaBackend.BusyChannelMatchesTheCpuAfter50Steps:CudaBackend.CandidateOverflow*:CudaPlugin.Rafting*:CudaBroadphase.Candidate*' > "$out/sanitizer.txt" 2>&1
-  unset GEM_CUDA_GRAPH
-  rc=$?; tail -3 "$out/sanitizer.txt"; echo "compute-sanitizer exit $rc"; [ $rc = 0 ] || status=1
+  # GEM_CUDA_GRAPH=0: the same kernels launched one by one, a sync per step.
+  for graph in 1 0; do
+    GEM_CUDA_GRAPH=$graph "$sanitizer" --tool memcheck --error-exitcode 9 --show-backtrace yes ./gem_cuda_tests --gtest_color=no \
+      --gtest_filter='CudaBackend.TwoFloes*:CudaBackend.BusyChannelMatchesTheCpuAfter50Steps:CudaBackend.CandidateOverflow*:CudaPlugin.Rafting*:CudaBroadphase.Candidate*' > "$out/sanitizer-graph$graph.txt" 2>&1
+    rc=$?
+    tail -3 "$out/sanitizer-graph$graph.txt"; echo "compute-sanitizer (GEM_CUDA_GRAPH=$graph) exit $rc"; [ $rc = 0 ] || status=1
+  done
+fi
+if [ -n "${GEM_BENCH_TABLE:-}" ]; then
+  echo "== gem bench --table $GEM_BENCH_TABLE"
+  mkdir -p "$out/bench"
+  ./gem bench --table "$GEM_BENCH_TABLE" --csv "$out/bench" 2>&1 | tee "$out/bench.txt"
+  [ "${PIPESTATUS[0]}" = 0 ] || status=1
+  exit $status
 fi
 echo "== timings (gem bench --table all: the thesis's Chapter 5 tables, one CSV per table under bench/)"
 mkdir -p "$out/bench"

@@ -1,5 +1,5 @@
 // The CUDA backend's host side: set-up from the scenario (through the CPU Simulation, which parses
-// and checks every event), record ordering, the host topology phase and the periodic re-sort.
+// and checks every event), record ordering, the topology phase and the periodic re-sort.
 #include "framework/cuda/cuda_simulation.hpp"
 
 #include <cuda_runtime.h>
@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include <unordered_map>
 
 #include "framework/cuda/device_world.hpp"
 #include "framework/log_channel.hpp"
@@ -105,6 +104,95 @@ void CudaSimulation::upload() {
   m_hostCurrent = true;
 }
 
+int CudaSimulation::mirrorSlot(int deviceSlot) const {
+  return m_pendingOrder.empty() ? deviceSlot : m_pendingOrder[static_cast<size_t>(deviceSlot)];
+}
+
+// Device slot by body id (ids are dense: never reused, a few new ones per break): one pass over
+// the mirror's ids per world order, not per step (at 10^6 floes a pass per step was most of a step).
+const std::vector<int>& CudaSimulation::slotOfId() {
+  if (m_slotOfId.empty()) {
+    const World& w = world();
+    m_slotOfId.assign(static_cast<size_t>(w.nextId), -1);
+    for (int k = 0; k < w.size(); ++k) m_slotOfId[static_cast<size_t>(w.id[static_cast<size_t>(mirrorSlot(k))])] = k;
+  }
+  return m_slotOfId;
+}
+
+// 6. Topology (flexural breaking), in a step that asked for it. The events run on the host mirror,
+// whose structure (shapes, mass properties) is always current; only the kinematics of the bodies
+// the requests name are fetched. What they removed and appended is then replayed on the device
+// (DeviceWorld::editBodies): the world's arrays never cross the bus, only the few new bodies do.
+void CudaSimulation::runTopology() {
+  World& w = world();
+  const std::vector<int>& slotOf = slotOfId();
+  std::vector<int> deviceSlots, hostSlots;
+  for (const BreakRequest& b : m_breaks) {
+    const int k = b.floeId < static_cast<std::int64_t>(slotOf.size()) ? slotOf[static_cast<size_t>(b.floeId)] : -1;
+    if (k < 0 || std::find(deviceSlots.begin(), deviceSlots.end(), k) != deviceSlots.end()) continue;
+    deviceSlots.push_back(k);
+    hostSlots.push_back(mirrorSlot(k));
+  }
+  if (m_topologyThroughHost) {
+    downloadState();  // the reference path (tests): the whole world round trips
+  } else {
+    m_device->downloadKinematics(deviceSlots, hostSlots, w);
+  }
+
+  const std::vector<std::int64_t> idsBefore = w.id;
+  const std::int64_t nextIdBefore = w.nextId;
+  TopologyData topology{&w, m_breaks.data(), static_cast<int>(m_breaks.size()), m_time};
+  for (const EnabledEvent& e : m_cpu->events())
+    if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
+  m_rubbleMass += topology.rubbleMass;
+  m_floesBroken += topology.floesBroken;
+  if (!topology.changed) return;
+  if (m_topologyThroughHost) {
+    upload();
+    return;
+  }
+
+  // What the events did, as World::removeBodies and World::addBody do it: the survivors keep their
+  // order, the new bodies (new ids) follow them.
+  int firstAdded = w.size();
+  while (firstAdded > 0 && w.id[static_cast<size_t>(firstAdded - 1)] >= nextIdBefore) --firstAdded;
+  std::vector<int> removedMirror, removedDevice;
+  int survivor = 0;
+  for (int i = 0; i < static_cast<int>(idsBefore.size()); ++i) {
+    if (survivor < firstAdded && w.id[static_cast<size_t>(survivor)] == idsBefore[static_cast<size_t>(i)]) {
+      ++survivor;
+    } else {
+      removedMirror.push_back(i);
+      removedDevice.push_back(slotOf[static_cast<size_t>(idsBefore[static_cast<size_t>(i)])]);
+    }
+  }
+  if (survivor != firstAdded)
+    throw std::logic_error("CUDA backend: a topology event reordered the bodies (only World::removeBodies and World::addBody may change them)");
+  std::sort(removedDevice.begin(), removedDevice.end());
+  m_device->editBodies(removedDevice, w, firstAdded, scenario().vessel.dof);
+
+  // The mirror's order after a device re-sort: device slot j (a survivor) held device slot
+  // keptDevice[j], i.e. mirror body pendingOrder[keptDevice[j]], which the removal moved down.
+  if (!m_pendingOrder.empty()) {
+    std::vector<int> composed;
+    composed.reserve(static_cast<size_t>(w.size()));
+    size_t r = 0;
+    for (int old = 0; old < static_cast<int>(m_pendingOrder.size()); ++old) {
+      if (r < removedDevice.size() && removedDevice[r] == old) {
+        ++r;
+        continue;
+      }
+      const int mirrorOld = m_pendingOrder[static_cast<size_t>(old)];
+      composed.push_back(mirrorOld - static_cast<int>(std::lower_bound(removedMirror.begin(), removedMirror.end(), mirrorOld) -
+                                                      removedMirror.begin()));
+    }
+    for (int k = firstAdded; k < w.size(); ++k) composed.push_back(k);
+    m_pendingOrder.swap(composed);
+  }
+  m_slotOfId.clear();
+  if (m_vesselSlot >= 0) m_vesselSlot = slotOfId()[static_cast<size_t>(m_vesselId)];
+}
+
 void CudaSimulation::downloadState() {
   if (m_hostCurrent) return;
   if (deviceAhead()) throw std::logic_error("CUDA backend: the world was asked for in the middle of a copy-back batch");
@@ -166,15 +254,8 @@ void CudaSimulation::step() {
   m_breaks.assign(batch.breaks.begin() + before.breakEnd, batch.breaks.begin() + r.breakEnd);
   m_logs.assign(batch.logs.begin() + before.logEnd, batch.logs.begin() + r.logEnd);
   if (m_impacts.size() > 1 || m_breaks.size() > 1 || !m_logs.empty()) {
-    // Slots of the ids, built once per world order (not per step: at 10^6 floes a pass over every
-    // body for each step with impacts was most of a step).
-    if (m_slotOfId.empty()) {
-      const World& w = world();
-      m_slotOfId.reserve(static_cast<size_t>(w.size()));
-      for (int i = 0; i < w.size(); ++i)
-        m_slotOfId[w.id[m_pendingOrder.empty() ? i : m_pendingOrder[static_cast<size_t>(i)]]] = i;
-    }
-    auto slotOf = [this](std::int64_t id) { return m_slotOfId.at(id); };
+    const std::vector<int>& slots = slotOfId();
+    auto slotOf = [&slots](std::int64_t id) { return slots.at(static_cast<size_t>(id)); };
     std::stable_sort(m_impacts.begin(), m_impacts.end(),
                      [&](const ImpactRecord& a, const ImpactRecord& b) { return slotOf(a.floeId) < slotOf(b.floeId); });
     std::stable_sort(m_breaks.begin(), m_breaks.end(),
@@ -189,17 +270,8 @@ void CudaSimulation::step() {
   m_vesselIceForce = (Real(1) / scenario().dt) * r.vesselImpulse;
   if (m_vesselSlot >= 0) m_vessel = VesselSample{true, r.vesselPosition, r.vesselAngle, r.vesselVelocity};
 
-  // 6. Topology on the host, only in a step that asked for a break (rare; the device stopped the
-  // batch there): the world goes back and forth.
-  if (!m_breaks.empty()) {
-    downloadState();
-    TopologyData topology{&world(), m_breaks.data(), static_cast<int>(m_breaks.size()), m_time};
-    for (const EnabledEvent& e : m_cpu->events())
-      if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
-    m_rubbleMass += topology.rubbleMass;
-    m_floesBroken += topology.floesBroken;
-    if (topology.changed) upload();
-  }
+  // 6. Topology, only in a step that asked for a break (the device stopped the batch there).
+  if (!m_breaks.empty()) runTopology();
 
   ++m_step;
   m_time = static_cast<Real>(m_step) * scenario().dt;

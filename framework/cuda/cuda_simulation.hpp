@@ -8,7 +8,9 @@
 //     search in the previous step's sorted contact id pairs
 //   4 pair events, solo events (the same evaluator structs as the CPU, templated kernels)
 //   5 gather: each body sums its contacts in contact order (no floating-point atomics), motion
-//   6 topology on the host (flexural_breaking), only in the rare steps that asked for a break.
+//   6 topology (flexural_breaking), only in the steps that asked for a break: the events cut the
+//     floes on the host mirror (the few bodies named fetched first) and the device replays the
+//     edit (survivors compacted in order, new floes appended, ids stable): the world stays put.
 // The whole step is one captured CUDA graph, the body of a device-side loop: copy_back_every steps
 // run as one launch, and their results (a small record per step, the impacts and logs) are copied
 // off once, through pinned buffers (thesis 5.7). step() then hands them out one step at a time.
@@ -17,7 +19,6 @@
 #pragma once
 #include <memory>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "framework/stepper.hpp"
@@ -51,12 +52,18 @@ class CudaSimulation final : public Stepper {
   int candidateCount() const { return m_candidateCount; }
   // Rebuilds of the device broadphase's kept list (0 for one that keeps none): reads the device.
   long broadphaseRebuilds() const;
+  // Tests: run the topology phase through a whole-world round trip (download, edit, upload), the
+  // reference that the device edit must match bit for bit.
+  void setTopologyThroughHost(bool on) { m_topologyThroughHost = on; }
 
  private:
   void upload();          // host world -> device (all arrays), after set-up, breaks and re-sorts
   void downloadState();   // device kinematics -> host world
   void runBatch();        // the next batch of steps on the device
   bool deviceAhead() const;  // the device has run steps that step() has not handed out yet
+  void runTopology();        // phase 6 on the mirror, replayed on the device
+  int mirrorSlot(int deviceSlot) const;  // the host mirror's row of a device slot
+  const std::vector<int>& slotOfId();
 
   World& world();                     // the host mirror (the CPU simulation's world, never stepped there)
   const Scenario& scenario() const;
@@ -66,7 +73,8 @@ class CudaSimulation final : public Stepper {
   // Re-sorts on the device leave the host mirror in the old slot order: device slot k holds the
   // mirror's body m_pendingOrder[k]. Applied (World::permute) when the host next needs its world.
   std::vector<int> m_pendingOrder;
-  std::unordered_map<std::int64_t, int> m_slotOfId;  // device slot of each body id, for ordering records
+  std::vector<int> m_slotOfId;  // device slot of each body id (-1: gone), for ordering records; empty: stale
+  bool m_topologyThroughHost = false;
   std::unique_ptr<cuda::DeviceWorld> m_device;
   std::unique_ptr<cuda::DeviceBatchResult> m_batch;
   size_t m_batchNext = 0;  // the batch's next step to hand out

@@ -16,6 +16,7 @@
 #include <tuple>
 #include <cstddef>
 #include <cstdlib>
+#include <iterator>
 #include <stdexcept>
 
 #include "framework/cuda/cuda_check.hpp"
@@ -59,6 +60,10 @@ class DeviceBuffer {
   void upload(const T* h_data, size_t n) {
     ensure(n);
     if (n) GEM_CUDA_CHECK(cudaMemcpy(m_data, h_data, n * sizeof(T), cudaMemcpyHostToDevice));
+  }
+  // Rows [offset, offset + n) from the host; the buffer already holds them.
+  void uploadAt(size_t offset, const T* h_data, size_t n) {
+    if (n) GEM_CUDA_CHECK(cudaMemcpy(m_data + offset, h_data, n * sizeof(T), cudaMemcpyHostToDevice));
   }
   void download(T* h_data, size_t n) const {
     if (n) GEM_CUDA_CHECK(cudaMemcpy(h_data, m_data, n * sizeof(T), cudaMemcpyDeviceToHost));
@@ -125,6 +130,7 @@ struct DeviceState {
   DeviceBuffer<Real> radius;  // bounding radius: what a device broadphase tests (MODEL.md 9)
   DeviceBuffer<unsigned char> isLarge;
   DeviceBuffer<int> large;
+  std::vector<int> largeHost;  // the same slots, ascending: a topology edit shifts them on the host
   int largeCount = 0;
   int n = 0;
   int vesselSlot = -1;
@@ -143,6 +149,7 @@ struct DeviceState {
   DeviceBuffer<unsigned> cellKey, cellKeySorted;
   DeviceBuffer<int> slot, slotSorted, cellStart, cellEnd;
   DeviceBuffer<int> partnerCount, partnerOffset;
+  DeviceBuffer<int> largeChunk;  // per large body and chunk of bodies: its hits, then their offset in the row
   // A device broadphase (nullptr: the grid above): its pairs as keys, sorted into candA/candB.
   std::unique_ptr<CudaBroadphase> broadphase;
   DeviceBuffer<unsigned long long> candKey, candKeySorted;
@@ -362,35 +369,52 @@ static void launchRows(int lanes, int blocks, int block, cudaStream_t s, const G
   GEM_CUDA_CHECK_LAUNCH();
 }
 
-// A large body's row (all j > l) is one block's work: a single thread walking 10^5 bodies was
-// most of a step at that size. Order is kept by a block-wide scan, chunk after chunk.
-constexpr int kLargeBlock = 1024;
+// A large body's row (every j > l whose box its box overlaps: walls and the vessel) is split into
+// chunks of kLargeChunk bodies, a block each, so that the rows of a few large bodies still fill the
+// GPU (a block per large body left all but five multiprocessors idle: 1.8 ms of a 10^6-floe step).
+// Count per chunk, a scan per row over its chunks, then each chunk writes its hits in order.
+constexpr int kLargeChunk = 256;
+static int largeChunks(int n) { return (n + kLargeChunk - 1) / kLargeChunk; }
 
-__global__ void largeRowCountKernel(GridView g, int* count) {
-  using Reduce = cub::BlockReduce<int, kLargeBlock>;
+// grid (chunks, largeCount): hits of large body large[blockIdx.y] in chunk blockIdx.x.
+__global__ void largeChunkCountKernel(GridView g, int chunks, int* chunkCount) {
+  using Reduce = cub::BlockReduce<int, kLargeChunk>;
   __shared__ typename Reduce::TempStorage temp;
-  const int l = g.large[blockIdx.x];
-  int c = 0;
-  for (int j = l + 1 + threadIdx.x; j < g.n; j += kLargeBlock) c += accept(g, l, j) ? 1 : 0;
-  const int total = Reduce(temp).Sum(c);
-  if (threadIdx.x == 0) count[l] = total;
+  const int l = g.large[blockIdx.y], j = blockIdx.x * kLargeChunk + threadIdx.x;
+  const int hit = j > l && j < g.n && accept(g, l, j) ? 1 : 0;
+  const int total = Reduce(temp).Sum(hit);
+  if (threadIdx.x == 0) chunkCount[blockIdx.y * chunks + blockIdx.x] = total;
 }
 
-__global__ void largeRowWriteKernel(GridView g, const int* offset, int* candA, int* candB) {
-  using Scan = cub::BlockScan<int, kLargeBlock>;
+// One block per large body: its chunks' counts become their offsets in the row, and the row's total
+// its partner count.
+__global__ void largeRowTotalKernel(GridView g, int chunks, int* chunkCount, int* count) {
+  using Scan = cub::BlockScan<int, kLargeChunk>;
   __shared__ typename Scan::TempStorage temp;
-  const int l = g.large[blockIdx.x];
-  if (offset[l + 1] > g.capacity) return;  // overflow: the step is redone with more room
-  int base = offset[l];
-  for (int start = l + 1; start < g.n; start += kLargeBlock) {
-    const int j = start + threadIdx.x;
-    const int hit = j < g.n && accept(g, l, j) ? 1 : 0;
+  int* row = chunkCount + blockIdx.x * chunks;
+  int base = 0;
+  for (int start = 0; start < chunks; start += kLargeChunk) {
+    const int k = start + threadIdx.x;
+    const int c = k < chunks ? row[k] : 0;
     int position = 0, total = 0;
-    Scan(temp).ExclusiveSum(hit, position, total);
-    if (hit) candA[base + position] = l, candB[base + position] = j;
+    Scan(temp).ExclusiveSum(c, position, total);
+    if (k < chunks) row[k] = base + position;
     base += total;
-    __syncthreads();  // temp is reused by the next chunk's scan
+    __syncthreads();  // temp is reused by the next round's scan
   }
+  if (threadIdx.x == 0) count[g.large[blockIdx.x]] = base;
+}
+
+__global__ void largeChunkWriteKernel(GridView g, int chunks, const int* chunkOffset, const int* offset, int* candA, int* candB) {
+  using Scan = cub::BlockScan<int, kLargeChunk>;
+  __shared__ typename Scan::TempStorage temp;
+  const int l = g.large[blockIdx.y], j = blockIdx.x * kLargeChunk + threadIdx.x;
+  if (offset[l + 1] > g.capacity) return;  // overflow: the step is redone with more room
+  const int hit = j > l && j < g.n && accept(g, l, j) ? 1 : 0;
+  int position = 0;
+  Scan(temp).ExclusiveSum(hit, position);
+  const int at = offset[l] + chunkOffset[blockIdx.y * chunks + blockIdx.x] + position;
+  if (hit) candA[at] = l, candB[at] = j;
 }
 
 // A device broadphase's pairs (device_broadphase.hpp) come as keys in any order. The sort has a
@@ -645,58 +669,26 @@ void DeviceWorld::setBroadphase(std::unique_ptr<CudaBroadphase> broadphase) {
 }
 const CudaBroadphase* DeviceWorld::broadphase() const { return m_state->broadphase.get(); }
 
-void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
-  DeviceState& d = *m_state;
-  // What the captured graph baked in: the same after the upload (a re-sort along the curve every
-  // 200 steps changes only the arrays' contents) and the graph is kept, not captured again.
-  auto baked = [&d] {
-    return std::make_tuple(d.n, d.cell, d.tableSize, d.largeCount, d.idBits, d.capacity, g_reallocations.load());
-  };
-  const auto before = baked();
-  const int n = w.size();
-  d.n = n;
-  d.vesselSlot = vesselSlot;
-  d.vessel.upload(&vesselSlot, 1);
-  d.id.upload(w.id.data(), n);
-  d.kind.upload(w.kind.data(), n);
-  d.vertexCount.upload(w.vertexCount.data(), n);
-  d.local.upload(w.localVertices.data(), static_cast<size_t>(n) * kMaxVertices);
-  d.x.upload(w.x.data(), n), d.y.upload(w.y.data(), n), d.angle.upload(w.angle.data(), n);
-  d.vx.upload(w.vx.data(), n), d.vy.upload(w.vy.data(), n), d.omega.upload(w.omega.data(), n);
-  d.area.upload(w.area.data(), n), d.thickness.upload(w.thickness.data(), n), d.mass.upload(w.mass.data(), n);
-  d.invMass.upload(w.invMass.data(), n), d.invInertia.upload(w.invInertia.data(), n);
-  d.gyration2.upload(w.gyration2.data(), n), d.gyrationX2.upload(w.gyrationX2.data(), n);
-  d.gyrationY2.upload(w.gyrationY2.data(), n), d.principalAngle.upload(w.principalAngle.data(), n);
-  d.radius.upload(w.radius.data(), n);
-  d.slotBits = bitsFor(static_cast<unsigned long long>(n));
-  if (d.broadphase) d.broadphase->upload(w);
+// What a captured graph baked in: when it is the same after an upload (a re-sort along the curve
+// every 200 steps changes only the arrays' contents) the graph is kept, not captured again.
+static auto bakedValues(const DeviceState& d) {
+  return std::make_tuple(d.n, d.cell, d.tableSize, d.largeCount, d.idBits, d.capacity, g_reallocations.load());
+}
 
-  // dof as Simulation's dofOf. The grid cell is the largest floe diameter, so a floe's box spans at
-  // most one cell; bodies larger than that (walls, the vessel) are "large" and tested against all.
-  std::vector<int> dof(n);
-  Real largestFloe = 0;
-  for (int i = 0; i < n; ++i) {
-    dof[i] = w.kind[i] == BodyKind::Wall ? 0 : (w.kind[i] == BodyKind::Vessel ? vesselDof : 3);
-    if (w.kind[i] == BodyKind::Floe) largestFloe = std::max(largestFloe, w.radius[i]);
-  }
-  d.cell = largestFloe > 0 ? 2 * largestFloe : Real(1);
-  std::vector<unsigned char> isLarge(n);
-  std::vector<int> large;
-  for (int i = 0; i < n; ++i) {
-    isLarge[i] = 2 * w.radius[i] > d.cell;
-    if (isLarge[i]) large.push_back(i);
-  }
-  d.dof.upload(dof.data(), n);
-  d.isLarge.upload(isLarge.data(), n);
-  d.large.upload(large.data(), large.size());
-  d.largeCount = static_cast<int>(large.size());
+// dof as Simulation's dofOf.
+static int dofOf(BodyKind kind, int vesselDof) { return kind == BodyKind::Wall ? 0 : (kind == BodyKind::Vessel ? vesselDof : 3); }
+
+// Everything that follows from n and the ids: the hash table, the key widths, the per-step buffers.
+static void sizeForBodies(DeviceState& d, std::int64_t nextId) {
+  const int n = d.n;
+  d.slotBits = bitsFor(static_cast<unsigned long long>(n));
   d.tableBits = 6;
   while ((1u << d.tableBits) < 2u * static_cast<unsigned>(n) && d.tableBits < 30) ++d.tableBits;
   d.tableSize = 1u << d.tableBits;
 
   // Contact keys: (lo << idBits) | hi with room for new ids from breaks; widened (and the kept keys
   // re-keyed) when the ids outgrow it.
-  const int bitsNeeded = bitsFor(static_cast<unsigned long long>(std::max<std::int64_t>(w.nextId, 1)));
+  const int bitsNeeded = bitsFor(static_cast<unsigned long long>(std::max<std::int64_t>(nextId, 1)));
   if (bitsNeeded > 32) throw std::runtime_error("CUDA backend: body ids past 2^32 are not supported");
   if (bitsNeeded > d.idBits) {
     const int newBits = std::min(32, bitsNeeded + 2);
@@ -714,14 +706,57 @@ void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
   d.cellKey.ensure(nn), d.cellKeySorted.ensure(nn), d.slot.ensure(nn), d.slotSorted.ensure(nn);
   d.cellStart.ensure(d.tableSize), d.cellEnd.ensure(d.tableSize);
   d.partnerCount.ensure(nn + 1), d.partnerOffset.ensure(nn + 1);
+  d.largeChunk.ensure(static_cast<size_t>(std::max(d.largeCount, 1)) * static_cast<size_t>(largeChunks(n)));
   if (d.capacity == 0) {
     // Grows when a step needs more (that step is then run again). GEM_CUDA_CAPACITY sets the start,
     // so that a test can force the regrowth path.
     const char* start = std::getenv("GEM_CUDA_CAPACITY");
     d.capacity = start ? std::max(1, std::atoi(start)) : 4 * n + 256;
   }
+}
+
+void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
+  DeviceState& d = *m_state;
+  const auto before = bakedValues(d);
+  const int n = w.size();
+  d.n = n;
+  d.vesselSlot = vesselSlot;
+  d.vessel.upload(&vesselSlot, 1);
+  d.id.upload(w.id.data(), n);
+  d.kind.upload(w.kind.data(), n);
+  d.vertexCount.upload(w.vertexCount.data(), n);
+  d.local.upload(w.localVertices.data(), static_cast<size_t>(n) * kMaxVertices);
+  d.x.upload(w.x.data(), n), d.y.upload(w.y.data(), n), d.angle.upload(w.angle.data(), n);
+  d.vx.upload(w.vx.data(), n), d.vy.upload(w.vy.data(), n), d.omega.upload(w.omega.data(), n);
+  d.area.upload(w.area.data(), n), d.thickness.upload(w.thickness.data(), n), d.mass.upload(w.mass.data(), n);
+  d.invMass.upload(w.invMass.data(), n), d.invInertia.upload(w.invInertia.data(), n);
+  d.gyration2.upload(w.gyration2.data(), n), d.gyrationX2.upload(w.gyrationX2.data(), n);
+  d.gyrationY2.upload(w.gyrationY2.data(), n), d.principalAngle.upload(w.principalAngle.data(), n);
+  d.radius.upload(w.radius.data(), n);
+  if (d.broadphase) d.broadphase->upload(w);
+
+  // The grid cell is the largest floe diameter, so a floe's box spans at most one cell; bodies
+  // larger than that (walls, the vessel) are "large" and tested against all.
+  std::vector<int> dof(n);
+  Real largestFloe = 0;
+  for (int i = 0; i < n; ++i) {
+    dof[i] = dofOf(w.kind[i], vesselDof);
+    if (w.kind[i] == BodyKind::Floe) largestFloe = std::max(largestFloe, w.radius[i]);
+  }
+  d.cell = largestFloe > 0 ? 2 * largestFloe : Real(1);
+  std::vector<unsigned char> isLarge(n);
+  d.largeHost.clear();
+  for (int i = 0; i < n; ++i) {
+    isLarge[i] = 2 * w.radius[i] > d.cell;
+    if (isLarge[i]) d.largeHost.push_back(i);
+  }
+  d.dof.upload(dof.data(), n);
+  d.isLarge.upload(isLarge.data(), n);
+  d.large.upload(d.largeHost.data(), d.largeHost.size());
+  d.largeCount = static_cast<int>(d.largeHost.size());
+  sizeForBodies(d, w.nextId);
   // A strategy's own storage (device_broadphase.hpp) may move in its upload(): always re-capture then.
-  if (baked() != before || d.broadphase) d.dropGraph();
+  if (bakedValues(d) != before || d.broadphase) d.dropGraph();
 }
 
 namespace {
@@ -761,14 +796,47 @@ __global__ void gatherRowsKernel(int n, int width, const int* order, const T* fr
   to[k] = from[static_cast<size_t>(order[row]) * width + column];
 }
 
+// Row k of the buffer becomes old row order[k], for k < n (a permutation of the n rows, or the
+// kept rows of `from` rows after a topology edit). The buffer then has room for `room` rows.
 template <class T>
-void permuteOnDevice(DeviceBuffer<T>& buffer, int n, int width, const int* order, ReorderScratch& scratch, cudaStream_t s) {
-  const size_t count = static_cast<size_t>(n) * width;
-  T* copy = static_cast<T*>(scratch.get(count * sizeof(T)));
-  GEM_CUDA_CHECK(cudaMemcpyAsync(copy, buffer.get(), count * sizeof(T), cudaMemcpyDeviceToDevice, s));
-  gatherRowsKernel<T><<<static_cast<unsigned>((count + kBlock - 1) / kBlock), kBlock, 0, s>>>(n, width, order, copy, buffer.get());
-  GEM_CUDA_CHECK_LAUNCH();
+void permuteOnDevice(DeviceBuffer<T>& buffer, int n, int width, const int* order, ReorderScratch& scratch, cudaStream_t s, int from = -1,
+                     int room = -1) {
+  const size_t rows = static_cast<size_t>(from < 0 ? n : from), count = static_cast<size_t>(n) * width;
+  T* copy = static_cast<T*>(scratch.get(std::max<size_t>(rows * width, 1) * sizeof(T)));
+  GEM_CUDA_CHECK(cudaMemcpyAsync(copy, buffer.get(), rows * width * sizeof(T), cudaMemcpyDeviceToDevice, s));
+  if (room > n) {
+    GEM_CUDA_CHECK(cudaStreamSynchronize(s));  // ensure() may free the buffer the copy reads
+    buffer.ensure(static_cast<size_t>(room) * width);
+  }
+  if (count > 0) {
+    gatherRowsKernel<T><<<static_cast<unsigned>((count + kBlock - 1) / kBlock), kBlock, 0, s>>>(n, width, order, copy, buffer.get());
+    GEM_CUDA_CHECK_LAUNCH();
+  }
   GEM_CUDA_CHECK(cudaStreamSynchronize(s));  // the scratch is reused by the next array
+}
+
+// order[k] = the k-th slot not in `removed` (ascending): the gather of a stable compaction.
+__global__ void keptOrderKernel(int n, const int* removed, int removedCount, int* order) {
+  const int slot = blockIdx.x * blockDim.x + threadIdx.x;
+  if (slot >= n) return;
+  int lo = 0, hi = removedCount;  // removed slots below `slot`
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (removed[mid] < slot) lo = mid + 1;
+    else hi = mid;
+  }
+  if (lo < removedCount && removed[lo] == slot) return;
+  order[slot - lo] = slot;
+}
+
+// Kinematics of a few bodies, for the host's topology phase.
+__global__ void gatherKinematicsKernel(int count, const int* slots, const Real* x, const Real* y, const Real* angle, const Real* vx,
+                                       const Real* vy, const Real* omega, Real* out) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= count) return;
+  const int i = slots[k];
+  Real* row = out + 6 * k;
+  row[0] = x[i], row[1] = y[i], row[2] = angle[i], row[3] = vx[i], row[4] = vy[i], row[5] = omega[i];
 }
 
 }  // namespace
@@ -813,17 +881,105 @@ std::vector<int> DeviceWorld::reorderAlongCurve() {
   sortedSlots.download(order.data(), static_cast<size_t>(n));
 
   // The large bodies' and the vessel's new slots (their count is unchanged: the graph stays valid).
-  std::vector<int> large;
   std::vector<unsigned char> isLarge(static_cast<size_t>(n));
   d.isLarge.download(isLarge.data(), static_cast<size_t>(n));
   const int vesselBefore = d.vesselSlot;
+  d.largeHost.clear();
   for (int k = 0; k < n; ++k) {
-    if (isLarge[static_cast<size_t>(k)]) large.push_back(k);
+    if (isLarge[static_cast<size_t>(k)]) d.largeHost.push_back(k);
     if (order[static_cast<size_t>(k)] == vesselBefore) d.vesselSlot = k;
   }
-  d.large.upload(large.data(), large.size());
+  d.large.upload(d.largeHost.data(), d.largeHost.size());
   d.vessel.upload(&d.vesselSlot, 1);
   return order;
+}
+
+void DeviceWorld::downloadKinematics(const std::vector<int>& deviceSlots, const std::vector<int>& hostSlots, World& w) const {
+  const DeviceState& d = *m_state;
+  const int count = static_cast<int>(deviceSlots.size());
+  if (count == 0) return;
+  DeviceBuffer<int> slots;
+  DeviceBuffer<Real> rows;
+  slots.upload(deviceSlots.data(), deviceSlots.size());
+  rows.ensure(6 * deviceSlots.size());
+  gatherKinematicsKernel<<<blocksFor(count), kBlock, 0, d.stream>>>(count, slots.get(), d.x.get(), d.y.get(), d.angle.get(), d.vx.get(),
+                                                                    d.vy.get(), d.omega.get(), rows.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
+  std::vector<Real> values(6 * deviceSlots.size());
+  rows.download(values.data(), values.size());
+  for (int k = 0; k < count; ++k) {
+    const int i = hostSlots[static_cast<size_t>(k)];
+    const Real* row = &values[6 * static_cast<size_t>(k)];
+    w.x[i] = row[0], w.y[i] = row[1], w.angle[i] = row[2], w.vx[i] = row[3], w.vy[i] = row[4], w.omega[i] = row[5];
+  }
+}
+
+void DeviceWorld::editBodies(const std::vector<int>& removedSlots, const World& after, int firstAdded, int vesselDof) {
+  DeviceState& d = *m_state;
+  const int before = d.n, removedCount = static_cast<int>(removedSlots.size());
+  const int kept = before - removedCount, added = after.size() - firstAdded, n = kept + added;
+  if (kept != firstAdded || kept < 0 || added < 0)
+    throw std::logic_error("DeviceWorld::editBodies: the edit does not match the device's bodies");
+  cudaStream_t s = d.stream;
+  static thread_local ReorderScratch scratch;
+
+  // The kept rows, in their order (a stable compaction), with room for the new ones after them.
+  DeviceBuffer<int> removed, order;
+  removed.upload(removedSlots.data(), removedSlots.size());
+  order.ensure(static_cast<size_t>(std::max(kept, 1)));
+  keptOrderKernel<<<blocksFor(before), kBlock, 0, s>>>(before, removed.get(), removedCount, order.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  const int* o = order.get();
+  permuteOnDevice(d.id, kept, 1, o, scratch, s, before, n), permuteOnDevice(d.kind, kept, 1, o, scratch, s, before, n);
+  permuteOnDevice(d.vertexCount, kept, 1, o, scratch, s, before, n), permuteOnDevice(d.dof, kept, 1, o, scratch, s, before, n);
+  permuteOnDevice(d.local, kept, kMaxVertices, o, scratch, s, before, n), permuteOnDevice(d.isLarge, kept, 1, o, scratch, s, before, n);
+  DeviceBuffer<Real>* reals[] = {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.radius, &d.area, &d.thickness, &d.mass, &d.invMass,
+                                 &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle};
+  for (DeviceBuffer<Real>* r : reals) permuteOnDevice(*r, kept, 1, o, scratch, s, before, n);
+
+  // The new bodies' rows, as World::addBody made them on the host (a few per step).
+  const size_t at = static_cast<size_t>(kept), count = static_cast<size_t>(added);
+  d.id.uploadAt(at, after.id.data() + at, count);
+  d.kind.uploadAt(at, after.kind.data() + at, count);
+  d.vertexCount.uploadAt(at, after.vertexCount.data() + at, count);
+  d.local.uploadAt(at * kMaxVertices, after.localVertices.data() + at * kMaxVertices, count * kMaxVertices);
+  const std::vector<Real>* hostReals[] = {&after.x, &after.y, &after.angle, &after.vx, &after.vy, &after.omega, &after.radius, &after.area,
+                                          &after.thickness, &after.mass, &after.invMass, &after.invInertia, &after.gyration2,
+                                          &after.gyrationX2, &after.gyrationY2, &after.principalAngle};
+  for (size_t k = 0; k < std::size(reals); ++k) reals[k]->uploadAt(at, hostReals[k]->data() + at, count);
+  std::vector<int> dof(count);
+  std::vector<unsigned char> isLarge(count);
+  for (size_t k = 0; k < count; ++k) {
+    dof[k] = dofOf(after.kind[at + k], vesselDof);
+    isLarge[k] = 2 * after.radius[at + k] > d.cell;  // the cell stays: a smaller largest floe only makes it coarse
+  }
+  d.dof.uploadAt(at, dof.data(), count);
+  d.isLarge.uploadAt(at, isLarge.data(), count);
+
+  // Slots past a removed body move down by the number removed before them.
+  auto newSlot = [&](int slot) {
+    return slot - static_cast<int>(std::lower_bound(removedSlots.begin(), removedSlots.end(), slot) - removedSlots.begin());
+  };
+  std::vector<int> large;
+  for (int slot : d.largeHost)
+    if (!std::binary_search(removedSlots.begin(), removedSlots.end(), slot)) large.push_back(newSlot(slot));
+  for (size_t k = 0; k < count; ++k)
+    if (isLarge[k]) large.push_back(kept + static_cast<int>(k));
+  d.largeHost = large;
+  d.large.upload(large.data(), large.size());
+  d.largeCount = static_cast<int>(large.size());
+  if (d.vesselSlot >= 0) {
+    if (std::binary_search(removedSlots.begin(), removedSlots.end(), d.vesselSlot))
+      throw std::logic_error("DeviceWorld::editBodies: a topology event removed the vessel");
+    d.vesselSlot = newSlot(d.vesselSlot);
+    d.vessel.upload(&d.vesselSlot, 1);
+  }
+  d.n = n;
+  sizeForBodies(d, after.nextId);
+  // A strategy keeps per-body structures: it rebuilds from the edited bodies (in device order).
+  if (d.broadphase) d.broadphase->upload(after);
+  d.dropGraph();  // n changed: the graph's launches were sized for the old count
 }
 
 void DeviceWorld::download(World& w) const {
@@ -929,14 +1085,19 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   const int lanes = rowLanes(n);
   const int rowBlocks = (lanes * (n + 1) + block - 1) / block;  // a tile per body, one more for count[n]
   launchRows<false>(lanes, rowBlocks, block, s, g, d.partnerCount.get(), nullptr, nullptr, nullptr);
+  const int chunks = largeChunks(n);
+  const dim3 largeGrid(static_cast<unsigned>(chunks), static_cast<unsigned>(d.largeCount));
   if (d.largeCount > 0) {
-    largeRowCountKernel<<<d.largeCount, kLargeBlock, 0, s>>>(g, d.partnerCount.get());
+    largeChunkCountKernel<<<largeGrid, kLargeChunk, 0, s>>>(g, chunks, d.largeChunk.get());
+    GEM_CUDA_CHECK_LAUNCH();
+    largeRowTotalKernel<<<d.largeCount, kLargeChunk, 0, s>>>(g, chunks, d.largeChunk.get(), d.partnerCount.get());
     GEM_CUDA_CHECK_LAUNCH();
   }
   cubCalls.scanPartners(n);
   launchRows<true>(lanes, rowBlocks, block, s, g, nullptr, d.partnerOffset.get(), d.candA.get(), d.candB.get());
   if (d.largeCount > 0) {
-    largeRowWriteKernel<<<d.largeCount, kLargeBlock, 0, s>>>(g, d.partnerOffset.get(), d.candA.get(), d.candB.get());
+    largeChunkWriteKernel<<<largeGrid, kLargeChunk, 0, s>>>(g, chunks, d.largeChunk.get(), d.partnerOffset.get(), d.candA.get(),
+                                                            d.candB.get());
     GEM_CUDA_CHECK_LAUNCH();
   }
   }
@@ -1024,6 +1185,9 @@ void prepareBuffers(DeviceState& d) {
 void captureStep(DeviceState& d) {
   prepareBuffers(d);
   d.dropGraph();
+  // Every allocation and upload finished before the capture: compute-sanitizer otherwise reports
+  // reads of "not yet allocated" memory inside a WHILE body (NVIDIA/warp#1406), and a capture is rare.
+  GEM_CUDA_CHECK(cudaDeviceSynchronize());
   cudaGraph_t graph = nullptr;
   GEM_CUDA_CHECK(cudaGraphCreate(&graph, 0));
   struct Owned {

@@ -54,8 +54,17 @@ class DeviceWorld {
   // the host, bit for bit. Returns the order (new slot k holds old slot order[k]) so that the host
   // can apply it to its mirror when it next needs it. The captured graph stays valid.
   std::vector<int> reorderAlongCurve();
-  // Positions, angles and velocities back into the host world (the rest never changes on the device).
+  // Positions, angles and velocities back into the host world (the rest changes on the device only
+  // through editBodies, which the host made first).
   void download(World& world) const;
+  // The same for a few bodies only: device slot deviceSlots[k] into host row hostSlots[k] (the
+  // topology phase reads only the bodies its requests name).
+  void downloadKinematics(const std::vector<int>& deviceSlots, const std::vector<int>& hostSlots, World& world) const;
+  // A topology edit, replayed on the device without moving the world: the bodies at removedSlots
+  // (ascending) leave, the others keep their order and their state, and the bodies after[firstAdded..]
+  // (made on the host by World::addBody) are appended. `after` is the host world after the same
+  // edit; a device broadphase rebuilds from it, so it must then be in the device's order.
+  void editBodies(const std::vector<int>& removedSlots, const World& after, int firstAdded, int vesselDof);
   // Steps kept on the device between two copies to the host (the ring's length), and threads per
   // block of the per-body and per-contact kernels. Before the first run.
   void configure(int copyBackEvery, int blockSize);
