@@ -36,6 +36,11 @@ MpiWork::MpiWork() {
   m_initialised = true;
   MPI_Comm_rank(MPI_COMM_WORLD, &m_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &m_size);
+  MPI_Comm node = MPI_COMM_NULL;
+  MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, m_rank, MPI_INFO_NULL, &node);
+  MPI_Comm_rank(node, &m_localRank);
+  MPI_Comm_size(node, &m_localSize);
+  MPI_Comm_free(&node);
   m_state = new State;
   MPI_Win_allocate(m_rank == 0 ? sizeof(long) : 0, sizeof(long), MPI_INFO_NULL, MPI_COMM_WORLD, &m_state->counter,
                    &m_state->window);

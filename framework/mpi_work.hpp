@@ -18,13 +18,17 @@ class MpiWork {
   bool active() const { return m_size > 1; }
   int rank() const { return m_rank; }
   int size() const { return m_size; }
+  // This rank's index among the ranks on its node (MPI_COMM_TYPE_SHARED), and their count: a node's
+  // GPUs are dealt out by it.
+  int localRank() const { return m_localRank; }
+  int localSize() const { return m_localSize; }
   // The next unclaimed index in [0, count) for this rank, or count when none is left. Thread-safe.
   std::size_t next(std::size_t count);
   // Waits for every rank; returns the sum of `value` over ranks.
   long sumOverRanks(long value);
 
  private:
-  int m_rank = 0, m_size = 1;
+  int m_rank = 0, m_size = 1, m_localRank = 0, m_localSize = 1;
   bool m_initialised = false;
   struct State;
   State* m_state = nullptr;

@@ -14,7 +14,8 @@ static std::map<std::string, BackendEntry>& backends() {
   static std::map<std::string, BackendEntry> table = [] {
     std::map<std::string, BackendEntry> t;
     t["cpu"] = BackendEntry{"cpu", [] { return true; }, [] { return std::string("cpu"); },
-                            [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); }};
+                            [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); },
+                            nullptr};  // the CPU backend's workers share the cores: no device to choose
     return t;
   }();
   return table;

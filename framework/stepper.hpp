@@ -53,6 +53,10 @@ struct BackendEntry {
   std::function<bool()> available;  // a device exists
   std::function<std::string()> deviceName;
   std::function<std::unique_ptr<Stepper>(const Scenario&)> make;
+  // Sweeps on a machine with several devices: the runs that this host thread makes next use device
+  // `worker` modulo the device count (a sweep's workers, over MPI ranks and threads, spread over the
+  // GPUs of their node). Empty for a backend without devices.
+  std::function<void(int worker)> useDeviceForWorker;
 };
 
 void registerBackend(BackendEntry entry);

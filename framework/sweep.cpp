@@ -22,6 +22,7 @@
 #include "framework/errors.hpp"
 #include "framework/runner.hpp"
 #include "framework/scenario.hpp"
+#include "framework/stepper.hpp"
 #include "framework/sweep_file.hpp"
 #include "framework/sweep_summary.hpp"
 
@@ -167,7 +168,12 @@ int runSweep(const SweepOptions& options) {
   // Under mpirun the ranks share one counter (cases go to whichever rank is free); alone, the
   // threads of this process share theirs.
   auto claim = [&]() { return mpi.active() ? mpi.next(todo.size()) : state.next++; };
-  auto worker = [&]() {
+  // Worker w of this node (its rank's local index x threads + its thread) runs on device w modulo
+  // the node's devices, for every backend that has devices: one GPU per rank, or per thread.
+  auto worker = [&](size_t thread) {
+    const int node = mpi.localRank() * static_cast<int>(jobs) + static_cast<int>(thread);
+    for (const std::string& name : backendNames())
+      if (const BackendEntry* b = findBackend(name); b && b->useDeviceForWorker) b->useDeviceForWorker(node);
     for (size_t k = claim(); k < todo.size(); k = claim()) {
       const size_t i = todo[k];
       const SweepCase& c = sweep.cases[i];
@@ -207,7 +213,7 @@ int runSweep(const SweepOptions& options) {
     }
   };
   std::vector<std::thread> threads;
-  for (size_t t = 0; t < jobs && t < todo.size(); ++t) threads.emplace_back(worker);
+  for (size_t t = 0; t < jobs && t < todo.size(); ++t) threads.emplace_back(worker, t);
   if (terminal && !todo.empty() && !mpi.active()) {
     std::unique_lock lock(state.mutex);
     while (state.finished < todo.size()) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "framework/cuda/cuda_check.hpp"
 #include "framework/cuda/device_world.hpp"
 #include "framework/log_channel.hpp"
 #include "framework/registry.hpp"
@@ -28,12 +29,34 @@ bool cudaAvailable() {
   return available;
 }
 
+static int deviceCount() {
+  int count = 0;
+  return cudaAvailable() && cudaGetDeviceCount(&count) == cudaSuccess ? count : 0;
+}
+
 std::string cudaDeviceName() {
   if (!cudaAvailable()) return "none";
   int device = 0;
   cudaDeviceProp prop{};
   if (cudaGetDevice(&device) != cudaSuccess || cudaGetDeviceProperties(&prop, device) != cudaSuccess) return "unknown CUDA device";
-  return prop.name;
+  const int count = deviceCount();
+  // With several devices the summary says which one ran the case (a sweep spreads its cases).
+  return count > 1 ? std::string(prop.name) + " (device " + std::to_string(device) + " of " + std::to_string(count) + ")" : prop.name;
+}
+
+// The device of the runs this host thread makes next (-1: the runtime's current one, device 0).
+static thread_local int t_workerDevice = -1;
+
+void useCudaDeviceForWorker(int worker) {
+  const int count = deviceCount();
+  t_workerDevice = count > 0 ? worker % count : -1;
+}
+
+int CudaSimulation::bindThreadToDevice() {
+  int device = 0;
+  if (t_workerDevice >= 0) GEM_CUDA_CHECK(cudaSetDevice(t_workerDevice));
+  GEM_CUDA_CHECK(cudaGetDevice(&device));
+  return device;
 }
 
 World& CudaSimulation::world() { return m_cpu->world(); }
@@ -60,7 +83,8 @@ long CudaSimulation::broadphaseRebuilds() const {
 }
 
 CudaSimulation::CudaSimulation(const Scenario& scenario)
-    : m_cpu(std::make_unique<Simulation>(scenario)),
+    : m_deviceOrdinal(bindThreadToDevice()),
+      m_cpu(std::make_unique<Simulation>(scenario)),
       m_device(std::make_unique<cuda::DeviceWorld>()),
       m_batch(std::make_unique<cuda::DeviceBatchResult>()),
       m_deviceName(cudaDeviceName()) {
@@ -307,7 +331,8 @@ void CudaSimulation::step() {
 // The backend's entry: listed by `gem info`, chosen by --backend cuda and by backend = "auto".
 static const bool kRegistered = [] {
   registerBackend(BackendEntry{"cuda", [] { return cudaAvailable(); }, [] { return cudaDeviceName(); },
-                               [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CudaSimulation>(s); }});
+                               [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CudaSimulation>(s); },
+                               useCudaDeviceForWorker});
   return true;
 }();
 

@@ -68,6 +68,8 @@ class CudaSimulation final : public Stepper {
   World& world();                     // the host mirror (the CPU simulation's world, never stepped there)
   const Scenario& scenario() const;
 
+  static int bindThreadToDevice();  // the worker's device (useCudaDeviceForWorker), before any CUDA call
+  int m_deviceOrdinal;               // first: every member after it lives on this device
   std::unique_ptr<Simulation> m_cpu;  // parses the events (and runs the topology ones) and holds the host world
   bool m_hostCurrent = true;
   // Re-sorts on the device leave the host mirror in the old slot order: device slot k holds the
@@ -95,6 +97,9 @@ class CudaSimulation final : public Stepper {
 
 // True when the CUDA runtime sees at least one device (never throws).
 bool cudaAvailable();
+// The current device's name; with several devices, which one ("NVIDIA H200 (device 1 of 2)").
 std::string cudaDeviceName();
+// The CudaSimulations this host thread makes from now on run on device `worker` modulo the count.
+void useCudaDeviceForWorker(int worker);
 
 }  // namespace gem

@@ -8,12 +8,14 @@
 //     magnitude of that quantity); the contact and impact counts must be equal;
 //   - the busy channel after 300 steps (a chaotic pack: last-bit differences grow): impacts count
 //     within 10 %, floes broken within 2, mean floe speed within 5 %.
+#include <cuda_runtime.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <set>
 
 #include "framework/cuda/cuda_simulation.hpp"
 #include "framework/simulation.hpp"
@@ -371,6 +373,36 @@ TEST(CudaBackend, GemRunWritesACudaSummary) {
   const std::string summary = test::readFile(out / "summary.json");
   EXPECT_NE(summary.find("\"backend\": \"cuda\""), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"device\": \"" + cudaDeviceName() + "\""), std::string::npos) << summary;
+}
+
+// A sweep on a machine with several GPUs spreads its workers over them (issue 5: one GPU per rank,
+// or per thread): with two jobs, cases run on device 0 and on device 1, and each summary says which.
+TEST(CudaBackend, SweepSpreadsItsWorkersOverTheDevices) {
+  GEM_SKIP_WITHOUT_CUDA();
+  int devices = 0;
+  cudaGetDeviceCount(&devices);
+  if (devices < 2) GTEST_SKIP() << "one CUDA device: nothing to spread over";
+  TempDir dir;
+  dir.write("busy.toml", kBusyScene);
+  const auto sweep = dir.write("spread.toml", R"([sweep]
+base = "busy.toml"
+set = { "simulation.steps" = 200, "simulation.backend" = "cuda" }
+[parameters]
+"vessel.bollard_thrust" = [300e3, 400e3, 500e3, 600e3, 700e3, 740e3]
+)");
+  const auto out = dir.path() / "runs";
+  ASSERT_EQ(0, runGemBinary("sweep " + sweep.string() + " --jobs 2 --out " + out.string(), dir.path() / "log.txt"))
+      << test::readFile(dir.path() / "log.txt");
+  std::set<std::string> used;
+  for (const auto& entry : std::filesystem::directory_iterator(out / "cases")) {
+    const std::string summary = test::readFile(entry.path() / "summary.json");
+    const size_t at = summary.find("(device ");
+    ASSERT_NE(at, std::string::npos) << summary;
+    used.insert(summary.substr(at, summary.find(')', at) - at + 1));
+  }
+  const std::string of = " of " + std::to_string(devices) + ")";
+  EXPECT_TRUE(used.count("(device 0" + of)) << "device 0 ran no case";
+  EXPECT_TRUE(used.count("(device 1" + of)) << "device 1 ran no case";
 }
 
 // A candidate list past its capacity makes the step run again with more room: same result bit for bit.
