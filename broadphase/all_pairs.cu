@@ -25,6 +25,7 @@ __global__ void allPairsKernel(BroadphaseBodies b, CandidateSink sink) {
 class DeviceAllPairs final : public CudaBroadphase {
  public:
   explicit DeviceAllPairs(const BroadphaseSettings&) {}
+  bool reorder(const int*, int, cudaStream_t) override { return true; }  // keeps nothing per body
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
     if (bodies.n < 2) return;
     const dim3 grid(static_cast<unsigned>(blocksFor(bodies.n - 1)), static_cast<unsigned>(std::min(bodies.n, kMaxRows)));

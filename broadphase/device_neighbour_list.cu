@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace gem::cuda {
 
@@ -120,6 +121,31 @@ void DeviceNeighbourList::upload(const World& world, const std::vector<Real>& ha
   m_tempBytes = bytes;
   if (m_control.ensure(1)) GEM_CUDA_CHECK(cudaMemset(m_control.get(), 0, sizeof(ListControl)));
   markStale();  // slots may name other bodies now (NeighbourList::invalidate)
+}
+
+// The slots of the always-direct bodies after a re-sort (their order in the list does not matter:
+// every candidate is sorted afterwards).
+__global__ void alwaysDirectListKernel(int n, const unsigned char* always, int* list, int* found) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n && always[i]) list[atomicAdd(found, 1)] = i;
+}
+
+void DeviceNeighbourList::reorder(const int* order, int n, cudaStream_t s) {
+  if (n != m_n) throw std::logic_error("DeviceNeighbourList::reorder: the body count changed (that takes an upload)");
+  if (n == 0) return;
+  const size_t nn = static_cast<size_t>(n);
+  m_halfBefore.ensure(nn), m_alwaysBefore.ensure(nn), m_alwaysFound.ensure(1);
+  GEM_CUDA_CHECK(cudaMemcpyAsync(m_halfBefore.get(), m_half.get(), nn * sizeof(Real), cudaMemcpyDeviceToDevice, s));
+  GEM_CUDA_CHECK(cudaMemcpyAsync(m_alwaysBefore.get(), m_alwaysDirect.get(), nn, cudaMemcpyDeviceToDevice, s));
+  gatherByOrderKernel<Real><<<blocksFor(n), kBlock, 0, s>>>(n, 1, order, m_halfBefore.get(), m_half.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  gatherByOrderKernel<unsigned char><<<blocksFor(n), kBlock, 0, s>>>(n, 1, order, m_alwaysBefore.get(), m_alwaysDirect.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  GEM_CUDA_CHECK(cudaMemsetAsync(m_alwaysFound.get(), 0, sizeof(int), s));
+  alwaysDirectListKernel<<<blocksFor(n), kBlock, 0, s>>>(n, m_alwaysDirect.get(), m_directList.get(), m_alwaysFound.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  GEM_CUDA_CHECK(cudaStreamSynchronize(s));
+  markStale();  // slots name other bodies now (NeighbourList::invalidate)
 }
 
 void DeviceNeighbourList::markStale() { GEM_CUDA_CHECK(cudaMemset(&m_control.get()->valid, 0, sizeof(int))); }

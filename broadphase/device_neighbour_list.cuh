@@ -89,6 +89,9 @@ class DeviceNeighbourList {
   explicit DeviceNeighbourList(Real skin) : m_skin(skin) {}
   // half: R + skin / 2 per body; floor: fixed_radius's global radius (0 for the others).
   void upload(const World& world, const std::vector<Real>& half, Real floor);
+  // The bodies were permuted on the device (new slot k holds old slot order[k]): the per-body
+  // inputs follow them and the list is rebuilt at the next step (as after an upload).
+  void reorder(const int* order, int n, cudaStream_t stream);
   void reserve();
   long rebuilds() const;
   Real skin() const { return m_skin; }
@@ -121,7 +124,19 @@ class DeviceNeighbourList {
   DeviceArray<ListedPair> m_pairs;
   DeviceArray<unsigned char> m_temp;
   size_t m_tempBytes = 0;
+  DeviceArray<Real> m_halfBefore;                // reorder()'s copies
+  DeviceArray<unsigned char> m_alwaysBefore;
+  DeviceArray<int> m_alwaysFound;
 };
+
+// Row k of `to` becomes row order[k] of `from`, width values a row (a strategy's per-body storage
+// following a re-sort of the bodies on the device).
+template <class T>
+__global__ void gatherByOrderKernel(long long count, int width, const int* order, const T* from, T* to) {
+  const long long k = static_cast<long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (k >= count) return;
+  to[k] = from[static_cast<long long>(order[k / width]) * width + k % width];
+}
 
 // The plain circle test of variable_radius and fixed_radius: nothing on top.
 struct AcceptAll {

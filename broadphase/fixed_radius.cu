@@ -18,6 +18,10 @@ class DeviceFixedRadius final : public CudaBroadphase {
     m_list.upload(world, half, m_fixedRadius > 0 ? m_fixedRadius : 2 * largestFloeRadius(world) + skin);
   }
   void reserve(cudaStream_t) override { m_list.reserve(); }
+  bool reorder(const int* order, int n, cudaStream_t stream) override {
+    m_list.reorder(order, n, stream);
+    return true;
+  }
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
     m_list.enqueue(bodies, sink, stream, AcceptAll{});
   }

@@ -71,6 +71,22 @@ class DeviceTriangulationMesh final : public CudaBroadphase {
     m_triangles.upload(triangles.data(), triangles.size());
   }
   void reserve(cudaStream_t) override { m_list.reserve(); }
+  bool reorder(const int* order, int n, cudaStream_t stream) override {
+    m_list.reorder(order, n, stream);
+    if (n == 0) return true;
+    // Each body's triangles (indices into its own vertices) follow it.
+    const long long rows = n, width = kMaxTriangles * 3;
+    m_countBefore.ensure(static_cast<size_t>(rows)), m_trianglesBefore.ensure(static_cast<size_t>(rows * width));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(m_countBefore.get(), m_count.get(), rows * sizeof(int), cudaMemcpyDeviceToDevice, stream));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(m_trianglesBefore.get(), m_triangles.get(), rows * width * sizeof(int), cudaMemcpyDeviceToDevice, stream));
+    gatherByOrderKernel<int><<<blocksFor(n), kBlock, 0, stream>>>(rows, 1, order, m_countBefore.get(), m_count.get());
+    GEM_CUDA_CHECK_LAUNCH();
+    gatherByOrderKernel<int><<<static_cast<unsigned>((rows * width + kBlock - 1) / kBlock), kBlock, 0, stream>>>(
+        rows * width, static_cast<int>(width), order, m_trianglesBefore.get(), m_triangles.get());
+    GEM_CUDA_CHECK_LAUNCH();
+    GEM_CUDA_CHECK(cudaStreamSynchronize(stream));
+    return true;
+  }
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
     m_list.enqueue(bodies, sink, stream, TrianglesOverlap{m_count.get(), m_triangles.get()});
   }
@@ -79,6 +95,7 @@ class DeviceTriangulationMesh final : public CudaBroadphase {
  private:
   DeviceNeighbourList m_list;
   DeviceArray<int> m_count, m_triangles;
+  DeviceArray<int> m_countBefore, m_trianglesBefore;  // reorder()'s copies
 };
 
 }  // namespace

@@ -17,6 +17,10 @@ class DeviceVariableRadius final : public CudaBroadphase {
     m_list.upload(world, half, 0);
   }
   void reserve(cudaStream_t) override { m_list.reserve(); }
+  bool reorder(const int* order, int n, cudaStream_t stream) override {
+    m_list.reorder(order, n, stream);
+    return true;
+  }
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
     m_list.enqueue(bodies, sink, stream, AcceptAll{});
   }

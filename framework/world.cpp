@@ -48,10 +48,12 @@ int World::addBody(const BodySpec& spec) {
   return slot;
 }
 
+// Rows before the first removed one stay where they are: a break removes a few floes from a world
+// of up to 10^6, so the pass starts there.
 template <class T>
-static void keepIf(std::vector<T>& v, const std::vector<char>& remove, size_t stride = 1) {
-  size_t out = 0;
-  for (size_t i = 0; i < remove.size(); ++i) {
+static void keepIf(std::vector<T>& v, const std::vector<char>& remove, size_t first, size_t stride = 1) {
+  size_t out = first;
+  for (size_t i = first; i < remove.size(); ++i) {
     if (remove[i]) continue;
     for (size_t k = 0; k < stride; ++k) v[out * stride + k] = v[i * stride + k];
     ++out;
@@ -60,14 +62,16 @@ static void keepIf(std::vector<T>& v, const std::vector<char>& remove, size_t st
 }
 
 void World::removeBodies(const std::vector<char>& remove) {
-  keepIf(id, remove); keepIf(kind, remove); keepIf(vertexCount, remove);
-  keepIf(localVertices, remove, kMaxVertices);
-  keepIf(x, remove); keepIf(y, remove); keepIf(angle, remove);
-  keepIf(vx, remove); keepIf(vy, remove); keepIf(omega, remove);
-  keepIf(area, remove); keepIf(thickness, remove); keepIf(mass, remove);
-  keepIf(invMass, remove); keepIf(invInertia, remove);
-  keepIf(gyration2, remove); keepIf(gyrationX2, remove); keepIf(gyrationY2, remove);
-  keepIf(principalAngle, remove); keepIf(radius, remove);
+  const size_t f = static_cast<size_t>(std::find_if(remove.begin(), remove.end(), [](char r) { return r != 0; }) - remove.begin());
+  if (f == remove.size()) return;
+  keepIf(id, remove, f); keepIf(kind, remove, f); keepIf(vertexCount, remove, f);
+  keepIf(localVertices, remove, f, kMaxVertices);
+  keepIf(x, remove, f); keepIf(y, remove, f); keepIf(angle, remove, f);
+  keepIf(vx, remove, f); keepIf(vy, remove, f); keepIf(omega, remove, f);
+  keepIf(area, remove, f); keepIf(thickness, remove, f); keepIf(mass, remove, f);
+  keepIf(invMass, remove, f); keepIf(invInertia, remove, f);
+  keepIf(gyration2, remove, f); keepIf(gyrationX2, remove, f); keepIf(gyrationY2, remove, f);
+  keepIf(principalAngle, remove, f); keepIf(radius, remove, f);
 }
 
 template <class T>

@@ -5,7 +5,10 @@
 #include <cuda_runtime.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 
 #include "framework/cuda/cuda_check.hpp"
@@ -16,6 +19,22 @@
 #include "framework/stepper.hpp"
 
 namespace gem {
+
+namespace {
+// Wall time in parts: lap() gives the seconds since the last lap (or since it was made).
+class Stopwatch {
+ public:
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - m_last).count();
+    m_last = now;
+    return seconds;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point m_last = std::chrono::steady_clock::now();
+};
+}  // namespace
 
 bool cudaAvailable() {
   static const bool available = [] {
@@ -116,7 +135,17 @@ CudaSimulation::CudaSimulation(const Scenario& scenario)
   upload();
 }
 
-CudaSimulation::~CudaSimulation() = default;
+CudaSimulation::~CudaSimulation() {
+  // GEM_CUDA_TIMING=1: where the host's wall time went (the device's kernels are ncu's to split).
+  const char* timing = std::getenv("GEM_CUDA_TIMING");
+  if (!timing || timing[0] != '1') return;
+  const HostTimes& t = m_times;
+  std::fprintf(stderr,
+               "gem cuda timing, %ld steps, %d bodies: batches %ld in %.3f s (device steps, copy-back); topology %ld in %.3f s "
+               "(fetch %.3f, events %.3f, device edit %.3f, bookkeeping %.3f); re-sorts %ld in %.3f s; record ordering %.3f s\n",
+               m_step, world().size(), t.batches, t.batch, t.topologies, t.fetch + t.events + t.edit + t.bookkeeping, t.fetch, t.events,
+               t.edit, t.bookkeeping, t.resorts, t.resort, t.ordering);
+}
 
 void CudaSimulation::upload() {
   const World& w = world();
@@ -148,7 +177,16 @@ const std::vector<int>& CudaSimulation::slotOfId() {
 // the requests name are fetched. What they removed and appended is then replayed on the device
 // (DeviceWorld::editBodies): the world's arrays never cross the bus, only the few new bodies do.
 void CudaSimulation::runTopology() {
+  Stopwatch clock;
+  ++m_times.topologies;
   World& w = world();
+  if (m_device->broadphase() && !m_pendingOrder.empty()) {
+    // A device strategy rebuilds its per-body storage from the edited mirror (editBodies), which
+    // must then be in the device's order: the re-sort's order is applied to the mirror first.
+    w.permute(m_pendingOrder);
+    m_pendingOrder.clear();
+    m_slotOfId.clear();
+  }
   const std::vector<int>& slotOf = slotOfId();
   std::vector<int> deviceSlots, hostSlots;
   for (const BreakRequest& b : m_breaks) {
@@ -162,6 +200,7 @@ void CudaSimulation::runTopology() {
   } else {
     m_device->downloadKinematics(deviceSlots, hostSlots, w);
   }
+  m_times.fetch += clock.lap();
 
   const std::vector<std::int64_t> idsBefore = w.id;
   const std::int64_t nextIdBefore = w.nextId;
@@ -170,6 +209,7 @@ void CudaSimulation::runTopology() {
     if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
   m_rubbleMass += topology.rubbleMass;
   m_floesBroken += topology.floesBroken;
+  m_times.events += clock.lap();
   if (!topology.changed) return;
   if (m_topologyThroughHost) {
     upload();
@@ -193,7 +233,9 @@ void CudaSimulation::runTopology() {
   if (survivor != firstAdded)
     throw std::logic_error("CUDA backend: a topology event reordered the bodies (only World::removeBodies and World::addBody may change them)");
   std::sort(removedDevice.begin(), removedDevice.end());
+  m_times.bookkeeping += clock.lap();
   m_device->editBodies(removedDevice, w, firstAdded, scenario().vessel.dof);
+  m_times.edit += clock.lap();
 
   // The mirror's order after a device re-sort: device slot j (a survivor) held device slot
   // keptDevice[j], i.e. mirror body pendingOrder[keptDevice[j]], which the removal moved down.
@@ -215,6 +257,7 @@ void CudaSimulation::runTopology() {
   }
   m_slotOfId.clear();
   if (m_vesselSlot >= 0) m_vesselSlot = slotOfId()[static_cast<size_t>(m_vesselId)];
+  m_times.bookkeeping += clock.lap();
 }
 
 void CudaSimulation::downloadState() {
@@ -257,7 +300,10 @@ void CudaSimulation::runBatch() {
   if (s.output.frameEvery > 0) stopAtMultipleOf(s.output.frameEvery);
   if (s.mortonSort) stopAtMultipleOf(200);
   if (m_step < s.steps) end = std::min(end, s.steps);
+  Stopwatch clock;
   m_device->run(m_step, s.dt, static_cast<int>(end - m_step), *m_batch);
+  m_times.batch += clock.lap();
+  ++m_times.batches;
   m_batchNext = 0;
   m_hostCurrent = false;
 }
@@ -278,6 +324,7 @@ void CudaSimulation::step() {
   m_breaks.assign(batch.breaks.begin() + before.breakEnd, batch.breaks.begin() + r.breakEnd);
   m_logs.assign(batch.logs.begin() + before.logEnd, batch.logs.begin() + r.logEnd);
   if (m_impacts.size() > 1 || m_breaks.size() > 1 || !m_logs.empty()) {
+    Stopwatch clock;
     const std::vector<int>& slots = slotOfId();
     auto slotOf = [&slots](std::int64_t id) { return slots.at(static_cast<size_t>(id)); };
     std::stable_sort(m_impacts.begin(), m_impacts.end(),
@@ -290,6 +337,7 @@ void CudaSimulation::step() {
     };
     std::stable_sort(m_logs.begin(), m_logs.end(), [&](const LogRecord& a, const LogRecord& b) { return pairOf(a) < pairOf(b); });
     deliverLogs(m_logs.data(), static_cast<int>(m_logs.size()));
+    m_times.ordering += clock.lap();
   }
   m_vesselIceForce = (Real(1) / scenario().dt) * r.vesselImpulse;
   if (m_vesselSlot >= 0) m_vessel = VesselSample{true, r.vesselPosition, r.vesselAngle, r.vesselVelocity};
@@ -299,32 +347,41 @@ void CudaSimulation::step() {
 
   ++m_step;
   m_time = static_cast<Real>(m_step) * scenario().dt;
-  if (scenario().mortonSort && m_step % 200 == 0 && m_device->broadphase()) {
-    // A device strategy keeps per-body structures made from the host world (CudaBroadphase::upload):
-    // the re-sort goes through the host, and the strategy rebuilds from the new order.
+  if (scenario().mortonSort && m_step % 200 == 0) {
+    Stopwatch clock;
+    reSortAlongCurve();
+    m_times.resort += clock.lap();
+    ++m_times.resorts;
+  }
+}
+
+// Every 200 steps (MODEL.md 9: neighbours in space become neighbours in memory).
+void CudaSimulation::reSortAlongCurve() {
+  // On the device, bit for bit as the host's World::curveOrder + World::permute; the mirror follows
+  // lazily (m_pendingOrder). At 10^6 floes a round trip through the host (download, sort, permute,
+  // upload, re-capture) cost more than the 200 steps it serves.
+  bool followed = true;
+  const std::vector<int> order = m_device->reorderAlongCurve(&followed);
+  m_slotOfId.clear();
+  if (m_pendingOrder.empty()) {
+    m_pendingOrder = order;
+  } else {
+    std::vector<int> composed(order.size());
+    for (size_t k = 0; k < order.size(); ++k) composed[k] = m_pendingOrder[static_cast<size_t>(order[k])];
+    m_pendingOrder.swap(composed);
+  }
+  m_hostCurrent = false;
+  if (m_vesselSlot >= 0)
+    for (size_t k = 0; k < order.size(); ++k)
+      if (order[k] == m_vesselSlot) {
+        m_vesselSlot = static_cast<int>(k);
+        break;
+      }
+  if (!followed) {
+    // A device broadphase that keeps per-body storage but cannot permute it (a plugin's, say)
+    // rebuilds from the whole world, in the new order.
     downloadState();
-    world().permute(world().curveOrder());
     upload();
-  } else if (scenario().mortonSort && m_step % 200 == 0) {
-    // The built-in grid keeps nothing between steps: the re-sort runs on the device, and the mirror
-    // follows lazily. At 10^6 floes a round trip through the host (download, sort, permute, upload,
-    // re-capture) cost more than the 200 steps it serves.
-    const std::vector<int> order = m_device->reorderAlongCurve();
-    m_slotOfId.clear();
-    if (m_pendingOrder.empty()) {
-      m_pendingOrder = order;
-    } else {
-      std::vector<int> composed(order.size());
-      for (size_t k = 0; k < order.size(); ++k) composed[k] = m_pendingOrder[static_cast<size_t>(order[k])];
-      m_pendingOrder.swap(composed);
-    }
-    m_hostCurrent = false;
-    if (m_vesselSlot >= 0)
-      for (size_t k = 0; k < order.size(); ++k)
-        if (order[k] == m_vesselSlot) {
-          m_vesselSlot = static_cast<int>(k);
-          break;
-        }
   }
 }
 

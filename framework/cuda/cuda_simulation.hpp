@@ -62,6 +62,7 @@ class CudaSimulation final : public Stepper {
   void runBatch();        // the next batch of steps on the device
   bool deviceAhead() const;  // the device has run steps that step() has not handed out yet
   void runTopology();        // phase 6 on the mirror, replayed on the device
+  void reSortAlongCurve();
   int mirrorSlot(int deviceSlot) const;  // the host mirror's row of a device slot
   const std::vector<int>& slotOfId();
 
@@ -91,6 +92,11 @@ class CudaSimulation final : public Stepper {
   std::vector<LogRecord> m_logs;
   Vec2 m_vesselIceForce{0, 0};
   VesselSample m_vessel{false, {0, 0}, 0, {0, 0}};
+  // Host wall time by part (GEM_CUDA_TIMING=1 prints it when the run ends), s.
+  struct HostTimes {
+    long batches = 0, topologies = 0, resorts = 0;
+    double batch = 0, fetch = 0, events = 0, edit = 0, bookkeeping = 0, resort = 0, ordering = 0;
+  } m_times;
   double m_rubbleMass = 0;
   long m_floesBroken = 0;
 };

@@ -79,6 +79,14 @@ class CudaBroadphase {
   // Host, outside the graph, before every capture: a sync is fine here. Grow what a kernel found
   // too small (after sink.redo()); anything reallocated must be marked stale on the device.
   virtual void reserve(cudaStream_t stream) { (void)stream; }
+  // Host, outside the graph: the bodies were re-sorted on the device (new slot k holds old slot
+  // order[k], a device array of n). Return true once the strategy's per-body storage follows the
+  // bodies (and kept structures are marked stale); false (the default) makes the host upload the
+  // whole world instead, which a strategy written before this existed handles in upload().
+  virtual bool reorder(const int* order, int n, cudaStream_t stream) {
+    (void)order, (void)n, (void)stream;
+    return false;
+  }
   virtual void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) = 0;
   // How many times a kept structure was (re)built (reads the device: host, between steps).
   virtual long rebuilds() const { return 0; }

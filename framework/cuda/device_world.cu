@@ -841,9 +841,10 @@ __global__ void gatherKinematicsKernel(int count, const int* slots, const Real* 
 
 }  // namespace
 
-std::vector<int> DeviceWorld::reorderAlongCurve() {
+std::vector<int> DeviceWorld::reorderAlongCurve(bool* broadphaseFollowed) {
   DeviceState& d = *m_state;
   const int n = d.n;
+  *broadphaseFollowed = true;
   std::vector<int> order(static_cast<size_t>(n));
   if (n < 2) {
     for (int i = 0; i < n; ++i) order[static_cast<size_t>(i)] = i;
@@ -878,6 +879,7 @@ std::vector<int> DeviceWorld::reorderAlongCurve() {
   for (DeviceBuffer<Real>* r : {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.radius, &d.area, &d.thickness, &d.mass, &d.invMass,
                                 &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle})
     permuteOnDevice(*r, n, 1, o, scratch, s);
+  if (d.broadphase) *broadphaseFollowed = d.broadphase->reorder(o, n, s);
   sortedSlots.download(order.data(), static_cast<size_t>(n));
 
   // The large bodies' and the vessel's new slots (their count is unchanged: the graph stays valid).

@@ -52,8 +52,10 @@ class DeviceWorld {
   void upload(const World& world, int vesselDof, int vesselSlot);
   // Re-sorts the bodies along the curve on the device, as World::curveOrder + World::permute do on
   // the host, bit for bit. Returns the order (new slot k holds old slot order[k]) so that the host
-  // can apply it to its mirror when it next needs it. The captured graph stays valid.
-  std::vector<int> reorderAlongCurve();
+  // can apply it to its mirror when it next needs it. The captured graph stays valid unless a
+  // device broadphase could not follow the new order (CudaBroadphase::reorder): then
+  // *broadphaseFollowed is false and the caller uploads the world.
+  std::vector<int> reorderAlongCurve(bool* broadphaseFollowed);
   // Positions, angles and velocities back into the host world (the rest changes on the device only
   // through editBodies, which the host made first).
   void download(World& world) const;

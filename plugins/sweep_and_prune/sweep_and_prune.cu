@@ -52,6 +52,7 @@ class DeviceSweepAndPrune final : public cuda::CudaBroadphase {
     m_temp.ensure(std::max<size_t>(bytes, 1));
     m_tempBytes = bytes;
   }
+  bool reorder(const int*, int, cudaStream_t) override { return true; }  // keeps nothing per body between steps
   void enqueue(const BroadphaseBodies& b, const CandidateSink& sink, cudaStream_t stream) override {
     if (b.n < 2) return;
     intervalStartKernel<<<cuda::blocksFor(b.n), cuda::kBlock, 0, stream>>>(b, m_start.get(), m_slot.get());
