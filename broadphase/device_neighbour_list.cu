@@ -95,9 +95,23 @@ void enqueueListBuild(const ListView& list, const BroadphaseBodies& bodies, void
   GEM_CUDA_CHECK_LAUNCH();
 }
 
+void DeviceNeighbourList::resize(int n) {
+  m_n = n;
+  const size_t nn = static_cast<size_t>(std::max(n, 1));
+  m_direct.ensure(nn), m_x0.ensure(nn), m_y0.ensure(nn), m_angle0.ensure(nn);
+  m_lo.ensure(nn), m_loSorted.ensure(nn), m_slot.ensure(nn), m_slotSorted.ensure(nn);
+  if (m_capacity == 0) m_capacity = 8 * n + 1024;  // grows in reserve() when a build needs more
+  m_pairs.ensure(static_cast<size_t>(m_capacity));
+  size_t bytes = 0;
+  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, m_lo.get(), m_loSorted.get(), m_slot.get(), m_slotSorted.get(),
+                                                 n, 0, static_cast<int>(sizeof(Real) * 8)));
+  m_temp.ensure(std::max<size_t>(bytes, 1));
+  m_tempBytes = bytes;
+  if (m_control.ensure(1)) GEM_CUDA_CHECK(cudaMemset(m_control.get(), 0, sizeof(ListControl)));
+}
+
 void DeviceNeighbourList::upload(const World& world, const std::vector<Real>& half, Real floor) {
   const int n = world.size();
-  m_n = n;
   m_floor = floor;
   const size_t nn = static_cast<size_t>(std::max(n, 1));
   std::vector<unsigned char> always(nn, 0);
@@ -110,16 +124,7 @@ void DeviceNeighbourList::upload(const World& world, const std::vector<Real>& ha
   m_directList.ensure(static_cast<size_t>(m_alwaysDirectCount + NeighbourList::kMaxDirect));
   if (!alwaysList.empty())
     GEM_CUDA_CHECK(cudaMemcpy(m_directList.get(), alwaysList.data(), alwaysList.size() * sizeof(int), cudaMemcpyHostToDevice));
-  m_direct.ensure(nn), m_x0.ensure(nn), m_y0.ensure(nn), m_angle0.ensure(nn);
-  m_lo.ensure(nn), m_loSorted.ensure(nn), m_slot.ensure(nn), m_slotSorted.ensure(nn);
-  if (m_capacity == 0) m_capacity = 8 * n + 1024;  // grows in reserve() when a build needs more
-  m_pairs.ensure(static_cast<size_t>(m_capacity));
-  size_t bytes = 0;
-  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, m_lo.get(), m_loSorted.get(), m_slot.get(), m_slotSorted.get(),
-                                                 n, 0, static_cast<int>(sizeof(Real) * 8)));
-  m_temp.ensure(std::max<size_t>(bytes, 1));
-  m_tempBytes = bytes;
-  if (m_control.ensure(1)) GEM_CUDA_CHECK(cudaMemset(m_control.get(), 0, sizeof(ListControl)));
+  resize(n);
   markStale();  // slots may name other bodies now (NeighbourList::invalidate)
 }
 
@@ -145,6 +150,41 @@ void DeviceNeighbourList::reorder(const int* order, int n, cudaStream_t s) {
   alwaysDirectListKernel<<<blocksFor(n), kBlock, 0, s>>>(n, m_alwaysDirect.get(), m_directList.get(), m_alwaysFound.get());
   GEM_CUDA_CHECK_LAUNCH();
   GEM_CUDA_CHECK(cudaStreamSynchronize(s));
+  markStale();  // slots name other bodies now (NeighbourList::invalidate)
+}
+
+void DeviceNeighbourList::edited(const int* keptOrder, int kept, const std::vector<Real>& addedHalf,
+                                 const std::vector<unsigned char>& addedAlways, cudaStream_t s) {
+  const size_t before = static_cast<size_t>(m_n), added = addedHalf.size(), n = static_cast<size_t>(kept) + added;
+  m_halfBefore.ensure(std::max<size_t>(before, 1)), m_alwaysBefore.ensure(std::max<size_t>(before, 1)), m_alwaysFound.ensure(1);
+  if (before) {
+    GEM_CUDA_CHECK(cudaMemcpyAsync(m_halfBefore.get(), m_half.get(), before * sizeof(Real), cudaMemcpyDeviceToDevice, s));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(m_alwaysBefore.get(), m_alwaysDirect.get(), before, cudaMemcpyDeviceToDevice, s));
+  }
+  GEM_CUDA_CHECK(cudaStreamSynchronize(s));  // ensure() below may move the arrays just copied
+  m_half.ensure(std::max<size_t>(n, 1)), m_alwaysDirect.ensure(std::max<size_t>(n, 1));
+  if (kept > 0) {
+    gatherByOrderKernel<Real><<<blocksFor(kept), kBlock, 0, s>>>(kept, 1, keptOrder, m_halfBefore.get(), m_half.get());
+    GEM_CUDA_CHECK_LAUNCH();
+    gatherByOrderKernel<unsigned char><<<blocksFor(kept), kBlock, 0, s>>>(kept, 1, keptOrder, m_alwaysBefore.get(), m_alwaysDirect.get());
+    GEM_CUDA_CHECK_LAUNCH();
+  }
+  if (added) {
+    GEM_CUDA_CHECK(cudaMemcpyAsync(m_half.get() + kept, addedHalf.data(), added * sizeof(Real), cudaMemcpyHostToDevice, s));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(m_alwaysDirect.get() + kept, addedAlways.data(), added, cudaMemcpyHostToDevice, s));
+  }
+  // The always-direct slots, counted again (a wall or the vessel never breaks, but a plugin's
+  // topology event might add one).
+  int alwaysCount = 0;
+  GEM_CUDA_CHECK(cudaMemsetAsync(m_alwaysFound.get(), 0, sizeof(int), s));
+  m_directList.ensure(static_cast<size_t>(m_alwaysDirectCount) + added + NeighbourList::kMaxDirect);
+  alwaysDirectListKernel<<<blocksFor(static_cast<int>(n)), kBlock, 0, s>>>(static_cast<int>(n), m_alwaysDirect.get(), m_directList.get(),
+                                                                           m_alwaysFound.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  GEM_CUDA_CHECK(cudaMemcpyAsync(&alwaysCount, m_alwaysFound.get(), sizeof(int), cudaMemcpyDeviceToHost, s));
+  GEM_CUDA_CHECK(cudaStreamSynchronize(s));
+  m_alwaysDirectCount = alwaysCount;
+  resize(static_cast<int>(n));
   markStale();  // slots name other bodies now (NeighbourList::invalidate)
 }
 

@@ -92,6 +92,10 @@ class DeviceNeighbourList {
   // The bodies were permuted on the device (new slot k holds old slot order[k]): the per-body
   // inputs follow them and the list is rebuilt at the next step (as after an upload).
   void reorder(const int* order, int n, cudaStream_t stream);
+  // A topology edit on the device (CudaBroadphase::edited): the survivors' inputs follow keptOrder,
+  // the new bodies' (half, always direct) are appended, and the list is rebuilt.
+  void edited(const int* keptOrder, int kept, const std::vector<Real>& addedHalf, const std::vector<unsigned char>& addedAlways,
+              cudaStream_t stream);
   void reserve();
   long rebuilds() const;
   Real skin() const { return m_skin; }
@@ -113,6 +117,7 @@ class DeviceNeighbourList {
  private:
   ListView view();
   void markStale();
+  void resize(int n);  // per-body storage and the sort's scratch for n bodies
 
   Real m_skin;
   int m_n = 0, m_alwaysDirectCount = 0, m_capacity = 0;
@@ -128,6 +133,16 @@ class DeviceNeighbourList {
   DeviceArray<unsigned char> m_alwaysBefore;
   DeviceArray<int> m_alwaysFound;
 };
+
+// The kept list's inputs for the bodies a topology edit appended (rows [first, world.size())):
+// half = R + skin / 2, and whether the body is always direct (not a floe).
+inline void appendedListInputs(const World& world, int first, Real skin, std::vector<Real>& half, std::vector<unsigned char>& always) {
+  half.clear(), always.clear();
+  for (int i = first; i < world.size(); ++i) {
+    half.push_back(world.radius[i] + skin / 2);
+    always.push_back(world.kind[i] != BodyKind::Floe ? 1 : 0);
+  }
+}
 
 // Row k of `to` becomes row order[k] of `from`, width values a row (a strategy's per-body storage
 // following a re-sort of the bodies on the device).

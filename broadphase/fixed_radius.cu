@@ -22,6 +22,14 @@ class DeviceFixedRadius final : public CudaBroadphase {
     m_list.reorder(order, n, stream);
     return true;
   }
+  bool edited(const int* keptOrder, int kept, const World& after, int firstAdded, cudaStream_t stream) override {
+    // The global radius stays: pieces are smaller than their floe, so it is still large enough.
+    std::vector<Real> half;
+    std::vector<unsigned char> always;
+    appendedListInputs(after, firstAdded, m_list.skin(), half, always);
+    m_list.edited(keptOrder, kept, half, always, stream);
+    return true;
+  }
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
     m_list.enqueue(bodies, sink, stream, AcceptAll{});
   }

@@ -60,6 +60,7 @@ class DeviceTriangulationMesh final : public CudaBroadphase {
   explicit DeviceTriangulationMesh(const BroadphaseSettings& s) : m_list(checkedSettings(s).skin) {}
   void upload(const World& world) override {
     const int n = world.size();
+    m_rows = n;
     std::vector<Real> half(world.radius.begin(), world.radius.end());
     for (Real& h : half) h += m_list.skin() / 2;
     m_list.upload(world, half, 0);
@@ -87,6 +88,42 @@ class DeviceTriangulationMesh final : public CudaBroadphase {
     GEM_CUDA_CHECK(cudaStreamSynchronize(stream));
     return true;
   }
+  bool edited(const int* keptOrder, int kept, const World& after, int firstAdded, cudaStream_t stream) override {
+    std::vector<Real> half;
+    std::vector<unsigned char> always;
+    appendedListInputs(after, firstAdded, m_list.skin(), half, always);
+    m_list.edited(keptOrder, kept, half, always, stream);
+    // The survivors' triangles follow them; only the new bodies are ear-clipped (on the host).
+    const long long width = kMaxTriangles * 3, added = after.size() - firstAdded, n = kept + added;
+    const long long before = static_cast<long long>(m_rows);
+    m_countBefore.ensure(static_cast<size_t>(std::max(before, 1LL))), m_trianglesBefore.ensure(static_cast<size_t>(std::max(before, 1LL) * width));
+    if (before) {
+      GEM_CUDA_CHECK(cudaMemcpyAsync(m_countBefore.get(), m_count.get(), before * sizeof(int), cudaMemcpyDeviceToDevice, stream));
+      GEM_CUDA_CHECK(cudaMemcpyAsync(m_trianglesBefore.get(), m_triangles.get(), before * width * sizeof(int), cudaMemcpyDeviceToDevice, stream));
+    }
+    GEM_CUDA_CHECK(cudaStreamSynchronize(stream));  // ensure() below may move the arrays just copied
+    m_count.ensure(static_cast<size_t>(std::max(n, 1LL))), m_triangles.ensure(static_cast<size_t>(std::max(n, 1LL) * width));
+    if (kept > 0) {
+      gatherByOrderKernel<int><<<blocksFor(kept), kBlock, 0, stream>>>(kept, 1, keptOrder, m_countBefore.get(), m_count.get());
+      GEM_CUDA_CHECK_LAUNCH();
+      gatherByOrderKernel<int><<<static_cast<unsigned>((kept * width + kBlock - 1) / kBlock), kBlock, 0, stream>>>(
+          kept * width, static_cast<int>(width), keptOrder, m_trianglesBefore.get(), m_triangles.get());
+      GEM_CUDA_CHECK_LAUNCH();
+    }
+    if (added > 0) {
+      std::vector<int> count(static_cast<size_t>(added)), triangles(static_cast<size_t>(added * width), 0);
+      for (int k = 0; k < added; ++k) {
+        const int i = firstAdded + k;
+        count[k] = earClip(after.local(i), after.vertexCount[i], reinterpret_cast<int(*)[3]>(&triangles[static_cast<size_t>(k * width)]));
+      }
+      GEM_CUDA_CHECK(cudaMemcpyAsync(m_count.get() + kept, count.data(), count.size() * sizeof(int), cudaMemcpyHostToDevice, stream));
+      GEM_CUDA_CHECK(cudaMemcpyAsync(m_triangles.get() + kept * width, triangles.data(), triangles.size() * sizeof(int),
+                                     cudaMemcpyHostToDevice, stream));
+    }
+    GEM_CUDA_CHECK(cudaStreamSynchronize(stream));
+    m_rows = static_cast<int>(n);
+    return true;
+  }
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
     m_list.enqueue(bodies, sink, stream, TrianglesOverlap{m_count.get(), m_triangles.get()});
   }
@@ -95,7 +132,8 @@ class DeviceTriangulationMesh final : public CudaBroadphase {
  private:
   DeviceNeighbourList m_list;
   DeviceArray<int> m_count, m_triangles;
-  DeviceArray<int> m_countBefore, m_trianglesBefore;  // reorder()'s copies
+  DeviceArray<int> m_countBefore, m_trianglesBefore;  // reorder()'s and edited()'s copies
+  int m_rows = 0;  // bodies the triangle arrays hold
 };
 
 }  // namespace

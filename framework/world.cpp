@@ -1,6 +1,8 @@
 #include "framework/world.hpp"
 
 #include <algorithm>
+#include <functional>
+#include <thread>
 #include <cmath>
 #include <stdexcept>
 
@@ -71,14 +73,24 @@ static void keepIf(std::vector<T>& v, const std::vector<char>& remove, size_t fi
 void World::removeBodies(const std::vector<char>& remove) {
   const size_t f = static_cast<size_t>(std::find_if(remove.begin(), remove.end(), [](char r) { return r != 0; }) - remove.begin());
   if (f == remove.size()) return;
-  keepIf(id, remove, f); keepIf(kind, remove, f); keepIf(vertexCount, remove, f);
+  std::vector<std::function<void()>> small = {[&] { keepIf(id, remove, f); }, [&] { keepIf(kind, remove, f); },
+                                              [&] { keepIf(vertexCount, remove, f); }};
+  for (std::vector<Real>* v : {&x, &y, &angle, &vx, &vy, &omega, &area, &thickness, &mass, &invMass, &invInertia, &gyration2,
+                               &gyrationX2, &gyrationY2, &principalAngle, &radius})
+    small.push_back([v, &remove, f] { keepIf(*v, remove, f); });
+  // A break in a world of 10^5 floes or more: the vertices (60 % of the bytes) are compacted while
+  // helper threads do the other arrays (at 10^6 floes one thread took 84 ms a break).
+  const size_t moved = remove.size() - f;
+  const unsigned helpers = moved < 100000 ? 0u : std::min(3u, std::max(1u, std::thread::hardware_concurrency()) - 1);
+  std::vector<std::thread> threads;
+  for (unsigned t = 0; t < helpers; ++t)
+    threads.emplace_back([&small, t, helpers] {
+      for (size_t a = t; a < small.size(); a += helpers) small[a]();
+    });
   keepIf(localVertices, remove, f, kMaxVertices);
-  keepIf(x, remove, f); keepIf(y, remove, f); keepIf(angle, remove, f);
-  keepIf(vx, remove, f); keepIf(vy, remove, f); keepIf(omega, remove, f);
-  keepIf(area, remove, f); keepIf(thickness, remove, f); keepIf(mass, remove, f);
-  keepIf(invMass, remove, f); keepIf(invInertia, remove, f);
-  keepIf(gyration2, remove, f); keepIf(gyrationX2, remove, f); keepIf(gyrationY2, remove, f);
-  keepIf(principalAngle, remove, f); keepIf(radius, remove, f);
+  if (helpers == 0)
+    for (auto& compact : small) compact();
+  for (std::thread& t : threads) t.join();
 }
 
 template <class T>

@@ -180,13 +180,6 @@ void CudaSimulation::runTopology() {
   Stopwatch clock;
   ++m_times.topologies;
   World& w = world();
-  if (m_device->broadphase() && !m_pendingOrder.empty()) {
-    // A device strategy rebuilds its per-body storage from the edited mirror (editBodies), which
-    // must then be in the device's order: the re-sort's order is applied to the mirror first.
-    w.permute(m_pendingOrder);
-    m_pendingOrder.clear();
-    m_slotOfId.clear();
-  }
   const std::vector<int>& slotOf = slotOfId();
   std::vector<int> deviceSlots, hostSlots;
   for (const BreakRequest& b : m_breaks) {
@@ -234,7 +227,7 @@ void CudaSimulation::runTopology() {
     throw std::logic_error("CUDA backend: a topology event reordered the bodies (only World::removeBodies and World::addBody may change them)");
   std::sort(removedDevice.begin(), removedDevice.end());
   m_times.bookkeeping += clock.lap();
-  m_device->editBodies(removedDevice, w, firstAdded, scenario().vessel.dof);
+  const bool broadphaseFollowed = m_device->editBodies(removedDevice, w, firstAdded, scenario().vessel.dof);
   m_times.edit += clock.lap();
 
   // The mirror's order after a device re-sort: device slot j (a survivor) held device slot
@@ -254,6 +247,13 @@ void CudaSimulation::runTopology() {
     }
     for (int k = firstAdded; k < w.size(); ++k) composed.push_back(k);
     m_pendingOrder.swap(composed);
+  }
+  if (!broadphaseFollowed) {
+    // A strategy that cannot follow the edit on the device (a plugin's, say) rebuilds from the
+    // mirror, which must then be in the device's order.
+    if (!m_pendingOrder.empty()) w.permute(m_pendingOrder);
+    m_pendingOrder.clear();
+    m_device->uploadBroadphase(w);
   }
   m_slotOfId.clear();
   if (m_vesselSlot >= 0) m_vesselSlot = slotOfId()[static_cast<size_t>(m_vesselId)];

@@ -87,6 +87,16 @@ class CudaBroadphase {
     (void)order, (void)n, (void)stream;
     return false;
   }
+  // Host, outside the graph: a topology edit replayed on the device (breaks): slot k < kept now
+  // holds old slot keptOrder[k] (a device array), and after the survivors come the new bodies,
+  // which are rows [firstAdded, after.size()) of the host world `after` (in that order; the rows
+  // before firstAdded may be in another order than the device's). Return true once the strategy's
+  // per-body storage follows; false (the default) makes the host put its world in the device's
+  // order and call upload() with it.
+  virtual bool edited(const int* keptOrder, int kept, const World& after, int firstAdded, cudaStream_t stream) {
+    (void)keptOrder, (void)kept, (void)after, (void)firstAdded, (void)stream;
+    return false;
+  }
   virtual void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) = 0;
   // How many times a kept structure was (re)built (reads the device: host, between steps).
   virtual long rebuilds() const { return 0; }

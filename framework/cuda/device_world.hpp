@@ -65,8 +65,11 @@ class DeviceWorld {
   // A topology edit, replayed on the device without moving the world: the bodies at removedSlots
   // (ascending) leave, the others keep their order and their state, and the bodies after[firstAdded..]
   // (made on the host by World::addBody) are appended. `after` is the host world after the same
-  // edit; a device broadphase rebuilds from it, so it must then be in the device's order.
-  void editBodies(const std::vector<int>& removedSlots, const World& after, int firstAdded, int vesselDof);
+  // edit. Returns false when the device broadphase could not follow (CudaBroadphase::edited): the
+  // caller then hands it the world in the device's order (uploadBroadphase).
+  bool editBodies(const std::vector<int>& removedSlots, const World& after, int firstAdded, int vesselDof);
+  // The device broadphase rebuilds its per-body storage from the host world (in the device's order).
+  void uploadBroadphase(const World& world);
   // Steps kept on the device between two copies to the host (the ring's length), and threads per
   // block of the per-body and per-contact kernels. Before the first run.
   void configure(int copyBackEvery, int blockSize);

@@ -238,12 +238,13 @@ TEST(CudaBackend, RepeatedRunIsBitIdentical) {
 
 // Breaking on the device: the edit replayed there (survivors compacted, new floes appended) must
 // give exactly what the whole-world round trip gives (download, cut on the host, upload), over 400
-// steps with breaks before and after the re-sort at step 200; with the built-in grid (whose re-sort
-// runs on the device and leaves the host mirror in the old order) and with a kept-list strategy.
+// steps with breaks before and after the re-sort at step 200 (which runs on the device and leaves
+// the host mirror in the old order); with the built-in grid and with every kept-list strategy
+// (which follow the edit on the device: CudaBroadphase::edited).
 TEST(CudaBackend, BreaksOnTheDeviceMatchTheWholeWorldRoundTrip) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
-  for (const char* broadphase : {"uniform_grid", "variable_radius"}) {
+  for (const char* broadphase : {"uniform_grid", "variable_radius", "fixed_radius", "triangulation_mesh"}) {
     SCOPED_TRACE(broadphase);
     Scenario s = test::scenarioFromToml(dir, kBreakingScene);
     s.broadphase = broadphase;
