@@ -104,4 +104,5 @@ grep -E '"backend"|"device"|"impacts"|"steps"|"wall_time_s"' "$out/random_50/sum
 exit $status
 RUN
 chmod +x "$stage/run.sh"
+cp "$root/scripts/gpu-record.sh" "$stage/record.sh"  # the README's record run (bench tables, ncu, host timing)
 du -sh "$stage"

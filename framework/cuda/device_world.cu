@@ -490,7 +490,11 @@ __global__ void narrowphaseKernel(int capacity, const int* needed, const int* ca
     stats->candidates = count;
     stats->overflow = total > capacity ? 1 : 0;
   }
-  if (p >= count) {
+  // A step whose candidates passed the capacity is redone with more room, and its candidate list
+  // may hold entries no one wrote (a strategy that ran out of its own room, grid rows that did not
+  // fit): it tests nothing. (Reading them once read far out of bounds, when the memory had held
+  // another run's data.)
+  if (p >= count || total > capacity) {
     flag[p] = 0;
     return;
   }

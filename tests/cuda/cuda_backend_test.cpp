@@ -423,6 +423,33 @@ TEST(CudaBackend, CandidateOverflowIsRedoneBitIdentically) {
   EXPECT_GT(roomy.candidateCount(), 8);
 }
 
+// A step past the candidate capacity is redone, and until then its candidate list holds entries
+// nobody wrote (grid rows that did not fit, a kept list out of room). They must not be read: with
+// the device memory first filled with 0xff (what another run could have left there), such a read
+// goes far out of bounds. Each strategy family: the grid's rows, and a kept list with the sink.
+TEST(CudaBackend, OverflowedStepReadsNoUnwrittenCandidates) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  for (const char* broadphase : {"uniform_grid", "fixed_radius"}) {
+    SCOPED_TRACE(broadphase);
+    Scenario s = test::scenarioFromToml(dir, kBusyScene);
+    s.broadphase = broadphase;
+    CudaSimulation roomy(s);
+    const State a = run(roomy, 60);
+    void* junk = nullptr;
+    const size_t bytes = size_t(1) << 28;
+    ASSERT_EQ(cudaSuccess, cudaMalloc(&junk, bytes));
+    ASSERT_EQ(cudaSuccess, cudaMemset(junk, 0xff, bytes));
+    ASSERT_EQ(cudaSuccess, cudaFree(junk));  // the allocations below reuse it
+    ::setenv("GEM_CUDA_CAPACITY", "8", 1);
+    CudaSimulation cramped(s);
+    ::unsetenv("GEM_CUDA_CAPACITY");
+    const State b = run(cramped, 60);
+    ASSERT_EQ(a.ids, b.ids);
+    EXPECT_EQ(0, std::memcmp(a.values.data(), b.values.data(), a.values.size() * sizeof(Real)));
+  }
+}
+
 // A plugin's event has no CUDA driver: asked for by name, cuda refuses it clearly; with "auto"
 // the run goes to the CPU. (Made here as an entry of a non-built-in origin, as a plugin's would be.)
 namespace {
