@@ -78,6 +78,30 @@ class DeviceBuffer {
   size_t m_capacity = 0;
 };
 
+// Scratch for the re-sort and the topology edits, outside the DeviceBuffers: growing it must not
+// look like a change of the graph's buffers. It grows with room to spare: a break adds a body or
+// two, and a cudaFree on each would wait for the whole device (every other simulation's stream).
+struct ReorderScratch {
+  void* data = nullptr;
+  size_t bytes = 0;
+  ReorderScratch() = default;
+  ReorderScratch(const ReorderScratch&) = delete;
+  ReorderScratch& operator=(const ReorderScratch&) = delete;
+  ~ReorderScratch() {
+    if (data) cudaFree(data);
+  }
+  void* get(size_t need) {
+    if (need > bytes) {
+      if (data) GEM_CUDA_CHECK(cudaFree(data));
+      data = nullptr;
+      const size_t capacity = need + need / 2 + 4096;
+      GEM_CUDA_CHECK(cudaMalloc(&data, capacity));
+      bytes = capacity;
+    }
+    return data;
+  }
+};
+
 // What the host sets before each launch of the step graph (pinned; the graph's first node copies it).
 struct BatchControl {
   long firstStep;  // index of the batch's first step
@@ -178,6 +202,14 @@ struct DeviceState {
   BatchControl* h_control = nullptr;  // pinned: the graph's first node copies it to control
   StepRecord* h_ring = nullptr;       // pinned, ringSize records
   DeviceBuffer<unsigned char> temp;  // CUB scratch, sized before capture
+  // Topology edits and the rows they fetch: kept here, because a cudaFree waits for the whole
+  // device, every other simulation's stream included (a sweep runs many at once).
+  DeviceBuffer<int> editRemoved, editOrder, fetchSlots;
+  DeviceBuffer<Real> fetchRows;
+  DeviceBuffer<Real> resortBounds;  // the re-sort along the curve's, likewise
+  DeviceBuffer<unsigned> resortKeys, resortKeysSorted;
+  DeviceBuffer<int> resortSlots, resortSlotsSorted;
+  ReorderScratch permuteScratch, sortScratch;
   size_t tempBytes = 0;
   int capacity = 0;  // candidate (and contact) capacity the graph was captured for
   cudaStream_t stream = nullptr;
@@ -807,24 +839,6 @@ void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
 
 namespace {
 
-// Scratch for the re-sort, outside the DeviceBuffers: growing it must not look like a change of
-// the graph's buffers.
-struct ReorderScratch {
-  void* data = nullptr;
-  size_t bytes = 0;
-  ~ReorderScratch() {
-    if (data) cudaFree(data);
-  }
-  void* get(size_t need) {
-    if (need > bytes) {
-      if (data) GEM_CUDA_CHECK(cudaFree(data));
-      data = nullptr;
-      GEM_CUDA_CHECK(cudaMalloc(&data, need));
-      bytes = need;
-    }
-    return data;
-  }
-};
 
 __global__ void curveKeyKernel(int n, const Real* x, const Real* y, const Real* bounds, unsigned* key, int* slot) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
@@ -897,9 +911,10 @@ std::vector<int> DeviceWorld::reorderAlongCurve(bool* broadphaseFollowed) {
     return order;
   }
   cudaStream_t s = d.stream;
-  static thread_local ReorderScratch scratch, sortScratch;
+  ReorderScratch& scratch = d.permuteScratch;
+  ReorderScratch& sortScratch = d.sortScratch;
   // The centroids' box: exact (min and max round nothing), as the host's loop.
-  DeviceBuffer<Real> bounds;
+  DeviceBuffer<Real>& bounds = d.resortBounds;
   bounds.ensure(4);
   size_t bytes = 0;
   GEM_CUDA_CHECK(cub::DeviceReduce::Min(nullptr, bytes, d.x.get(), bounds.get(), n, s));
@@ -909,8 +924,10 @@ std::vector<int> DeviceWorld::reorderAlongCurve(bool* broadphaseFollowed) {
   GEM_CUDA_CHECK(cub::DeviceReduce::Max(temp, bytes, d.x.get(), bounds.get() + 2, n, s));
   GEM_CUDA_CHECK(cub::DeviceReduce::Max(temp, bytes, d.y.get(), bounds.get() + 3, n, s));
   // Keys, then a stable radix sort: ties keep slot order, as the host's sort of (key, slot) pairs.
-  DeviceBuffer<unsigned> keys, sortedKeys;
-  DeviceBuffer<int> slots, sortedSlots;
+  DeviceBuffer<unsigned>& keys = d.resortKeys;
+  DeviceBuffer<unsigned>& sortedKeys = d.resortKeysSorted;
+  DeviceBuffer<int>& slots = d.resortSlots;
+  DeviceBuffer<int>& sortedSlots = d.resortSlotsSorted;
   keys.ensure(n), sortedKeys.ensure(n), slots.ensure(n), sortedSlots.ensure(n);
   curveKeyKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.x.get(), d.y.get(), bounds.get(), keys.get(), slots.get());
   GEM_CUDA_CHECK_LAUNCH();
@@ -943,11 +960,11 @@ std::vector<int> DeviceWorld::reorderAlongCurve(bool* broadphaseFollowed) {
 }
 
 void DeviceWorld::downloadKinematics(const std::vector<int>& deviceSlots, const std::vector<int>& hostSlots, World& w) const {
-  const DeviceState& d = *m_state;
+  DeviceState& d = *m_state;
   const int count = static_cast<int>(deviceSlots.size());
   if (count == 0) return;
-  DeviceBuffer<int> slots;
-  DeviceBuffer<Real> rows;
+  DeviceBuffer<int>& slots = d.fetchSlots;
+  DeviceBuffer<Real>& rows = d.fetchRows;
   slots.upload(deviceSlots.data(), deviceSlots.size());
   rows.ensure(6 * deviceSlots.size());
   gatherKinematicsKernel<<<blocksFor(count), kBlock, 0, d.stream>>>(count, slots.get(), d.x.get(), d.y.get(), d.angle.get(), d.vx.get(),
@@ -970,11 +987,13 @@ bool DeviceWorld::editBodies(const std::vector<int>& removedSlots, const World& 
   if (kept != firstAdded || kept < 0 || added < 0)
     throw std::logic_error("DeviceWorld::editBodies: the edit does not match the device's bodies");
   cudaStream_t s = d.stream;
-  static thread_local ReorderScratch scratch;
+  ReorderScratch& scratch = d.permuteScratch;
 
   // The kept rows, in their order (a stable compaction), with room for the new ones after them.
-  DeviceBuffer<int> removed, order;
-  removed.upload(removedSlots.data(), removedSlots.size());
+  DeviceBuffer<int>& removed = d.editRemoved;
+  DeviceBuffer<int>& order = d.editOrder;
+  removed.ensure(std::max<size_t>(removedSlots.size(), 1));
+  removed.uploadAt(0, removedSlots.data(), removedSlots.size());
   order.ensure(static_cast<size_t>(std::max(kept, 1)));
   keptOrderKernel<<<blocksFor(before), kBlock, 0, s>>>(before, removed.get(), removedCount, order.get());
   GEM_CUDA_CHECK_LAUNCH();
@@ -1241,9 +1260,11 @@ void prepareBuffers(DeviceState& d) {
 void captureStep(DeviceState& d) {
   prepareBuffers(d);
   d.dropGraph();
-  // Every allocation and upload finished before the capture: compute-sanitizer otherwise reports
-  // reads of "not yet allocated" memory inside a WHILE body (NVIDIA/warp#1406), and a capture is rare.
-  GEM_CUDA_CHECK(cudaDeviceSynchronize());
+  // This stream's uploads and memsets finished before the capture: compute-sanitizer otherwise
+  // reports reads of "not yet allocated" memory inside a WHILE body (NVIDIA/warp#1406). Only this
+  // stream: a device-wide sync would also wait on (and so invalidate) another thread's capture
+  // (a sweep runs several simulations on one device).
+  GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
   cudaGraph_t graph = nullptr;
   GEM_CUDA_CHECK(cudaGraphCreate(&graph, 0));
   struct Owned {
