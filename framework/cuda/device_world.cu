@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <iterator>
 #include <stdexcept>
+#include <string>
 
 #include "framework/cuda/cuda_check.hpp"
 #include "geometry/contact.hpp"
@@ -278,9 +279,21 @@ struct PrepareArgs {
 
 // Phase 1 and the views: as Simulation::narrowphase's box loop and Simulation::step's view loops.
 // A body's rows (16 vertices, a PairBody, a SoloBody) are large, and a thread writing its own is a
-// strided pattern that wasted most of each memory transaction (0.92 ms of a 10^6-floe step): the
-// block stages them in shared memory and moves each block's rows as one contiguous run.
+// strided pattern that wastes most of each memory transaction (0.92 ms of a 10^6-floe step): on
+// large fields the block stages them in shared memory and moves each block's rows as one
+// contiguous run. On small ones the staging's barriers cost more than they save (14 -> 27 us at
+// 824 floes), and each thread writes its own rows.
 constexpr int kPrepareBlock = 128;
+constexpr int kStagedPrepareFrom = 16384;  // bodies
+
+// GEM_CUDA_PREPARE = staged or direct overrides the choice (tests compare the two). Read when the
+// step is enqueued: once per capture.
+static bool stagedPrepare(int n) {
+  const char* v = std::getenv("GEM_CUDA_PREPARE");
+  if (v && std::string(v) == "staged") return true;
+  if (v && std::string(v) == "direct") return false;
+  return n >= kStagedPrepareFrom;
+}
 
 // The block's `count` consecutive rows of T between global memory and shared memory, 8 bytes a
 // thread at a time (every staged type holds doubles, so is a multiple of 8 bytes).
@@ -293,7 +306,24 @@ __device__ void copyRows(T* to, const T* from, int count) {
   for (int w = threadIdx.x; w < words; w += blockDim.x) d[w] = f[w];
 }
 
-__global__ void __launch_bounds__(kPrepareBlock) prepareKernel(PrepareArgs a) {
+__global__ void prepareDirectKernel(PrepareArgs a) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= a.n) return;
+  Vec2* v = a.worldVertices + static_cast<size_t>(i) * kMaxVertices;
+  const int count = a.vertexCount[i];
+  toWorld(a.local + static_cast<size_t>(i) * kMaxVertices, count, Vec2{a.x[i], a.y[i]}, a.angle[i], v);
+  const Box box = boundingBox(v, count);
+  a.boxes[i] = box;
+  const PairBody b = pairBodyOf(a, i, a.dof[i], v, count);
+  a.pairBodies[i] = b;
+  a.soloBodies[i] = SoloBody{b.kind, b.dof, b.position, b.angle, b.velocity, b.omega, b.mass, b.area, b.thickness};
+  a.changes[i] = VelocityChange{{0, 0}, 0};
+  // A small body lives in the cell of its box's lower-left corner; large ones stay out of the grid.
+  a.cellKey[i] = a.isLarge[i] ? a.largeKey : cellHash(cellCoord(box.x0, a.cell), cellCoord(box.y0, a.cell), a.mask);
+  a.slot[i] = i;
+}
+
+__global__ void __launch_bounds__(kPrepareBlock) prepareStagedKernel(PrepareArgs a) {
   // Vertex rows, then PairBody rows, then SoloBody rows: one buffer, used in turn.
   constexpr size_t kRowBytes = sizeof(Vec2) * kMaxVertices > sizeof(PairBody) ? sizeof(Vec2) * kMaxVertices : sizeof(PairBody);
   __shared__ alignas(16) unsigned char staging[kPrepareBlock * kRowBytes];
@@ -1129,7 +1159,8 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
                 d.invMass.get(), d.invInertia.get(), d.gyration2.get(), d.gyrationX2.get(), d.gyrationY2.get(),
                 d.principalAngle.get(), d.isLarge.get(), d.cell, d.tableSize - 1, largeKey, d.worldVertices.get(), d.boxes.get(),
                 d.pairBodies.get(), d.soloBodies.get(), d.changes.get(), d.cellKey.get(), d.slot.get()};
-  prepareKernel<<<blocksFor(n, kPrepareBlock), kPrepareBlock, 0, s>>>(a);  // shared-memory staging: a fixed block
+  if (stagedPrepare(n)) prepareStagedKernel<<<blocksFor(n, kPrepareBlock), kPrepareBlock, 0, s>>>(a);  // a fixed block
+  else prepareDirectKernel<<<blocksFor(n, block), block, 0, s>>>(a);
   GEM_CUDA_CHECK_LAUNCH();
 
   // 2. Broadphase. A device strategy (device_broadphase.hpp) emits keys in any order; they are

@@ -437,6 +437,26 @@ TEST(CudaBackend, ConcurrentRunsOnOneDeviceAreIndependent) {
   }
 }
 
+// Phase 1 on large fields stages each block's rows in shared memory, on small ones each thread
+// writes its own (GEM_CUDA_PREPARE forces either): the two give the same run bit for bit.
+TEST(CudaBackend, StagedPrepareChangesNothing) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  const Scenario s = test::scenarioFromToml(dir, kBusyScene);
+  State results[2];
+  const char* modes[] = {"direct", "staged"};
+  for (int m = 0; m < 2; ++m) {
+    ::setenv("GEM_CUDA_PREPARE", modes[m], 1);
+    CudaSimulation sim(s);
+    results[m] = run(sim, 150);
+    ::unsetenv("GEM_CUDA_PREPARE");
+  }
+  ASSERT_EQ(results[0].ids, results[1].ids);
+  EXPECT_EQ(0, std::memcmp(results[0].values.data(), results[1].values.data(), results[0].values.size() * sizeof(Real)));
+  EXPECT_EQ(results[0].impacts, results[1].impacts);
+  EXPECT_GT(results[0].broken, 0);
+}
+
 // A candidate list past its capacity makes the step run again with more room: same result bit for bit.
 TEST(CudaBackend, CandidateOverflowIsRedoneBitIdentically) {
   GEM_SKIP_WITHOUT_CUDA();
