@@ -1,7 +1,8 @@
 // fixed_radius on the device: fixed_radius.cpp's kept list (centroids within one global radius,
 // default 2 x the largest floe radius + skin, or R_a + R_b + skin where that is larger), built,
 // checked and filtered on the device by device_neighbour_list.cuh. The global radius is fixed at
-// each upload (the largest floe changes only when the topology does, and that uploads).
+// each upload; a break keeps it (every pair's reach is at least R_a + R_b + skin, which covers any
+// piece, whatever the largest floe is now).
 #include "broadphase/device_neighbour_list.cuh"
 #include "framework/registry.hpp"
 
@@ -23,7 +24,7 @@ class DeviceFixedRadius final : public CudaBroadphase {
     return true;
   }
   bool edited(const int* keptOrder, int kept, const World& after, int firstAdded, cudaStream_t stream) override {
-    // The global radius stays: pieces are smaller than their floe, so it is still large enough.
+    // The global radius stays: the R_a + R_b + skin reach covers the pieces (see the top).
     std::vector<Real> half;
     std::vector<unsigned char> always;
     appendedListInputs(after, firstAdded, m_list.skin(), half, always);

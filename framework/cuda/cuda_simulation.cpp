@@ -367,7 +367,7 @@ void CudaSimulation::step() {
   }
 }
 
-// Every 200 steps (MODEL.md 9: neighbours in space become neighbours in memory).
+// Every 200 steps (DESIGN.md "Speed habits": neighbours in space become neighbours in memory).
 void CudaSimulation::reSortAlongCurve() {
   // On the device, bit for bit as the host's World::curveOrder + World::permute; the mirror follows
   // lazily (m_pendingOrder). At 10^6 floes a round trip through the host (download, sort, permute,

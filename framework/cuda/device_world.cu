@@ -869,7 +869,6 @@ void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
 
 namespace {
 
-
 __global__ void curveKeyKernel(int n, const Real* x, const Real* y, const Real* bounds, unsigned* key, int* slot) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
