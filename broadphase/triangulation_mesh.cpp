@@ -10,43 +10,19 @@
 //
 // Per step: world vertices of a body are computed at most once (lazily, only for bodies in a
 // circle-overlapping pair), and a triangle is tested only when its box meets the other body's box.
-// The overlap test is conservative within eps = kEpsRel x (size + distance from the origin), so
-// rounding in the placement can never drop a pair whose polygons touch.
+// The overlap test and its eps are broadphase/triangle_overlap.hpp's (shared with the device part).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
 
 #include "broadphase/neighbour_list.hpp"
+#include "broadphase/triangle_overlap.hpp"
 #include "framework/registry.hpp"
 #include "geometry/triangulate.hpp"
 
 namespace gem {
 namespace {
-
-constexpr int kMaxTriangles = kMaxVertices - 2;
-#if defined(GEM_REAL_FLOAT)
-constexpr Real kEpsRel = Real(1e-5);
-#else
-constexpr Real kEpsRel = Real(1e-9);
-#endif
-
-struct Box {
-  Real lox, loy, hix, hiy;
-};
-
-inline bool boxesMeet(const Box& p, const Box& q, Real eps) {
-  return p.lox <= q.hix + eps && q.lox <= p.hix + eps && p.loy <= q.hiy + eps && q.loy <= p.hiy + eps;
-}
-
-inline Box boxOf(const Vec2* v, int n) {
-  Box b{v[0].x, v[0].y, v[0].x, v[0].y};
-  for (int k = 1; k < n; ++k) {
-    b.lox = std::min(b.lox, v[k].x), b.hix = std::max(b.hix, v[k].x);
-    b.loy = std::min(b.loy, v[k].y), b.hiy = std::max(b.hiy, v[k].y);
-  }
-  return b;
-}
 
 struct TriangleSet {
   int count;
@@ -81,7 +57,7 @@ class TriangulationMesh final : public KeptListBroadphase {
     for (const CandidatePair& p : m_circles) {
       place(world, p.a);
       place(world, p.b);
-      const Real eps = kEpsRel * (world.radius[p.a] + world.radius[p.b] + std::fabs(x[p.a]) + std::fabs(y[p.a]));
+      const Real eps = triangleTestEps(world.radius[p.a], world.radius[p.b], x[p.a], y[p.a]);
       if (!boxesMeet(m_box[p.a], m_box[p.b], eps)) continue;
       if (trianglesMeet(p.a, p.b, eps)) pairs.push_back({p.a, p.b});
     }
@@ -126,7 +102,7 @@ class TriangulationMesh final : public KeptListBroadphase {
     Vec2* v = &m_world[m_vertStart[i]];
     const int n = world.vertexCount[i];
     toWorld(world.local(i), n, world.position(i), world.angle[i], v);
-    m_box[i] = boxOf(v, n);
+    m_box[i] = boundingBox(v, n);
   }
 
   // Any triangle of a meets any triangle of b? Only the triangles whose boxes meet the other body's
@@ -138,7 +114,7 @@ class TriangulationMesh final : public KeptListBroadphase {
       for (int t = m_triStart[body]; t < m_triStart[body + 1]; ++t) {
         const int* k = &m_tri[static_cast<size_t>(t) * 3];
         Vec2 tri[3] = {v[k[0]], v[k[1]], v[k[2]]};
-        if (!boxesMeet(boxOf(tri, 3), other, eps)) continue;
+        if (!boxesMeet(boundingBox(tri, 3), other, eps)) continue;
         std::copy(tri, tri + 3, out[count++]);
       }
       return count;

@@ -1,29 +1,20 @@
 // triangulation_mesh on the device. What runs where:
-//   host, at each upload (set-up, breaks, re-sorts): every polygon is ear-clipped in its body frame
-//     (geometry/triangulate.hpp, the CPU's very function) and the index triples are copied over;
+//   host, at an upload (set-up), and for the new floes of a break: polygons are ear-clipped in
+//     their body frame (geometry/triangulate.hpp, the CPU's very function) and the index triples
+//     copied over; a re-sort or a break moves the others' triples on the device;
 //   device, every step: the variable_radius kept list of device_neighbour_list.cuh (same skin, same
 //     rebuild rule, as triangulation_mesh.cpp), and on each pair whose circles overlap the
 //     triangle test of triangulation_mesh.cpp: boxes within eps, then any triangle of one whose box
 //     meets the other's box overlapping any such triangle of the other (trianglesOverlap, GEM_HD),
 //     the world vertices being the step's own (phase 1).
-// The eps is the CPU's: conservative within kEpsRel x (size + distance from the origin).
+// The eps and the box test are the CPU's (broadphase/triangle_overlap.hpp).
 #include "broadphase/device_neighbour_list.cuh"
+#include "broadphase/triangle_overlap.hpp"
 #include "framework/registry.hpp"
 #include "geometry/triangulate.hpp"
 
 namespace gem::cuda {
 namespace {
-
-constexpr int kMaxTriangles = kMaxVertices - 2;
-#if defined(GEM_REAL_FLOAT)
-constexpr Real kEpsRel = Real(1e-5);
-#else
-constexpr Real kEpsRel = Real(1e-9);
-#endif
-
-__device__ inline bool boxesMeet(const Box& p, const Box& q, Real eps) {
-  return p.x0 <= q.x1 + eps && q.x0 <= p.x1 + eps && p.y0 <= q.y1 + eps && q.y0 <= p.y1 + eps;
-}
 
 struct TrianglesOverlap {
   const int* triangleCount;  // per body
@@ -37,7 +28,7 @@ struct TrianglesOverlap {
   }
   __device__ bool operator()(const BroadphaseBodies& b, int i, int j) const {
     const int p = i < j ? i : j, q = i < j ? j : i;  // the CPU's eps is taken at the pair's a
-    const Real eps = kEpsRel * (b.radius[p] + b.radius[q] + fabs(b.x[p]) + fabs(b.y[p]));
+    const Real eps = triangleTestEps(b.radius[p], b.radius[q], b.x[p], b.y[p]);
     if (!boxesMeet(b.boxes[p], b.boxes[q], eps)) return false;
     for (int s = 0; s < triangleCount[p]; ++s) {
       Vec2 tp[3];
