@@ -80,11 +80,10 @@ __global__ void listSweepKernel(ListView list, BroadphaseBodies b) {
   }
 }
 
-void enqueueListBuild(const ListView& list, const BroadphaseBodies& bodies, void* temp, size_t tempBytes, cudaStream_t s) {
+// The build proper (span, sort, reset, sweep): every step when launched one by one (each kernel
+// checks the rebuild flag), only when the flag is set inside a captured step.
+static void enqueueBuildSteps(const ListView& list, const BroadphaseBodies& bodies, void* temp, size_t tempBytes, cudaStream_t s) {
   const int n = bodies.n;
-  GEM_CUDA_CHECK(cudaMemsetAsync(&list.control->rebuild, 0, sizeof(int), s));
-  listCheckKernel<<<blocksFor(n), kBlock, 0, s>>>(list, bodies);
-  GEM_CUDA_CHECK_LAUNCH();
   listSpanKernel<<<blocksFor(n), kBlock, 0, s>>>(list, bodies);
   GEM_CUDA_CHECK_LAUNCH();
   GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp, tempBytes, list.lo, list.loSorted, list.slot, list.slotSorted, n, 0,
@@ -95,8 +94,55 @@ void enqueueListBuild(const ListView& list, const BroadphaseBodies& bodies, void
   GEM_CUDA_CHECK_LAUNCH();
 }
 
+// The IF node's condition: this step rebuilds.
+__global__ void setRebuildConditionKernel(cudaGraphConditionalHandle handle, const ListControl* control) {
+  cudaGraphSetConditional(handle, control->rebuild ? 1u : 0u);
+}
+
+void enqueueListBuild(const ListView& list, const BroadphaseBodies& bodies, void* temp, size_t tempBytes, cudaStream_t s,
+                      cudaStream_t side) {
+  const int n = bodies.n;
+  GEM_CUDA_CHECK(cudaMemsetAsync(&list.control->rebuild, 0, sizeof(int), s));
+  listCheckKernel<<<blocksFor(n), kBlock, 0, s>>>(list, bodies);
+  GEM_CUDA_CHECK_LAUNCH();
+  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
+  cudaGraph_t graph = nullptr;
+  GEM_CUDA_CHECK(cudaStreamGetCaptureInfo(s, &status, nullptr, &graph));
+  if (status != cudaStreamCaptureStatusActive || !side) {
+    enqueueBuildSteps(list, bodies, temp, tempBytes, s);
+    return;
+  }
+  // Captured: the build sits in an IF node, so a step that keeps its list skips the span, the
+  // sort of n keys and the sweep (17 us of a 824-floe step on an H200, and n-sized work at 10^6).
+  cudaGraphConditionalHandle handle;
+  GEM_CUDA_CHECK(cudaGraphConditionalHandleCreate(&handle, graph, 0, cudaGraphCondAssignDefault));
+  setRebuildConditionKernel<<<1, 1, 0, s>>>(handle, list.control);
+  GEM_CUDA_CHECK_LAUNCH();
+  const cudaGraphNode_t* dependencies = nullptr;
+  size_t dependencyCount = 0;
+  GEM_CUDA_CHECK(cudaStreamGetCaptureInfo(s, &status, nullptr, &graph, &dependencies, nullptr, &dependencyCount));
+  cudaGraphNodeParams params{};
+  params.type = cudaGraphNodeTypeConditional;
+  params.conditional.handle = handle;
+  params.conditional.type = cudaGraphCondTypeIf;
+  params.conditional.size = 1;
+  cudaGraphNode_t node;
+  GEM_CUDA_CHECK(cudaGraphAddNode(&node, graph, dependencies, nullptr, dependencyCount, &params));
+  GEM_CUDA_CHECK(cudaStreamUpdateCaptureDependencies(s, &node, nullptr, 1, cudaStreamSetCaptureDependencies));
+  cudaGraph_t body = params.conditional.phGraph_out[0];
+  GEM_CUDA_CHECK(cudaStreamBeginCaptureToGraph(side, body, nullptr, nullptr, 0, cudaStreamCaptureModeThreadLocal));
+  try {
+    enqueueBuildSteps(list, bodies, temp, tempBytes, side);
+  } catch (...) {
+    cudaStreamEndCapture(side, &body);
+    throw;
+  }
+  GEM_CUDA_CHECK(cudaStreamEndCapture(side, &body));
+}
+
 void DeviceNeighbourList::resize(int n) {
   m_n = n;
+  if (!m_side) GEM_CUDA_CHECK(cudaStreamCreateWithFlags(&m_side, cudaStreamNonBlocking));
   const size_t nn = static_cast<size_t>(std::max(n, 1));
   m_direct.ensure(nn), m_x0.ensure(nn), m_y0.ensure(nn), m_angle0.ensure(nn);
   m_lo.ensure(nn), m_loSorted.ensure(nn), m_slot.ensure(nn), m_slotSorted.ensure(nn);
@@ -187,6 +233,8 @@ void DeviceNeighbourList::edited(const int* keptOrder, int kept, const std::vect
   resize(static_cast<int>(n));
   markStale();  // slots name other bodies now (NeighbourList::invalidate)
 }
+
+cudaStream_t DeviceNeighbourList::sideStream() { return m_side; }
 
 void DeviceNeighbourList::markStale() { GEM_CUDA_CHECK(cudaMemset(&m_control.get()->valid, 0, sizeof(int))); }
 

@@ -50,7 +50,9 @@ struct ListView {
   int *slot, *slotSorted;
 };
 
-void enqueueListBuild(const ListView& list, const BroadphaseBodies& bodies, void* temp, size_t tempBytes, cudaStream_t stream);
+// side: a stream of the list's own, on which a captured step's build is captured into an IF node.
+void enqueueListBuild(const ListView& list, const BroadphaseBodies& bodies, void* temp, size_t tempBytes, cudaStream_t stream,
+                      cudaStream_t side);
 
 #if defined(__CUDACC__)
 template <class Accept>
@@ -105,7 +107,7 @@ class DeviceNeighbourList {
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream, Accept accept) {
     if (bodies.n == 0) return;
     const ListView list = view();
-    enqueueListBuild(list, bodies, m_temp.get(), m_tempBytes, stream);
+    enqueueListBuild(list, bodies, m_temp.get(), m_tempBytes, stream, sideStream());
     listFilterKernel<<<blocksFor(list.capacity), kBlock, 0, stream>>>(list, bodies, sink, accept);
     GEM_CUDA_CHECK_LAUNCH();
     const long long threads = static_cast<long long>(list.directRoom) * bodies.n;
@@ -117,6 +119,7 @@ class DeviceNeighbourList {
  private:
   ListView view();
   void markStale();
+  cudaStream_t sideStream();  // made once, outside any capture (upload)
   void resize(int n);  // per-body storage and the sort's scratch for n bodies
 
   Real m_skin;
@@ -132,6 +135,14 @@ class DeviceNeighbourList {
   DeviceArray<Real> m_halfBefore;                // reorder()'s copies
   DeviceArray<unsigned char> m_alwaysBefore;
   DeviceArray<int> m_alwaysFound;
+  cudaStream_t m_side = nullptr;
+
+ public:
+  ~DeviceNeighbourList() {
+    if (m_side) cudaStreamDestroy(m_side);
+  }
+  DeviceNeighbourList(const DeviceNeighbourList&) = delete;
+  DeviceNeighbourList& operator=(const DeviceNeighbourList&) = delete;
 };
 
 // The kept list's inputs for the bodies a topology edit appended (rows [first, world.size())):
