@@ -27,7 +27,6 @@
 #include <functional>
 #include <memory>
 #include <string>
-#include <utility>
 
 #include "broadphase/broadphase.hpp"
 #include "framework/cuda/cuda_check.hpp"
@@ -111,8 +110,7 @@ void addCudaBroadphase(const std::string& name, CudaBroadphaseFactory factory, c
 // nullptr when no device part of that name comes from that origin.
 const CudaBroadphaseFactory* findCudaBroadphase(const std::string& name, const std::string& origin = "built-in");
 
-// A device array that only grows (sized on the host, outside the graph): a strategy's own storage,
-// and every array of the step's state (device_world.cu).
+// A device array that only grows, for a strategy's own storage (sized on the host, outside the graph).
 template <class T>
 class DeviceArray {
  public:
@@ -132,29 +130,9 @@ class DeviceArray {
     m_capacity = capacity;
     return true;
   }
-  // Grows keeping the first `keep` elements; true when it reallocated.
-  bool ensureKeeping(size_t n, size_t keep) {
-    if (n <= m_capacity) return false;
-    DeviceArray bigger;
-    bigger.ensure(n);
-    if (keep && m_data) GEM_CUDA_CHECK(cudaMemcpy(bigger.m_data, m_data, keep * sizeof(T), cudaMemcpyDeviceToDevice));
-    swap(bigger);
-    return true;
-  }
   void upload(const T* h_data, size_t n) {
     ensure(n);
     if (n) GEM_CUDA_CHECK(cudaMemcpy(m_data, h_data, n * sizeof(T), cudaMemcpyHostToDevice));
-  }
-  // Elements [offset, offset + n) from the host; the array already holds them.
-  void uploadAt(size_t offset, const T* h_data, size_t n) {
-    if (n) GEM_CUDA_CHECK(cudaMemcpy(m_data + offset, h_data, n * sizeof(T), cudaMemcpyHostToDevice));
-  }
-  void download(T* h_data, size_t n) const {
-    if (n) GEM_CUDA_CHECK(cudaMemcpy(h_data, m_data, n * sizeof(T), cudaMemcpyDeviceToHost));
-  }
-  void swap(DeviceArray& other) {
-    std::swap(m_data, other.m_data);
-    std::swap(m_capacity, other.m_capacity);
   }
   T* get() const { return m_data; }
   size_t capacity() const { return m_capacity; }

@@ -29,21 +29,54 @@ namespace gem::cuda {
 // so a change of this count means the graph must be captured again.
 static std::atomic<unsigned long> g_reallocations{0};
 
-// The step's arrays: DeviceArrays whose reallocations are counted, because a captured graph holds
-// their addresses (a change of g_reallocations means the graph must be captured again).
+// A device array that only grows (steps reuse it; no allocation in the steady state).
 template <class T>
-class DeviceBuffer : public DeviceArray<T> {
+class DeviceBuffer {
  public:
+  DeviceBuffer() = default;
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  ~DeviceBuffer() {
+    if (m_data) cudaFree(m_data);  // no throw from a destructor
+  }
   void ensure(size_t n) {
-    if (DeviceArray<T>::ensure(n)) ++g_reallocations;
+    if (n <= m_capacity) return;
+    const size_t capacity = std::max<size_t>(n + n / 2, 64);
+    T* data = nullptr;
+    GEM_CUDA_CHECK(cudaMalloc(&data, capacity * sizeof(T)));
+    if (m_data) GEM_CUDA_CHECK(cudaFree(m_data));
+    m_data = data;
+    m_capacity = capacity;
+    ++g_reallocations;
   }
+  // Grows keeping the first `keep` elements (the previous step's contact keys survive a regrowth).
   void ensureKeeping(size_t n, size_t keep) {
-    if (DeviceArray<T>::ensureKeeping(n, keep)) ++g_reallocations;
+    if (n <= m_capacity) return;
+    DeviceBuffer bigger;
+    bigger.ensure(n);
+    if (keep && m_data) GEM_CUDA_CHECK(cudaMemcpy(bigger.m_data, m_data, keep * sizeof(T), cudaMemcpyDeviceToDevice));
+    swap(bigger);
   }
+  T* get() const { return m_data; }
   void upload(const T* h_data, size_t n) {
     ensure(n);
-    if (n) DeviceArray<T>::uploadAt(0, h_data, n);
+    if (n) GEM_CUDA_CHECK(cudaMemcpy(m_data, h_data, n * sizeof(T), cudaMemcpyHostToDevice));
   }
+  // Rows [offset, offset + n) from the host; the buffer already holds them.
+  void uploadAt(size_t offset, const T* h_data, size_t n) {
+    if (n) GEM_CUDA_CHECK(cudaMemcpy(m_data + offset, h_data, n * sizeof(T), cudaMemcpyHostToDevice));
+  }
+  void download(T* h_data, size_t n) const {
+    if (n) GEM_CUDA_CHECK(cudaMemcpy(h_data, m_data, n * sizeof(T), cudaMemcpyDeviceToHost));
+  }
+  void swap(DeviceBuffer& other) {
+    std::swap(m_data, other.m_data);
+    std::swap(m_capacity, other.m_capacity);
+  }
+
+ private:
+  T* m_data = nullptr;
+  size_t m_capacity = 0;
 };
 
 // Scratch for the re-sort and the topology edits, outside the DeviceBuffers: growing it must not
