@@ -9,35 +9,10 @@
 #include "test_support.hpp"
 
 using namespace gem;
+using gem::test::kBusyScene;
 using gem::test::TempDir;
 
 namespace {
-
-// A busy little channel: 40 % ice, the vessel entering it, floes breaking.
-const char* kBusyScene = R"(
-[simulation]
-dt = 0.1
-steps = 300
-seed = 3
-[domain]
-x = [0.0, 120.0]
-y = [-40.0, 40.0]
-walls = true
-[field]
-kind = "random_convex"
-concentration = 0.45
-size_mean = 5.0
-size_sd = 2.0
-size_min = 2.0
-size_max = 12.0
-thickness = 0.4
-[vessel]
-position = [-56.0, 0.0]
-bollard_thrust = 740e3
-open_water_speed = 6.5
-[events.flexural_breaking]
-min_area = 2.0
-)";
 
 struct Trajectory {
   std::vector<std::int64_t> ids;

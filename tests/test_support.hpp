@@ -35,13 +35,42 @@ class TempDir {
   std::filesystem::path m_path;
 };
 
+// A busy little channel: 40 % ice in 120 m x 80 m between walls, the vessel entering it at 740 kN,
+// floes breaking. The CPU and the CUDA tests share it.
+inline constexpr const char* kBusyScene = R"(
+[simulation]
+dt = 0.1
+steps = 300
+seed = 3
+[domain]
+x = [0.0, 120.0]
+y = [-40.0, 40.0]
+walls = true
+[field]
+kind = "random_convex"
+concentration = 0.45
+size_mean = 5.0
+size_sd = 2.0
+size_min = 2.0
+size_max = 12.0
+thickness = 0.4
+[vessel]
+position = [-56.0, 0.0]
+bollard_thrust = 740e3
+open_water_speed = 6.5
+[events.flexural_breaking]
+min_area = 2.0
+)";
+
 inline Scenario scenarioFromToml(const TempDir& dir, const std::string& text, const std::vector<std::string>& overrides = {}) {
   return loadScenario(dir.write("scenario.toml", text), overrides);
 }
 
-// Runs the built gem binary; returns its exit status. Output goes to `log`.
+// Runs the gem binary ($GEM_BINARY_DIR when set: a staged copy on the GPU machine; else the
+// build's); returns its exit status. Output goes to `log`.
 inline int runGem(const std::string& arguments, const std::filesystem::path& log) {
-  const std::string command = std::string(GEM_BINARY_DIR) + "/gem " + arguments + " > " + log.string() + " 2>&1";
+  const char* staged = std::getenv("GEM_BINARY_DIR");
+  const std::string command = std::string(staged ? staged : GEM_BINARY_DIR) + "/gem " + arguments + " > " + log.string() + " 2>&1";
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }

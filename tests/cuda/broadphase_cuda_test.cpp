@@ -16,45 +16,13 @@
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 #include "../test_support.hpp"
+#include "cuda_test_support.hpp"
 
 using namespace gem;
+using gem::test::kBusyScene;
 using gem::test::TempDir;
 
 namespace {
-
-#define GEM_SKIP_WITHOUT_CUDA() \
-  if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device"
-
-// cuda_backend_test.cpp's busy channel: walls, the vessel shoving floes, flexural breaking.
-const char* kBusyScene = R"(
-[simulation]
-dt = 0.1
-steps = 300
-seed = 3
-[domain]
-x = [0.0, 120.0]
-y = [-40.0, 40.0]
-walls = true
-[field]
-kind = "random_convex"
-concentration = 0.45
-size_mean = 5.0
-size_sd = 2.0
-size_min = 2.0
-size_max = 12.0
-thickness = 0.4
-[vessel]
-position = [-56.0, 0.0]
-bollard_thrust = 740e3
-open_water_speed = 6.5
-[events.flexural_breaking]
-min_area = 2.0
-)";
-
-std::string sweepAndPrunePlugin() {
-  const char* dir = std::getenv("GEM_TEST_CUDA_PLUGIN_DIR");
-  return std::string(dir ? dir : GEM_TEST_CUDA_PLUGIN_DIR) + "/libsweep_and_prune.so";
-}
 
 // Every body's x, y, angle, vx, vy, omega, and the per-step contact and candidate counts.
 struct Trajectory {
@@ -179,13 +147,13 @@ TEST(CudaBroadphase, CandidateOverflowWithAKeptListIsRedoneBitForBit) {
 // The sweep_and_prune example plugin, built with its .cu (tests/CMakeLists.txt): its device part is
 // registered under its own origin only, and a cuda run with it is the grid's run.
 TEST(CudaBroadphase, PluginBroadphaseRunsOnTheDeviceIdentically) {
-  const LoadedPlugin& plugin = loadPlugin(sweepAndPrunePlugin());
+  const LoadedPlugin& plugin = loadPlugin(test::cudaTestPlugin("libsweep_and_prune.so"));
   EXPECT_EQ(Registry::global().broadphase("sweep_and_prune").origin, plugin.origin);
   EXPECT_NE(cuda::findCudaBroadphase("sweep_and_prune", plugin.origin), nullptr);
   EXPECT_EQ(cuda::findCudaBroadphase("sweep_and_prune"), nullptr);  // not a built-in's
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
-  const std::string scene = std::string(kBusyScene) + "[[plugins]]\npath = \"" + sweepAndPrunePlugin() + "\"\n";
+  const std::string scene = std::string(kBusyScene) + "[[plugins]]\npath = \"" + test::cudaTestPlugin("libsweep_and_prune.so") + "\"\n";
   const Trajectory grid = runOnDevice(withBroadphase(dir, scene, "uniform_grid"), 200);
   const Trajectory sap = runOnDevice(withBroadphase(dir, scene, "sweep_and_prune"), 200);
   std::printf("sweep_and_prune plugin, 200 steps on the device: %zu bodies, %ld impacts\n", sap.ids.size(), sap.impacts);

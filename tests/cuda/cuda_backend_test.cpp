@@ -21,74 +21,13 @@
 #include "framework/cuda/cuda_simulation.hpp"
 #include "framework/simulation.hpp"
 #include "../test_support.hpp"
+#include "cuda_test_support.hpp"
 
 using namespace gem;
+using gem::test::kBusyScene;
 using gem::test::TempDir;
 
 namespace {
-
-// The gem binary: $GEM_BINARY_DIR when set (a staged copy on the GPU machine), else the build's.
-int runGemBinary(const std::string& arguments, const std::filesystem::path& log) {
-  const char* dir = std::getenv("GEM_BINARY_DIR");
-  const std::string command = std::string(dir ? dir : GEM_BINARY_DIR) + "/gem " + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-#define GEM_SKIP_WITHOUT_CUDA() \
-  if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device"
-
-const char* kBusyScene = R"(
-[simulation]
-dt = 0.1
-steps = 300
-seed = 3
-[domain]
-x = [0.0, 120.0]
-y = [-40.0, 40.0]
-walls = true
-[field]
-kind = "random_convex"
-concentration = 0.45
-size_mean = 5.0
-size_sd = 2.0
-size_min = 2.0
-size_max = 12.0
-thickness = 0.4
-[vessel]
-position = [-56.0, 0.0]
-bollard_thrust = 740e3
-open_water_speed = 6.5
-[events.flexural_breaking]
-min_area = 2.0
-)";
-
-// The busy channel twice as long, in thinner ice: floes break all along the 400 steps (about 50
-// before the re-sort at step 200 and 40 after it, on the CPU), some pieces leaving as rubble.
-const char* kBreakingScene = R"(
-[simulation]
-dt = 0.1
-steps = 400
-seed = 3
-[domain]
-x = [0.0, 240.0]
-y = [-40.0, 40.0]
-walls = true
-[field]
-kind = "random_convex"
-concentration = 0.45
-size_mean = 5.0
-size_sd = 2.0
-size_min = 2.0
-size_max = 12.0
-thickness = 0.25
-[vessel]
-position = [-56.0, 0.0]
-bollard_thrust = 740e3
-open_water_speed = 6.5
-[events.flexural_breaking]
-min_area = 2.0
-)";
 
 // Two floes approaching head on, slightly offset so that rotation is involved.
 const char* kTwoFloes = R"(
@@ -247,7 +186,9 @@ TEST(CudaBackend, BreaksOnTheDeviceMatchTheWholeWorldRoundTrip) {
   TempDir dir;
   for (const char* broadphase : {"uniform_grid", "variable_radius", "fixed_radius", "triangulation_mesh"}) {
     SCOPED_TRACE(broadphase);
-    Scenario s = test::scenarioFromToml(dir, kBreakingScene);
+    // The busy channel twice as long, in thinner ice: floes break all along the 400 steps (about
+    // 50 before the re-sort at step 200 and 40 after it, on the CPU), some pieces leaving as rubble.
+    Scenario s = test::scenarioFromToml(dir, kBusyScene, {"domain.x=[0.0, 240.0]", "field.thickness=0.25", "simulation.steps=400"});
     s.broadphase = broadphase;
     CudaSimulation onDevice(s), roundTrip(s);
     roundTrip.setTopologyThroughHost(true);
@@ -314,7 +255,7 @@ TEST_P(EveryScenario, CudaSummaryAgreesWithTheCpu) {
       const std::filesystem::path out = dir.path() / backends[b];
       char position[96];
       std::snprintf(position, sizeof position, "vessel.position=[%.17g, %.17g]", base.vessel.position.x, base.vessel.position.y + dy);
-      ASSERT_EQ(0, runGemBinary("run " + file + " --backend " + backends[b] + " --out " + out.string() +
+      ASSERT_EQ(0, test::runGem("run " + file + " --backend " + backends[b] + " --out " + out.string() +
                                     " --set output.frame_every=0 --set '" + position + "'",
                                 dir.path() / "log.txt"))
           << test::readFile(dir.path() / "log.txt");
@@ -369,7 +310,7 @@ TEST(CudaBackend, GemRunWritesACudaSummary) {
   TempDir dir;
   const auto scenario = dir.write("busy.toml", kBusyScene);
   const auto out = dir.path() / "run";
-  const int status = runGemBinary("run " + scenario.string() + " --steps 60 --backend cuda --out " + out.string(), dir.path() / "log.txt");
+  const int status = test::runGem("run " + scenario.string() + " --steps 60 --backend cuda --out " + out.string(), dir.path() / "log.txt");
   const std::string log = test::readFile(dir.path() / "log.txt");
   ASSERT_EQ(status, 0) << log;
   const std::string summary = test::readFile(out / "summary.json");
@@ -393,7 +334,7 @@ set = { "simulation.steps" = 200, "simulation.backend" = "cuda" }
 "vessel.bollard_thrust" = [300e3, 400e3, 500e3, 600e3, 700e3, 740e3]
 )");
   const auto out = dir.path() / "runs";
-  ASSERT_EQ(0, runGemBinary("sweep " + sweep.string() + " --jobs 2 --out " + out.string(), dir.path() / "log.txt"))
+  ASSERT_EQ(0, test::runGem("sweep " + sweep.string() + " --jobs 2 --out " + out.string(), dir.path() / "log.txt"))
       << test::readFile(dir.path() / "log.txt");
   std::set<std::string> used;
   for (const auto& entry : std::filesystem::directory_iterator(out / "cases")) {

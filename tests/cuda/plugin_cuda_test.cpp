@@ -15,17 +15,14 @@
 #include "framework/registry.hpp"
 #include "framework/simulation.hpp"
 #include "../test_support.hpp"
+#include "cuda_test_support.hpp"
 
 using namespace gem;
 using gem::test::TempDir;
 
 namespace {
 
-// $GEM_TEST_CUDA_PLUGIN_DIR when set (a staged copy on the GPU machine), else the build's.
-std::string shearPlugin() {
-  const char* dir = std::getenv("GEM_TEST_CUDA_PLUGIN_DIR");
-  return std::string(dir ? dir : GEM_TEST_CUDA_PLUGIN_DIR) + "/libshear_current.so";
-}
+std::string shearPlugin() { return test::cudaTestPlugin("libshear_current.so"); }
 
 // The example's three floes across the shear current (plugins/shear_current/scenario.toml), two of
 // them set moving into each other, so that contacts and the built-in pair events run too.
@@ -76,7 +73,7 @@ TEST(CudaPlugin, RegistersItsDeviceDriverUnderItsOwnOrigin) {
 }
 
 TEST(CudaPlugin, ShearCurrentOnCudaMatchesTheCpu) {
-  if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
+  GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, shearScene(shearPlugin(), 20));
   Simulation cpu(s);
@@ -111,14 +108,11 @@ TEST(CudaPlugin, ShearCurrentOnCudaMatchesTheCpu) {
 // `gem run --backend cuda` end to end with the plugin named in the scenario: it runs on the device
 // (no fallback to the CPU) and says so in summary.json.
 TEST(CudaPlugin, GemRunWithThePluginOnBackendCuda) {
-  if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
+  GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const std::filesystem::path scene = dir.write("shear.toml", shearScene(shearPlugin(), 50)), log = dir.path() / "log.txt";
-  const char* bin = std::getenv("GEM_BINARY_DIR");
-  const std::string command = std::string(bin ? bin : GEM_BINARY_DIR) + "/gem run " + scene.string() +
-                              " --backend cuda --quiet --out " + (dir.path() / "run").string() + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << test::readFile(log);
+  ASSERT_EQ(0, test::runGem("run " + scene.string() + " --backend cuda --quiet --out " + (dir.path() / "run").string(), log))
+      << test::readFile(log);
   const std::string summary = test::readFile(dir.path() / "run" / "summary.json");
   EXPECT_NE(summary.find("\"backend\": \"cuda\""), std::string::npos) << summary;
 }
@@ -127,9 +121,8 @@ TEST(CudaPlugin, GemRunWithThePluginOnBackendCuda) {
 // on the host in contact order, so rafting.csv lists the same onsets (time, floe pair) in the same
 // order as the CPU run's, over a busy scene where floes collide all the time.
 TEST(CudaPlugin, RaftingOnsetLogsTheSameRowsOnCudaAsOnTheCpu) {
-  if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
-  const char* pluginDir = std::getenv("GEM_TEST_CUDA_PLUGIN_DIR");
-  const std::string plugin = std::string(pluginDir ? pluginDir : GEM_TEST_CUDA_PLUGIN_DIR) + "/librafting_onset.so";
+  GEM_SKIP_WITHOUT_CUDA();
+  const std::string plugin = test::cudaTestPlugin("librafting_onset.so");
   TempDir dir;
   const std::filesystem::path scene = dir.write(
       "rafting.toml",
@@ -138,13 +131,10 @@ TEST(CudaPlugin, RaftingOnsetLogsTheSameRowsOnCudaAsOnTheCpu) {
       "thickness = 0.4\n[vessel]\nposition = [-56.0, 0.0]\nbollard_thrust = 740e3\nopen_water_speed = 6.5\n"
       "[events.rafting_onset]\nmin_closing_speed = 0.0\nmax_thickness = 1.0\n"
       "[output]\nframe_every = 0\n[[plugins]]\npath = \"" + plugin + "\"\n");
-  const char* bin = std::getenv("GEM_BINARY_DIR");
   auto rows = [&](const std::string& backend) {
     const std::filesystem::path out = dir.path() / backend, log = dir.path() / (backend + ".log");
-    const std::string command = std::string(bin ? bin : GEM_BINARY_DIR) + "/gem run " + scene.string() + " --backend " + backend +
-                                " --quiet --out " + out.string() + " > " + log.string() + " 2>&1";
-    const int status = std::system(command.c_str());
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << test::readFile(log);
+    EXPECT_EQ(0, test::runGem("run " + scene.string() + " --backend " + backend + " --quiet --out " + out.string(), log))
+        << test::readFile(log);
     // t, floe_a, floe_b of each row: the values after them agree to rounding, not bit for bit.
     std::vector<std::string> keys;
     std::istringstream in(test::readFile(out / "rafting.csv"));
