@@ -17,7 +17,7 @@
 
 // Bump on any change to the descriptor, the Registry/EventEntry/BroadphaseEntry layout, the event
 // API structs (framework/event_api.hpp) or the World that a plugin's code may see.
-#define GEM_PLUGIN_ABI_VERSION 2
+#define GEM_PLUGIN_ABI_VERSION 3
 
 #define GEM_PLUGIN_STRINGIFY_INNER(x) #x
 #define GEM_PLUGIN_STRINGIFY(x) GEM_PLUGIN_STRINGIFY_INNER(x)

@@ -3,7 +3,8 @@
 // as the CPU, so no physics is written twice. An event's events/NAME.cu is one line:
 //   GEM_REGISTER_CUDA_SOLO_EVENT(Drag, "drag");
 // which registers, under the event's name, a factory that takes the parsed Params of the CPU
-// instance (EventInstance::params()), so both backends run from the very same values.
+// instance (EventInstance::params()), so both backends run from the very same values: one per
+// world when a sweep batches several cases into one device state.
 //
 // Each driver is also keyed by its origin, as the registry's entries are: "built-in" for GEM's
 // own, the plugin's origin ("PATH (NAME VERSION)") for a plugin's. A plugin's .cu uses the same
@@ -14,10 +15,12 @@
 #pragma once
 #include <cuda_runtime.h>
 
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "framework/cuda/cuda_check.hpp"
 #include "framework/event_api.hpp"
@@ -28,8 +31,13 @@ namespace gem::cuda {
 // a captured CUDA graph replayed every step, so what changes from step to step is read from device
 // memory, not baked into the kernel arguments: the step context and the live contact count (the
 // launch covers the buffers' capacity, `count`).
+//
+// `world` is each body's world: a sweep on a GPU runs several cases in one device state, each case
+// a world of its own (DeviceWorld::upload), and an event applies its own case's Params to a body.
+// Contacts never join two worlds.
 struct DevicePairData {
   const PairBody* bodies;
+  const int* world;
   const int* contactA;
   const int* contactB;
   const PairContact* contacts;
@@ -43,6 +51,7 @@ struct DevicePairData {
 
 struct DeviceSoloData {
   const SoloBody* bodies;
+  const int* world;
   VelocityChange* changes;
   int count;
   int block;
@@ -51,6 +60,7 @@ struct DeviceSoloData {
 
 struct DeviceMotionData {
   MotionBody* bodies;
+  const int* world;
   int count;
   int block;
   const StepContext* ctx;  // device
@@ -67,7 +77,9 @@ class CudaEventDriver {
   virtual void launchMotion(const DeviceMotionData&, cudaStream_t) {}
 };
 
-using CudaEventFactory = std::function<std::unique_ptr<CudaEventDriver>(const void* params)>;
+// params[w]: the parsed Params of world w's instance of the event (EventInstance::params()), for
+// worlds w = 0 .. worlds - 1 (1 but for a sweep's batch of cases).
+using CudaEventFactory = std::function<std::unique_ptr<CudaEventDriver>(const void* const* params, int worlds)>;
 // origin: "built-in", or the registering plugin's. A second driver of one (name, origin) replaces
 // the first.
 void addCudaEvent(const std::string& name, CudaEventFactory factory, const std::string& origin = "built-in");
@@ -75,76 +87,108 @@ void addCudaEvent(const std::string& name, CudaEventFactory factory, const std::
 const CudaEventFactory* findCudaEvent(const std::string& name, const std::string& origin = "built-in");
 
 #if defined(__CUDACC__)
+// The Params of every world: world 0's travel by value as a kernel argument (one case, or a batch
+// whose cases agree on this event); when the worlds' differ, all of them also sit in a device
+// array, read at the body's world.
+template <class Params>
+class WorldParams {
+ public:
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  WorldParams(const void* const* params, int worlds) : m_first(*static_cast<const Params*>(params[0])) {
+    bool same = true;
+    for (int w = 1; w < worlds; ++w) same = same && std::memcmp(params[w], params[0], sizeof(Params)) == 0;
+    if (same) return;
+    std::vector<Params> all;
+    for (int w = 0; w < worlds; ++w) all.push_back(*static_cast<const Params*>(params[w]));
+    GEM_CUDA_CHECK(cudaMalloc(&m_perWorld, sizeof(Params) * all.size()));
+    GEM_CUDA_CHECK(cudaMemcpy(m_perWorld, all.data(), sizeof(Params) * all.size(), cudaMemcpyHostToDevice));
+  }
+  WorldParams(const WorldParams&) = delete;
+  WorldParams& operator=(const WorldParams&) = delete;
+  ~WorldParams() {
+    if (m_perWorld) cudaFree(m_perWorld);  // no throw from a destructor
+  }
+  const Params& first() const { return m_first; }
+  const Params* perWorld() const { return m_perWorld; }  // nullptr: every world has first()
+
+ private:
+  Params m_first;
+  Params* m_perWorld = nullptr;
+};
+
+template <class Params>
+__device__ inline const Params& paramsOf(const Params& first, const Params* perWorld, const int* world, int body) {
+  return perWorld ? perWorld[world[body]] : first;
+}
+
 template <class Event, class Params>
-__global__ void pairEventKernel(Params params, DevicePairData d) {
+__global__ void pairEventKernel(Params params, const Params* perWorld, DevicePairData d) {
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k >= d.count || k >= *d.liveCount) return;
   const StepContext ctx = *d.ctx;
-  Event::apply(params, d.bodies[d.contactA[k]], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], ctx, d.sink);
+  const int a = d.contactA[k];
+  Event::apply(paramsOf(params, perWorld, d.world, a), d.bodies[a], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], ctx, d.sink);
 }
 
 template <class Event, class Params>
-__global__ void soloEventKernel(Params params, DeviceSoloData d) {
+__global__ void soloEventKernel(Params params, const Params* perWorld, DeviceSoloData d) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= d.count) return;
   const StepContext ctx = *d.ctx;
-  Event::apply(params, d.bodies[i], d.changes[i], ctx);
+  Event::apply(paramsOf(params, perWorld, d.world, i), d.bodies[i], d.changes[i], ctx);
 }
 
 template <class Event, class Params>
-__global__ void motionKernel(Params params, DeviceMotionData d) {
+__global__ void motionKernel(Params params, const Params* perWorld, DeviceMotionData d) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= d.count) return;
   const StepContext ctx = *d.ctx;
-  Event::apply(params, d.bodies[i], ctx);
+  Event::apply(paramsOf(params, perWorld, d.world, i), d.bodies[i], ctx);
 }
 
 template <class Event>
 class CudaPairDriver final : public CudaEventDriver {
  public:
   using Params = typename Event::Params;
-  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
-  explicit CudaPairDriver(const void* p) : m_params(*static_cast<const Params*>(p)) {}
+  CudaPairDriver(const void* const* params, int worlds) : m_params(params, worlds) {}
   void launchPairs(const DevicePairData& d, cudaStream_t stream) override {
     if (d.count == 0) return;
-    pairEventKernel<Event, Params><<<blocksFor(d.count, d.block), d.block, 0, stream>>>(m_params, d);
+    pairEventKernel<Event, Params><<<blocksFor(d.count, d.block), d.block, 0, stream>>>(m_params.first(), m_params.perWorld(), d);
     GEM_CUDA_CHECK_LAUNCH();
   }
 
  private:
-  Params m_params;
+  WorldParams<Params> m_params;
 };
 
 template <class Event>
 class CudaSoloDriver final : public CudaEventDriver {
  public:
   using Params = typename Event::Params;
-  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
-  explicit CudaSoloDriver(const void* p) : m_params(*static_cast<const Params*>(p)) {}
+  CudaSoloDriver(const void* const* params, int worlds) : m_params(params, worlds) {}
   void launchSolo(const DeviceSoloData& d, cudaStream_t stream) override {
     if (d.count == 0) return;
-    soloEventKernel<Event, Params><<<blocksFor(d.count, d.block), d.block, 0, stream>>>(m_params, d);
+    soloEventKernel<Event, Params><<<blocksFor(d.count, d.block), d.block, 0, stream>>>(m_params.first(), m_params.perWorld(), d);
     GEM_CUDA_CHECK_LAUNCH();
   }
 
  private:
-  Params m_params;
+  WorldParams<Params> m_params;
 };
 
 template <class Event>
 class CudaMotionDriver final : public CudaEventDriver {
  public:
   using Params = typename Event::Params;
-  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
-  explicit CudaMotionDriver(const void* p) : m_params(*static_cast<const Params*>(p)) {}
+  CudaMotionDriver(const void* const* params, int worlds) : m_params(params, worlds) {}
   void launchMotion(const DeviceMotionData& d, cudaStream_t stream) override {
     if (d.count == 0) return;
-    motionKernel<Event, Params><<<blocksFor(d.count, d.block), d.block, 0, stream>>>(m_params, d);
+    motionKernel<Event, Params><<<blocksFor(d.count, d.block), d.block, 0, stream>>>(m_params.first(), m_params.perWorld(), d);
     GEM_CUDA_CHECK_LAUNCH();
   }
 
  private:
-  Params m_params;
+  WorldParams<Params> m_params;
 };
 
 struct RegisterCudaEvent {
@@ -161,15 +205,15 @@ struct RegisterCudaEvent {
 #define GEM_REGISTER_CUDA_EVENT(DRIVER, EVENT, NAME)                                                       \
   GEM_REGISTRATION(cuda_event_, ::gem::cuda::addCudaEvent(                                                \
       NAME,                                                                                                \
-      [](const void* params) -> std::unique_ptr<::gem::cuda::CudaEventDriver> {                           \
-        return std::make_unique<DRIVER<EVENT>>(params);                                                   \
+      [](const void* const* params, int worlds) -> std::unique_ptr<::gem::cuda::CudaEventDriver> {        \
+        return std::make_unique<DRIVER<EVENT>>(params, worlds);                                           \
       },                                                                                                   \
       registry.pluginOrigin()))
 #else
 #define GEM_REGISTER_CUDA_EVENT(DRIVER, EVENT, NAME)                                                       \
   static const ::gem::cuda::RegisterCudaEvent GEM_CONCAT(gem_register_cuda_event_, __LINE__){            \
-      NAME, [](const void* params) -> std::unique_ptr<::gem::cuda::CudaEventDriver> {                     \
-        return std::make_unique<DRIVER<EVENT>>(params);                                                   \
+      NAME, [](const void* const* params, int worlds) -> std::unique_ptr<::gem::cuda::CudaEventDriver> {  \
+        return std::make_unique<DRIVER<EVENT>>(params, worlds);                                           \
       }}
 #endif
 #define GEM_REGISTER_CUDA_PAIR_EVENT(EVENT, NAME) GEM_REGISTER_CUDA_EVENT(::gem::cuda::CudaPairDriver, EVENT, NAME)

@@ -16,6 +16,9 @@
 // off once, through pinned buffers (thesis 5.7). step() then hands them out one step at a time.
 // A batch never runs past a step whose state the host needs: a frame, a re-sort, the run's last
 // step, or a break (the device stops itself there).
+//
+// A device state may hold several cases (CudaSimulation::together): a world each, with its own
+// Params, vessel and records, its bodies never paired with another world's (gem sweep, issue 5).
 #pragma once
 #include <memory>
 #include <string>
@@ -27,14 +30,20 @@ namespace gem {
 
 class Simulation;
 
-namespace cuda {
-class DeviceWorld;
-struct DeviceBatchResult;
-}
+class CudaBatch;
 
 class CudaSimulation final : public Stepper {
  public:
-  explicit CudaSimulation(const Scenario& scenario);
+  explicit CudaSimulation(const Scenario& scenario);  // alone on its device state
+  // Several cases in one device state, a world each, so that small cases fill the GPU (gem sweep
+  // batches them). Each steps exactly as it would alone, bit for bit: its bodies keep the order
+  // of its own run, its events their own Params. They share the step loop, so they are stepped
+  // together: every case's step k before any case's step k + 1 (runScenariosTogether does). The
+  // scenarios must agree on batchKey (else BackendUnsupported says what differs).
+  static std::vector<std::unique_ptr<CudaSimulation>> together(const std::vector<const Scenario*>& scenarios);
+  // What cases must share to run together: "" when a scenario cannot share a device state (a
+  // device broadphase other than the built-in uniform_grid, which alone keeps worlds apart).
+  static std::string batchKey(const Scenario& scenario);
   ~CudaSimulation() override;
 
   void step() override;
@@ -49,20 +58,25 @@ class CudaSimulation final : public Stepper {
   long floesBroken() const override { return m_floesBroken; }
   std::string device() const override { return m_deviceName; }
   std::string backend() const override { return "cuda"; }
-  int candidateCount() const { return m_candidateCount; }
+  int candidateCount() const { return m_candidateCount; }  // over the whole device state
+  int casesOnDevice() const;  // 1 alone, the batch's size when run together
   // Rebuilds of the device broadphase's kept list (0 for one that keeps none): reads the device.
   long broadphaseRebuilds() const;
-  // Tests: run the topology phase through a whole-world round trip (download, edit, upload), the
-  // reference that the device edit must match bit for bit.
+  // Tests, alone only: run the topology phase through a whole-world round trip (download, edit,
+  // upload), the reference that the device edit must match bit for bit.
   void setTopologyThroughHost(bool on) { m_topologyThroughHost = on; }
 
  private:
-  void upload();          // host world -> device (all arrays), after set-up, breaks and re-sorts
-  void downloadState();   // device kinematics -> host world
-  void runBatch();        // the next batch of steps on the device
+  friend class CudaBatch;
+  struct Member {};
+  CudaSimulation(const Scenario& scenario, Member);  // a case of a batch; the batch attaches itself
+
+  void downloadState();      // device kinematics -> host mirror
   bool deviceAhead() const;  // the device has run steps that step() has not handed out yet
-  void runTopology();        // phase 6 on the mirror, replayed on the device
-  void reSortAlongCurve();
+  void runTopology();        // phase 6 on the mirror, replayed on the device (CudaBatch::addEdit)
+  void followReorder(const std::vector<int>& order);  // a device re-sort of this world's bodies
+  void flushPendingOrder();  // the mirror into the device's order
+  void locateVessel();       // m_vesselSlot from the mirror (in the device's order)
   int mirrorSlot(int deviceSlot) const;  // the host mirror's row of a device slot
   const std::vector<int>& slotOfId();
 
@@ -72,17 +86,19 @@ class CudaSimulation final : public Stepper {
   static int bindThreadToDevice();  // the worker's device (useCudaDeviceForWorker), before any CUDA call
   int m_deviceOrdinal;               // first: every member after it lives on this device
   std::unique_ptr<Simulation> m_cpu;  // parses the events (and runs the topology ones) and holds the host world
+  std::shared_ptr<CudaBatch> m_batch;  // the device state, alone or shared
+  int m_world = 0;                     // this case's world in it
   bool m_hostCurrent = true;
-  // Re-sorts on the device leave the host mirror in the old slot order: device slot k holds the
-  // mirror's body m_pendingOrder[k]. Applied (World::permute) when the host next needs its world.
+  // Device slots below are this world's own, in the device's order (with several worlds, the
+  // batch maps them to the shared slots). Re-sorts on the device leave the host mirror in the old
+  // order: device slot k holds the mirror's body m_pendingOrder[k]. Applied (World::permute) when
+  // the host next needs its world.
   std::vector<int> m_pendingOrder;
   std::vector<int> m_slotOfId;  // device slot of each body id (-1: gone), for ordering records; empty: stale
   bool m_topologyThroughHost = false;
-  std::unique_ptr<cuda::DeviceWorld> m_device;
-  std::unique_ptr<cuda::DeviceBatchResult> m_batch;
-  size_t m_batchNext = 0;  // the batch's next step to hand out
   std::string m_deviceName;
   long m_step = 0;
+  long m_taken = 0;  // steps whose results step() has handed out (the step in progress included)
   Real m_time = 0;
   std::int64_t m_vesselId = -1;
   int m_vesselSlot = -1;
@@ -92,11 +108,6 @@ class CudaSimulation final : public Stepper {
   std::vector<LogRecord> m_logs;
   Vec2 m_vesselIceForce{0, 0};
   VesselSample m_vessel{false, {0, 0}, 0, {0, 0}};
-  // Host wall time by part (GEM_CUDA_TIMING=1 prints it when the run ends), s.
-  struct HostTimes {
-    long batches = 0, topologies = 0, resorts = 0;
-    double batch = 0, fetch = 0, events = 0, edit = 0, bookkeeping = 0, resort = 0, ordering = 0;
-  } m_times;
   double m_rubbleMass = 0;
   long m_floesBroken = 0;
 };

@@ -123,13 +123,11 @@ struct StepStats {
   int contacts, previousContacts;
   int overflow;                 // 1: candidates or records past their capacity: the step left the state alone
   int stepsDone, halt;          // completed steps of the batch, and why it stopped
-  Vec2 vesselImpulse;
-  Vec2 vesselPosition, vesselVelocity;
-  Real vesselAngle;
 };
 
 // The grid's view, passed by value to the broadphase kernels.
 struct GridView {
+  const int* world;  // bodies of two worlds (a sweep's batched cases) never pair
   const Box* boxes;
   const Real* invMass;
   const unsigned char* isLarge;
@@ -158,8 +156,14 @@ struct DeviceState {
   std::vector<int> largeHost;  // the same slots, ascending: a topology edit shifts them on the host
   int largeCount = 0;
   int n = 0;
-  int vesselSlot = -1;
-  DeviceBuffer<int> vessel;  // vesselSlot on the device: a re-sort moves it without a new graph
+  // Worlds (DeviceWorld::upload): each body's, and each world's vessel slot (-1: none), on the host
+  // and on the device (a re-sort moves them without a new graph).
+  int worlds = 1;
+  DeviceBuffer<int> world;
+  std::vector<int> worldHost;
+  std::vector<int> vesselHost{-1};
+  DeviceBuffer<int> vessel;
+  DeviceBuffer<WorldStepRecord> worldStats;  // this step's, per world
   Real cell = 1;
   unsigned tableSize = 64;
   int tableBits = 6;
@@ -197,18 +201,20 @@ struct DeviceState {
   DeviceBuffer<StepContext> ctx;  // written on the device at the start of each step
   DeviceBuffer<BatchControl> control;
   DeviceBuffer<StepRecord> ring;  // one record per step of the batch
+  DeviceBuffer<WorldStepRecord> worldRing;  // ringSize x worlds
   int ringSize = 16;              // simulation.copy_back_every
   int block = kBlock;             // simulation.cuda_block_size
   StepStats* h_stats = nullptr;       // pinned
   BatchControl* h_control = nullptr;  // pinned: the graph's first node copies it to control
   StepRecord* h_ring = nullptr;       // pinned, ringSize records
+  WorldStepRecord* h_worldRing = nullptr;  // pinned, ringSize x worlds records
   DeviceBuffer<unsigned char> temp;  // CUB scratch, sized before capture
   // Topology edits and the rows they fetch: kept here, because a cudaFree waits for the whole
   // device, every other simulation's stream included (a sweep runs many at once).
   DeviceBuffer<int> editRemoved, editOrder, fetchSlots;
   DeviceBuffer<Real> fetchRows;
-  DeviceBuffer<Real> resortBounds;  // the re-sort along the curve's, likewise
-  DeviceBuffer<unsigned> resortKeys, resortKeysSorted;
+  DeviceBuffer<unsigned long long> resortBounds;  // the re-sort along the curve's, likewise
+  DeviceBuffer<unsigned long long> resortKeys, resortKeysSorted;
   DeviceBuffer<int> resortSlots, resortSlotsSorted;
   ReorderScratch permuteScratch, sortScratch;
   size_t tempBytes = 0;
@@ -225,7 +231,7 @@ struct DeviceState {
     stats.ensure(1);
     ctx.ensure(1);
     control.ensure(1);
-    setRingSize(ringSize);
+    setRing(ringSize, worlds);
     GEM_CUDA_CHECK(cudaMemset(stats.get(), 0, sizeof(StepStats)));
   }
   ~DeviceState() {
@@ -233,14 +239,20 @@ struct DeviceState {
     if (h_stats) cudaFreeHost(h_stats);
     if (h_control) cudaFreeHost(h_control);
     if (h_ring) cudaFreeHost(h_ring);
+    if (h_worldRing) cudaFreeHost(h_worldRing);
     if (stream) cudaStreamDestroy(stream);
   }
-  void setRingSize(int size) {
+  void setRing(int size, int worldCount) {
     if (h_ring) GEM_CUDA_CHECK(cudaFreeHost(h_ring));
-    h_ring = nullptr;
+    if (h_worldRing) GEM_CUDA_CHECK(cudaFreeHost(h_worldRing));
+    h_ring = nullptr, h_worldRing = nullptr;
     ringSize = size;
+    const size_t worldRecords = static_cast<size_t>(size) * static_cast<size_t>(worldCount);
     GEM_CUDA_CHECK(cudaMallocHost(&h_ring, sizeof(StepRecord) * static_cast<size_t>(size)));
+    GEM_CUDA_CHECK(cudaMallocHost(&h_worldRing, sizeof(WorldStepRecord) * worldRecords));
     ring.ensure(static_cast<size_t>(size));
+    worldRing.ensure(worldRecords);
+    worldStats.ensure(static_cast<size_t>(worldCount));
     dropGraph();
   }
   void dropGraph() {
@@ -253,8 +265,9 @@ struct DeviceState {
 
 __device__ inline long long cellCoord(Real v, Real cell) { return static_cast<long long>(floor(v / cell)); }
 
-__device__ inline unsigned cellHash(long long cx, long long cy, unsigned mask) {
-  return (static_cast<unsigned>(cx) * 73856093u ^ static_cast<unsigned>(cy) * 19349663u) & mask;
+// A cell of one world: the worlds of a batch share the table (world 0 hashes as a lone run did).
+__device__ inline unsigned cellHash(long long cx, long long cy, int world, unsigned mask) {
+  return (static_cast<unsigned>(cx) * 73856093u ^ static_cast<unsigned>(cy) * 19349663u ^ static_cast<unsigned>(world) * 83492791u) & mask;
 }
 
 struct PrepareArgs {
@@ -266,6 +279,7 @@ struct PrepareArgs {
   const Real *x, *y, *angle, *vx, *vy, *omega, *area, *thickness, *mass, *invMass, *invInertia, *gyration2, *gyrationX2,
       *gyrationY2, *principalAngle;
   const unsigned char* isLarge;
+  const int* world;
   Real cell;
   unsigned mask, largeKey;
   Vec2* worldVertices;
@@ -319,7 +333,7 @@ __global__ void prepareDirectKernel(PrepareArgs a) {
   a.soloBodies[i] = SoloBody{b.kind, b.dof, b.position, b.angle, b.velocity, b.omega, b.mass, b.area, b.thickness};
   a.changes[i] = VelocityChange{{0, 0}, 0};
   // A small body lives in the cell of its box's lower-left corner; large ones stay out of the grid.
-  a.cellKey[i] = a.isLarge[i] ? a.largeKey : cellHash(cellCoord(box.x0, a.cell), cellCoord(box.y0, a.cell), a.mask);
+  a.cellKey[i] = a.isLarge[i] ? a.largeKey : cellHash(cellCoord(box.x0, a.cell), cellCoord(box.y0, a.cell), a.world[i], a.mask);
   a.slot[i] = i;
 }
 
@@ -355,7 +369,7 @@ __global__ void __launch_bounds__(kPrepareBlock) prepareStagedKernel(PrepareArgs
     pairRows[threadIdx.x] = b;
     a.changes[i] = VelocityChange{{0, 0}, 0};
     // A small body lives in the cell of its box's lower-left corner; large ones stay out of the grid.
-    a.cellKey[i] = a.isLarge[i] ? a.largeKey : cellHash(cellCoord(box.x0, a.cell), cellCoord(box.y0, a.cell), a.mask);
+    a.cellKey[i] = a.isLarge[i] ? a.largeKey : cellHash(cellCoord(box.x0, a.cell), cellCoord(box.y0, a.cell), a.world[i], a.mask);
     a.slot[i] = i;
   }
   __syncthreads();
@@ -376,6 +390,7 @@ __global__ void cellRangeKernel(const unsigned* key, int n, unsigned largeKey, i
 
 // The pair test of Simulation::narrowphase's prefilter: not two immovable bodies, boxes overlap.
 __device__ inline bool accept(const GridView& g, int i, int j) {
+  if (g.world[i] != g.world[j]) return false;  // a hash cell may hold another world's bodies
   if (g.invMass[i] == 0 && g.invMass[j] == 0) return false;
   return boxesOverlap(g.boxes[i], g.boxes[j]);
 }
@@ -411,11 +426,12 @@ __global__ void partnerRowsKernel(GridView g, int* count, const int* offset, int
   };
   const Box box = g.boxes[i];
   const long long cx = cellCoord(box.x0, g.cell), cy = cellCoord(box.y0, g.cell);
+  const int world = g.world[i];
   unsigned seen[9];
   int seenCount = 0;
   for (int dy = -1; dy <= 1; ++dy)
     for (int dx = -1; dx <= 1; ++dx) {
-      const unsigned h = cellHash(cx + dx, cy + dy, g.mask);
+      const unsigned h = cellHash(cx + dx, cy + dy, world, g.mask);
       bool repeated = false;
       for (int s = 0; s < seenCount; ++s) repeated = repeated || seen[s] == h;
       if (repeated) continue;
@@ -543,7 +559,7 @@ __global__ void unpackCandidatesKernel(int capacity, const int* count, const uns
 // fixed length (captured in the graph) counts exactly this step's contacts.
 __global__ void narrowphaseKernel(int capacity, const int* needed, const int* candA, const int* candB, const Vec2* worldVertices,
                                   const int* vertexCount, const Real* x, const Real* y, const Box* boxes, const Real* invMass,
-                                  Contact* out, int* flag, StepStats* stats) {
+                                  const int* world, Contact* out, int* flag, StepStats* stats) {
   const int p = blockIdx.x * blockDim.x + threadIdx.x;
   if (p > capacity) return;
   const int total = *needed, count = total < capacity ? total : capacity;
@@ -563,7 +579,8 @@ __global__ void narrowphaseKernel(int capacity, const int* needed, const int* ca
   const int a = candA[p], b = candB[p];
   // Simulation::narrowphase's prefilter: a device broadphase may propose more than the grid's
   // accept() lets through; dropping the same pairs here keeps the contacts bit-identical.
-  if ((invMass[a] == 0 && invMass[b] == 0) || !boxesOverlap(boxes[a], boxes[b])) {
+  // Bodies of two worlds never touch (a device strategy does not know the worlds).
+  if (world[a] != world[b] || (invMass[a] == 0 && invMass[b] == 0) || !boxesOverlap(boxes[a], boxes[b])) {
     flag[p] = 0;
     return;
   }
@@ -595,6 +612,8 @@ struct CompactArgs {
   const Contact* cand;
   const int *flag, *offset;
   const std::int64_t* id;
+  const int* world;
+  WorldStepRecord* worldStats;
   const unsigned long long* previous;
   int *contactA, *contactB;
   PairContact* contacts;
@@ -622,6 +641,7 @@ __global__ void compactContactsKernel(CompactArgs a) {
   }
   const int k = a.offset[p], ia = a.candA[p], ib = a.candB[p];
   const unsigned long long key = contactIdKey(a.id[ia], a.id[ib], a.idBits);
+  atomicAdd(&a.worldStats[a.world[ia]].contacts, 1);  // an integer count: the order does not matter
   a.contactA[k] = ia;
   a.contactB[k] = ib;
   a.contacts[k] = PairContact{a.cand[p], !sortedContains(a.previous, a.stats->previousContacts, key)};
@@ -675,12 +695,12 @@ __device__ inline void addImpulse(const PairBody& b, Vec2 ji, Vec2 c, VelocityCh
 // body's contacts as b (a < i) all come before its contacts as a (sorted by a). No atomics.
 // contactA and bKeySorted are sorted with the padding (slot n) last, so searching the whole
 // capacity finds only real contacts.
-__global__ void gatherKernel(int n, const int* vesselSlot, const PairBody* bodies, const VelocityChange* changes, int capacity,
-                             const int* contactA, const int* bKeySorted, const int* bIndexSorted, const PairContact* contacts,
-                             const PairSlot* slots, MotionBody* motion, StepStats* stats) {
+__global__ void gatherKernel(int n, const int* world, const int* vesselSlot, const PairBody* bodies, const VelocityChange* changes,
+                             int capacity, const int* contactA, const int* bKeySorted, const int* bIndexSorted,
+                             const PairContact* contacts, const PairSlot* slots, MotionBody* motion, WorldStepRecord* worldStats) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
-  const int vessel = *vesselSlot;
+  const int vessel = vesselSlot[world[i]];
   const PairBody& b = bodies[i];
   VelocityChange total = changes[i];
   Vec2 vesselImpulse{0, 0};
@@ -697,7 +717,7 @@ __global__ void gatherKernel(int n, const int* vesselSlot, const PairBody* bodie
     if (i == vessel) vesselImpulse += -j;
     addImpulse(b, -j, contacts[k].geometry.point, total);
   }
-  if (i == vessel) stats->vesselImpulse = vesselImpulse;
+  if (i == vessel) worldStats[world[i]].vesselImpulse = vesselImpulse;
   motion[i] = MotionBody{b.kind, b.dof, b.position, b.angle, b.velocity + total.dv, b.omega + total.domega};
 }
 
@@ -714,7 +734,18 @@ __global__ void beginStepKernel(const BatchControl* c, StepStats* s, StepContext
   *ctx = StepContext{c->dt, static_cast<Real>(step) * c->dt, step};
   s->impactBegin = s->impactCount, s->breakBegin = s->breakCount, s->logBegin = s->logCount;
   s->overflow = 0;
-  s->vesselImpulse = Vec2{0, 0};
+}
+
+// ... and each world's share of it.
+__global__ void beginWorldsKernel(int worlds, WorldStepRecord* worldStats) {
+  const int w = blockIdx.x * blockDim.x + threadIdx.x;
+  if (w < worlds) worldStats[w] = WorldStepRecord{0, {0, 0}, {0, 0}, {0, 0}, 0};
+}
+
+// The worlds' records of a completed step into the ring, beside the step's (endStepKernel, next).
+__global__ void recordWorldsKernel(int worlds, const StepStats* s, const WorldStepRecord* worldStats, WorldStepRecord* ring) {
+  const int w = blockIdx.x * blockDim.x + threadIdx.x;
+  if (w < worlds && !s->overflow) ring[static_cast<size_t>(s->stepsDone) * worlds + w] = worldStats[w];
 }
 
 // After the pair events: records past a buffer's end fail the step like too many candidates do.
@@ -730,8 +761,7 @@ __global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, con
     s->impactCount = s->impactBegin, s->breakCount = s->breakBegin, s->logCount = s->logBegin;
     s->halt = kHaltOverflow;
   } else {
-    ring[s->stepsDone] = StepRecord{s->candidates, s->contacts, s->impactCount, s->breakCount, s->logCount,
-                                    s->vesselImpulse, s->vesselPosition, s->vesselVelocity, s->vesselAngle};
+    ring[s->stepsDone] = StepRecord{s->candidates, s->contacts, s->impactCount, s->breakCount, s->logCount};
     ++s->stepsDone;
     if (s->breakCount > s->breakBegin) s->halt = kHaltBreak;
     else if (s->stepsDone >= c->steps) s->halt = kHaltDone;
@@ -740,8 +770,8 @@ __global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, con
 }
 
 // The only write of the state; skipped when the step overflowed, so it can simply be run again.
-__global__ void writeBackKernel(int n, const int* vesselSlot, const MotionBody* motion, Real* x, Real* y, Real* angle, Real* vx, Real* vy,
-                                Real* omega, StepStats* stats) {
+__global__ void writeBackKernel(int n, const int* world, const int* vesselSlot, const MotionBody* motion, Real* x, Real* y, Real* angle,
+                                Real* vx, Real* vy, Real* omega, const StepStats* stats, WorldStepRecord* worldStats) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n || stats->overflow) return;
   const MotionBody& b = motion[i];
@@ -751,10 +781,11 @@ __global__ void writeBackKernel(int n, const int* vesselSlot, const MotionBody* 
   vx[i] = b.velocity.x;
   vy[i] = b.velocity.y;
   omega[i] = b.omega;
-  if (i == *vesselSlot) {
-    stats->vesselPosition = b.position;
-    stats->vesselVelocity = b.velocity;
-    stats->vesselAngle = b.angle;
+  if (i == vesselSlot[world[i]]) {
+    WorldStepRecord& r = worldStats[world[i]];
+    r.vesselPosition = b.position;
+    r.vesselVelocity = b.velocity;
+    r.vesselAngle = b.angle;
   }
 }
 
@@ -780,7 +811,7 @@ const CudaBroadphase* DeviceWorld::broadphase() const { return m_state->broadpha
 // What a captured graph baked in: when it is the same after an upload (a re-sort along the curve
 // every 200 steps changes only the arrays' contents) the graph is kept, not captured again.
 static auto bakedValues(const DeviceState& d) {
-  return std::make_tuple(d.n, d.cell, d.tableSize, d.largeCount, d.idBits, d.capacity, g_reallocations.load());
+  return std::make_tuple(d.n, d.cell, d.tableSize, d.largeCount, d.idBits, d.capacity, d.worlds, g_reallocations.load());
 }
 
 // dof as Simulation's dofOf.
@@ -823,13 +854,28 @@ static void sizeForBodies(DeviceState& d, std::int64_t nextId) {
   }
 }
 
-void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
+int DeviceWorld::worlds() const { return m_state->worlds; }
+const std::vector<int>& DeviceWorld::worldOfSlots() const { return m_state->worldHost; }
+
+// Each world's vessel slot, to the device.
+static void uploadVessels(DeviceState& d) { d.vessel.upload(d.vesselHost.data(), d.vesselHost.size()); }
+
+void DeviceWorld::upload(const World& w, const std::vector<int>& worldOf, const std::vector<int>& vesselSlots,
+                         const std::vector<int>& vesselDofs) {
   DeviceState& d = *m_state;
+  const int n = w.size(), worlds = static_cast<int>(vesselSlots.size());
+  if (worlds < 1 || vesselDofs.size() != vesselSlots.size() || (!worldOf.empty() && worldOf.size() != static_cast<size_t>(n)))
+    throw std::invalid_argument("DeviceWorld::upload: one world at least, a vessel and its dof per world, a world per body");
+  if (worlds != d.worlds) {
+    d.worlds = worlds;
+    d.setRing(d.ringSize, worlds);
+  }
   const auto before = bakedValues(d);
-  const int n = w.size();
   d.n = n;
-  d.vesselSlot = vesselSlot;
-  d.vessel.upload(&vesselSlot, 1);
+  d.worldHost = worldOf.empty() ? std::vector<int>(static_cast<size_t>(n), 0) : worldOf;
+  d.world.upload(d.worldHost.data(), d.worldHost.size());
+  d.vesselHost = vesselSlots;
+  uploadVessels(d);
   d.id.upload(w.id.data(), n);
   d.kind.upload(w.kind.data(), n);
   d.vertexCount.upload(w.vertexCount.data(), n);
@@ -848,7 +894,7 @@ void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
   std::vector<int> dof(n);
   Real largestFloe = 0;
   for (int i = 0; i < n; ++i) {
-    dof[i] = dofOf(w.kind[i], vesselDof);
+    dof[i] = dofOf(w.kind[i], vesselDofs[static_cast<size_t>(d.worldHost[static_cast<size_t>(i)])]);
     if (w.kind[i] == BodyKind::Floe) largestFloe = std::max(largestFloe, w.radius[i]);
   }
   d.cell = largestFloe > 0 ? 2 * largestFloe : Real(1);
@@ -869,11 +915,38 @@ void DeviceWorld::upload(const World& w, int vesselDof, int vesselSlot) {
 
 namespace {
 
-__global__ void curveKeyKernel(int n, const Real* x, const Real* y, const Real* bounds, unsigned* key, int* slot) {
+// A coordinate as an integer of the same order (min and max by integer atomics are then exact, as
+// the host's loop): doubles keep every float and coordinate exactly.
+__device__ inline unsigned long long orderedBits(Real v) {
+  const unsigned long long u = static_cast<unsigned long long>(__double_as_longlong(static_cast<double>(v)));
+  return (u >> 63) ? ~u : u | (1ull << 63);
+}
+__device__ inline Real fromOrderedBits(unsigned long long u) {
+  return static_cast<Real>(__longlong_as_double(static_cast<long long>((u >> 63) ? u & ~(1ull << 63) : ~u)));
+}
+
+// Per world: the box of its bodies' centroids (min x, min y, max x, max y), as ordered bits.
+__global__ void curveBoundsInitKernel(int worlds, unsigned long long* bounds) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k < 4 * worlds) bounds[k] = k % 4 < 2 ? ~0ull : 0ull;
+}
+__global__ void curveBoundsKernel(int n, const Real* x, const Real* y, const int* world, unsigned long long* bounds) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
-  const Real x0 = bounds[0], y0 = bounds[1], scale = curveScale(bounds[0], bounds[1], bounds[2], bounds[3]);
-  key[i] = curveKey(x[i], y[i], x0, y0, scale);
+  unsigned long long* b = bounds + 4 * world[i];
+  const unsigned long long bx = orderedBits(x[i]), by = orderedBits(y[i]);
+  atomicMin(b + 0, bx), atomicMin(b + 1, by), atomicMax(b + 2, bx), atomicMax(b + 3, by);
+}
+
+// Key (world, curve key within the world's box): worlds in order, each along its own curve.
+__global__ void curveKeyKernel(int n, const Real* x, const Real* y, const int* world, const unsigned long long* bounds,
+                               unsigned long long* key, int* slot) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const unsigned long long* b = bounds + 4 * world[i];
+  const Real x0 = fromOrderedBits(b[0]), y0 = fromOrderedBits(b[1]);
+  const Real scale = curveScale(x0, y0, fromOrderedBits(b[2]), fromOrderedBits(b[3]));
+  key[i] = (static_cast<unsigned long long>(world[i]) << 32) | curveKey(x[i], y[i], x0, y0, scale);
   slot[i] = i;
 }
 
@@ -942,30 +1015,29 @@ std::vector<int> DeviceWorld::reorderAlongCurve(bool* broadphaseFollowed) {
   cudaStream_t s = d.stream;
   ReorderScratch& scratch = d.permuteScratch;
   ReorderScratch& sortScratch = d.sortScratch;
-  // The centroids' box: exact (min and max round nothing), as the host's loop.
-  DeviceBuffer<Real>& bounds = d.resortBounds;
-  bounds.ensure(4);
-  size_t bytes = 0;
-  GEM_CUDA_CHECK(cub::DeviceReduce::Min(nullptr, bytes, d.x.get(), bounds.get(), n, s));
-  void* temp = sortScratch.get(bytes);
-  GEM_CUDA_CHECK(cub::DeviceReduce::Min(temp, bytes, d.x.get(), bounds.get() + 0, n, s));
-  GEM_CUDA_CHECK(cub::DeviceReduce::Min(temp, bytes, d.y.get(), bounds.get() + 1, n, s));
-  GEM_CUDA_CHECK(cub::DeviceReduce::Max(temp, bytes, d.x.get(), bounds.get() + 2, n, s));
-  GEM_CUDA_CHECK(cub::DeviceReduce::Max(temp, bytes, d.y.get(), bounds.get() + 3, n, s));
+  // Each world's centroid box: exact (min and max round nothing), as the host's loop.
+  DeviceBuffer<unsigned long long>& bounds = d.resortBounds;
+  bounds.ensure(4 * static_cast<size_t>(d.worlds));
+  curveBoundsInitKernel<<<blocksFor(4 * d.worlds), kBlock, 0, s>>>(d.worlds, bounds.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  curveBoundsKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.x.get(), d.y.get(), d.world.get(), bounds.get());
+  GEM_CUDA_CHECK_LAUNCH();
   // Keys, then a stable radix sort: ties keep slot order, as the host's sort of (key, slot) pairs.
-  DeviceBuffer<unsigned>& keys = d.resortKeys;
-  DeviceBuffer<unsigned>& sortedKeys = d.resortKeysSorted;
+  DeviceBuffer<unsigned long long>& keys = d.resortKeys;
+  DeviceBuffer<unsigned long long>& sortedKeys = d.resortKeysSorted;
   DeviceBuffer<int>& slots = d.resortSlots;
   DeviceBuffer<int>& sortedSlots = d.resortSlotsSorted;
   keys.ensure(n), sortedKeys.ensure(n), slots.ensure(n), sortedSlots.ensure(n);
-  curveKeyKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.x.get(), d.y.get(), bounds.get(), keys.get(), slots.get());
+  curveKeyKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.x.get(), d.y.get(), d.world.get(), bounds.get(), keys.get(), slots.get());
   GEM_CUDA_CHECK_LAUNCH();
-  bytes = 0;
-  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, 32, s));
-  temp = sortScratch.get(bytes);
-  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, 32, s));
+  const int keyBits = 32 + (d.worlds > 1 ? bitsFor(static_cast<unsigned long long>(d.worlds - 1)) : 0);
+  size_t bytes = 0;
+  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, keyBits, s));
+  void* temp = sortScratch.get(bytes);
+  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, keyBits, s));
   const int* o = sortedSlots.get();
   permuteOnDevice(d.id, n, 1, o, scratch, s), permuteOnDevice(d.kind, n, 1, o, scratch, s);
+  permuteOnDevice(d.world, n, 1, o, scratch, s);
   permuteOnDevice(d.vertexCount, n, 1, o, scratch, s), permuteOnDevice(d.dof, n, 1, o, scratch, s);
   permuteOnDevice(d.local, n, kMaxVertices, o, scratch, s), permuteOnDevice(d.isLarge, n, 1, o, scratch, s);
   for (DeviceBuffer<Real>* r : {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.radius, &d.area, &d.thickness, &d.mass, &d.invMass,
@@ -974,17 +1046,21 @@ std::vector<int> DeviceWorld::reorderAlongCurve(bool* broadphaseFollowed) {
   if (d.broadphase) *broadphaseFollowed = d.broadphase->reorder(o, n, s);
   sortedSlots.download(order.data(), static_cast<size_t>(n));
 
-  // The large bodies' and the vessel's new slots (their count is unchanged: the graph stays valid).
+  // The large bodies' and the vessels' new slots, the worlds' (their count is unchanged: the graph
+  // stays valid).
   std::vector<unsigned char> isLarge(static_cast<size_t>(n));
   d.isLarge.download(isLarge.data(), static_cast<size_t>(n));
-  const int vesselBefore = d.vesselSlot;
+  std::vector<int> newSlot(static_cast<size_t>(n)), worldBefore = d.worldHost;
   d.largeHost.clear();
   for (int k = 0; k < n; ++k) {
     if (isLarge[static_cast<size_t>(k)]) d.largeHost.push_back(k);
-    if (order[static_cast<size_t>(k)] == vesselBefore) d.vesselSlot = k;
+    newSlot[static_cast<size_t>(order[static_cast<size_t>(k)])] = k;
+    d.worldHost[static_cast<size_t>(k)] = worldBefore[static_cast<size_t>(order[static_cast<size_t>(k)])];
   }
+  for (int& v : d.vesselHost)
+    if (v >= 0) v = newSlot[static_cast<size_t>(v)];
   d.large.upload(d.largeHost.data(), d.largeHost.size());
-  d.vessel.upload(&d.vesselSlot, 1);
+  uploadVessels(d);
   return order;
 }
 
@@ -1009,11 +1085,13 @@ void DeviceWorld::downloadKinematics(const std::vector<int>& deviceSlots, const 
   }
 }
 
-bool DeviceWorld::editBodies(const std::vector<int>& removedSlots, const World& after, int firstAdded, int vesselDof) {
+bool DeviceWorld::editBodies(const std::vector<int>& removedSlots, const World& from, int firstAdded, const std::vector<int>& addedWorlds,
+                             const std::vector<int>& vesselDofs) {
   DeviceState& d = *m_state;
   const int before = d.n, removedCount = static_cast<int>(removedSlots.size());
-  const int kept = before - removedCount, added = after.size() - firstAdded, n = kept + added;
-  if (kept != firstAdded || kept < 0 || added < 0)
+  const int kept = before - removedCount, added = from.size() - firstAdded, n = kept + added;
+  if (kept < 0 || added < 0 || (!addedWorlds.empty() && addedWorlds.size() != static_cast<size_t>(added)) ||
+      vesselDofs.size() != static_cast<size_t>(d.worlds))
     throw std::logic_error("DeviceWorld::editBodies: the edit does not match the device's bodies");
   cudaStream_t s = d.stream;
   ReorderScratch& scratch = d.permuteScratch;
@@ -1030,28 +1108,32 @@ bool DeviceWorld::editBodies(const std::vector<int>& removedSlots, const World& 
   permuteOnDevice(d.id, kept, 1, o, scratch, s, before, n), permuteOnDevice(d.kind, kept, 1, o, scratch, s, before, n);
   permuteOnDevice(d.vertexCount, kept, 1, o, scratch, s, before, n), permuteOnDevice(d.dof, kept, 1, o, scratch, s, before, n);
   permuteOnDevice(d.local, kept, kMaxVertices, o, scratch, s, before, n), permuteOnDevice(d.isLarge, kept, 1, o, scratch, s, before, n);
+  permuteOnDevice(d.world, kept, 1, o, scratch, s, before, n);
   DeviceBuffer<Real>* reals[] = {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.radius, &d.area, &d.thickness, &d.mass, &d.invMass,
                                  &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle};
   for (DeviceBuffer<Real>* r : reals) permuteOnDevice(*r, kept, 1, o, scratch, s, before, n);
 
-  // The new bodies' rows, as World::addBody made them on the host (a few per step).
-  const size_t at = static_cast<size_t>(kept), count = static_cast<size_t>(added);
-  d.id.uploadAt(at, after.id.data() + at, count);
-  d.kind.uploadAt(at, after.kind.data() + at, count);
-  d.vertexCount.uploadAt(at, after.vertexCount.data() + at, count);
-  d.local.uploadAt(at * kMaxVertices, after.localVertices.data() + at * kMaxVertices, count * kMaxVertices);
-  const std::vector<Real>* hostReals[] = {&after.x, &after.y, &after.angle, &after.vx, &after.vy, &after.omega, &after.radius, &after.area,
-                                          &after.thickness, &after.mass, &after.invMass, &after.invInertia, &after.gyration2,
-                                          &after.gyrationX2, &after.gyrationY2, &after.principalAngle};
-  for (size_t k = 0; k < std::size(reals); ++k) reals[k]->uploadAt(at, hostReals[k]->data() + at, count);
-  std::vector<int> dof(count);
+  // The new bodies' rows, as World::addBody made them on the host (a few per step): rows
+  // from[firstAdded..] go to slots kept...
+  const size_t at = static_cast<size_t>(kept), first = static_cast<size_t>(firstAdded), count = static_cast<size_t>(added);
+  d.id.uploadAt(at, from.id.data() + first, count);
+  d.kind.uploadAt(at, from.kind.data() + first, count);
+  d.vertexCount.uploadAt(at, from.vertexCount.data() + first, count);
+  d.local.uploadAt(at * kMaxVertices, from.localVertices.data() + first * kMaxVertices, count * kMaxVertices);
+  const std::vector<Real>* hostReals[] = {&from.x, &from.y, &from.angle, &from.vx, &from.vy, &from.omega, &from.radius, &from.area,
+                                          &from.thickness, &from.mass, &from.invMass, &from.invInertia, &from.gyration2,
+                                          &from.gyrationX2, &from.gyrationY2, &from.principalAngle};
+  for (size_t k = 0; k < std::size(reals); ++k) reals[k]->uploadAt(at, hostReals[k]->data() + first, count);
+  std::vector<int> dof(count), worlds(count, 0);
   std::vector<unsigned char> isLarge(count);
   for (size_t k = 0; k < count; ++k) {
-    dof[k] = dofOf(after.kind[at + k], vesselDof);
-    isLarge[k] = 2 * after.radius[at + k] > d.cell;  // the cell stays: a smaller largest floe only makes it coarse
+    if (!addedWorlds.empty()) worlds[k] = addedWorlds[k];
+    dof[k] = dofOf(from.kind[first + k], vesselDofs[static_cast<size_t>(worlds[k])]);
+    isLarge[k] = 2 * from.radius[first + k] > d.cell;  // the cell stays: a smaller largest floe only makes it coarse
   }
   d.dof.uploadAt(at, dof.data(), count);
   d.isLarge.uploadAt(at, isLarge.data(), count);
+  d.world.uploadAt(at, worlds.data(), count);
 
   // Slots past a removed body move down by the number removed before them.
   auto newSlot = [&](int slot) {
@@ -1065,16 +1147,28 @@ bool DeviceWorld::editBodies(const std::vector<int>& removedSlots, const World& 
   d.largeHost = large;
   d.large.upload(large.data(), large.size());
   d.largeCount = static_cast<int>(large.size());
-  if (d.vesselSlot >= 0) {
-    if (std::binary_search(removedSlots.begin(), removedSlots.end(), d.vesselSlot))
+  for (int& v : d.vesselHost) {
+    if (v < 0) continue;
+    if (std::binary_search(removedSlots.begin(), removedSlots.end(), v))
       throw std::logic_error("DeviceWorld::editBodies: a topology event removed the vessel");
-    d.vesselSlot = newSlot(d.vesselSlot);
-    d.vessel.upload(&d.vesselSlot, 1);
+    v = newSlot(v);
   }
+  uploadVessels(d);
+  std::vector<int> worldAfter;
+  worldAfter.reserve(static_cast<size_t>(n));
+  for (int slot = 0, r = 0; slot < before; ++slot) {
+    if (r < removedCount && removedSlots[static_cast<size_t>(r)] == slot) {
+      ++r;
+      continue;
+    }
+    worldAfter.push_back(d.worldHost[static_cast<size_t>(slot)]);
+  }
+  worldAfter.insert(worldAfter.end(), worlds.begin(), worlds.end());
+  d.worldHost.swap(worldAfter);
   d.n = n;
-  sizeForBodies(d, after.nextId);
+  sizeForBodies(d, from.nextId);
   // A strategy's per-body storage follows the edit on the device, or (false) the caller uploads it.
-  const bool followed = !d.broadphase || d.broadphase->edited(o, kept, after, firstAdded, s);
+  const bool followed = !d.broadphase || d.broadphase->edited(o, kept, from, firstAdded, s);
   d.dropGraph();  // n changed: the graph's launches were sized for the old count
   return followed;
 }
@@ -1151,12 +1245,14 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
 
   beginStepKernel<<<1, 1, 0, s>>>(d.control.get(), stats, d.ctx.get());
   GEM_CUDA_CHECK_LAUNCH();
+  beginWorldsKernel<<<blocksFor(d.worlds), kBlock, 0, s>>>(d.worlds, d.worldStats.get());
+  GEM_CUDA_CHECK_LAUNCH();
 
   // 1. World vertices, boxes, views, cell keys.
   PrepareArgs a{n, d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.local.get(), d.x.get(), d.y.get(),
                 d.angle.get(), d.vx.get(), d.vy.get(), d.omega.get(), d.area.get(), d.thickness.get(), d.mass.get(),
                 d.invMass.get(), d.invInertia.get(), d.gyration2.get(), d.gyrationX2.get(), d.gyrationY2.get(),
-                d.principalAngle.get(), d.isLarge.get(), d.cell, d.tableSize - 1, largeKey, d.worldVertices.get(), d.boxes.get(),
+                d.principalAngle.get(), d.isLarge.get(), d.world.get(), d.cell, d.tableSize - 1, largeKey, d.worldVertices.get(), d.boxes.get(),
                 d.pairBodies.get(), d.soloBodies.get(), d.changes.get(), d.cellKey.get(), d.slot.get()};
   if (stagedPrepare(n)) prepareStagedKernel<<<blocksFor(n, kPrepareBlock), kPrepareBlock, 0, s>>>(a);  // a fixed block
   else prepareDirectKernel<<<blocksFor(n, block), block, 0, s>>>(a);
@@ -1185,7 +1281,7 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   GEM_CUDA_CHECK(cudaMemsetAsync(d.cellStart.get(), 0xff, d.tableSize * sizeof(int), s));
   cellRangeKernel<<<blocksFor(n, block), block, 0, s>>>(d.cellKeySorted.get(), n, largeKey, d.cellStart.get(), d.cellEnd.get());
   GEM_CUDA_CHECK_LAUNCH();
-  const GridView g{d.boxes.get(), d.invMass.get(), d.isLarge.get(), d.large.get(), d.largeCount, d.cellStart.get(),
+  const GridView g{d.world.get(), d.boxes.get(), d.invMass.get(), d.isLarge.get(), d.large.get(), d.largeCount, d.cellStart.get(),
                    d.cellEnd.get(), d.slotSorted.get(), d.cell, d.tableSize - 1, n, capacity};
   const int lanes = rowLanes(n);
   const int rowBlocks = (lanes * (n + 1) + block - 1) / block;  // a tile per body, one more for count[n]
@@ -1213,12 +1309,12 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   const int narrowBlock = capacity + 1 < 64 * 1024 ? 32 : block;
   narrowphaseKernel<<<(capacity + narrowBlock) / narrowBlock, narrowBlock, 0, s>>>(capacity, candidatesNeeded, d.candA.get(), d.candB.get(),
                                                                 d.worldVertices.get(), d.vertexCount.get(), d.x.get(), d.y.get(),
-                                                                d.boxes.get(), d.invMass.get(), d.candContact.get(), d.flag.get(), stats);
+                                                                d.boxes.get(), d.invMass.get(), d.world.get(), d.candContact.get(), d.flag.get(), stats);
   GEM_CUDA_CHECK_LAUNCH();
   cubCalls.scanFlags(capacity);
   const unsigned long long padKey = d.idBits >= 32 ? ~0ull : (1ull << (2 * d.idBits)) - 1;
   const CompactArgs c{capacity, n, d.idBits, padKey, d.candA.get(), d.candB.get(), d.candContact.get(), d.flag.get(),
-                      d.flagOffset.get(), d.id.get(), d.previousKeys.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(),
+                      d.flagOffset.get(), d.id.get(), d.world.get(), d.worldStats.get(), d.previousKeys.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(),
                       d.slots.get(), d.contactKey.get(), d.bKey.get(), d.bIndex.get(), stats};
   compactContactsKernel<<<blocksFor(capacity, block), block, 0, s>>>(c);
   GEM_CUDA_CHECK_LAUNCH();
@@ -1230,25 +1326,27 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   const int records = d.recordCapacity;
   const RecordSink sink{d.impacts.get(), records, &stats->impactCount, d.breaks.get(), records, &stats->breakCount,
                         d.logs.get(), records, &stats->logCount};
-  const DevicePairData pairData{d.pairBodies.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(), d.slots.get(),
+  const DevicePairData pairData{d.pairBodies.get(), d.world.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(), d.slots.get(),
                                 capacity, block, &stats->contacts, d.ctx.get(), sink};
   for (auto& e : d.pairEvents) e->launchPairs(pairData, s);
   checkRecordsKernel<<<1, 1, 0, s>>>(stats, records);
   GEM_CUDA_CHECK_LAUNCH();
-  const DeviceSoloData soloData{d.soloBodies.get(), d.changes.get(), n, block, d.ctx.get()};
+  const DeviceSoloData soloData{d.soloBodies.get(), d.world.get(), d.changes.get(), n, block, d.ctx.get()};
   for (auto& e : d.soloEvents) e->launchSolo(soloData, s);
 
   // 5. Gather, motion, write back; then the counters to the host.
-  gatherKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.vessel.get(), d.pairBodies.get(), d.changes.get(), capacity, d.contactA.get(),
-                                               d.bKeySorted.get(), d.bIndexSorted.get(), d.contacts.get(), d.slots.get(),
-                                               d.motionBodies.get(), stats);
+  gatherKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.world.get(), d.vessel.get(), d.pairBodies.get(), d.changes.get(), capacity,
+                                                     d.contactA.get(), d.bKeySorted.get(), d.bIndexSorted.get(), d.contacts.get(),
+                                                     d.slots.get(), d.motionBodies.get(), d.worldStats.get());
   GEM_CUDA_CHECK_LAUNCH();
-  const DeviceMotionData motionData{d.motionBodies.get(), n, block, d.ctx.get()};
+  const DeviceMotionData motionData{d.motionBodies.get(), d.world.get(), n, block, d.ctx.get()};
   for (auto& e : d.motionEvents) e->launchMotion(motionData, s);
-  writeBackKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.vessel.get(), d.motionBodies.get(), d.x.get(), d.y.get(), d.angle.get(),
-                                                        d.vx.get(), d.vy.get(), d.omega.get(), stats);
+  writeBackKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.world.get(), d.vessel.get(), d.motionBodies.get(), d.x.get(), d.y.get(),
+                                                        d.angle.get(), d.vx.get(), d.vy.get(), d.omega.get(), stats, d.worldStats.get());
   GEM_CUDA_CHECK_LAUNCH();
   commitContactsKernel<<<blocksFor(capacity, block), block, 0, s>>>(capacity, d.sortedKeys.get(), d.previousKeys.get(), stats);
+  GEM_CUDA_CHECK_LAUNCH();
+  recordWorldsKernel<<<blocksFor(d.worlds), kBlock, 0, s>>>(d.worlds, stats, d.worldStats.get(), d.worldRing.get());
   GEM_CUDA_CHECK_LAUNCH();
   endStepKernel<<<1, 1, 0, s>>>(loop, inGraph, d.control.get(), stats, d.ring.get());
   GEM_CUDA_CHECK_LAUNCH();
@@ -1301,7 +1399,7 @@ void captureStep(DeviceState& d) {
     cudaGraph_t g;
     ~Owned() { cudaGraphDestroy(g); }
   } owned{graph};
-  cudaGraphNode_t controlIn, begin, loop, ringOut, statsOut;
+  cudaGraphNode_t controlIn, begin, loop, ringOut, worldRingOut, statsOut;
   GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&controlIn, graph, nullptr, 0, d.control.get(), d.h_control, sizeof(BatchControl),
                                           cudaMemcpyHostToDevice));
   StepStats* stats = d.stats.get();
@@ -1333,6 +1431,9 @@ void captureStep(DeviceState& d) {
 
   GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&ringOut, graph, &loop, 1, d.h_ring, d.ring.get(),
                                           sizeof(StepRecord) * static_cast<size_t>(d.ringSize), cudaMemcpyDeviceToHost));
+  GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&worldRingOut, graph, &loop, 1, d.h_worldRing, d.worldRing.get(),
+                                          sizeof(WorldStepRecord) * static_cast<size_t>(d.ringSize) * static_cast<size_t>(d.worlds),
+                                          cudaMemcpyDeviceToHost));
   GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&statsOut, graph, &loop, 1, d.h_stats, stats, sizeof(StepStats), cudaMemcpyDeviceToHost));
   GEM_CUDA_CHECK(cudaGraphInstantiate(&d.graph, graph, 0));
 }
@@ -1349,6 +1450,9 @@ void runBatchUncaptured(DeviceState& d) {
     GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
   } while (d.h_stats->halt == kRunning);
   GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_ring, d.ring.get(), sizeof(StepRecord) * static_cast<size_t>(d.ringSize), cudaMemcpyDeviceToHost, d.stream));
+  GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_worldRing, d.worldRing.get(),
+                                 sizeof(WorldStepRecord) * static_cast<size_t>(d.ringSize) * static_cast<size_t>(d.worlds), cudaMemcpyDeviceToHost,
+                                 d.stream));
 }
 
 }  // namespace
@@ -1357,16 +1461,18 @@ void DeviceWorld::configure(int copyBackEvery, int blockSize) {
   DeviceState& d = *m_state;
   if (copyBackEvery < 1 || blockSize < 32 || blockSize > 1024 || blockSize % 32)
     throw std::invalid_argument("DeviceWorld::configure: copy_back_every >= 1, block size a multiple of 32 up to 1024");
-  if (copyBackEvery != d.ringSize) d.setRingSize(copyBackEvery);
+  if (copyBackEvery != d.ringSize) d.setRing(copyBackEvery, d.worlds);
   if (blockSize != d.block) d.dropGraph();
   d.block = blockSize;
 }
 
 void DeviceWorld::run(long firstStep, Real dt, int steps, DeviceBatchResult& result) {
   DeviceState& d = *m_state;
-  result.steps.clear(), result.impacts.clear(), result.breaks.clear(), result.logs.clear();
+  result.steps.clear(), result.worldSteps.clear(), result.impacts.clear(), result.breaks.clear(), result.logs.clear();
+  result.worlds = d.worlds;
   if (d.n == 0) {
-    for (int k = 0; k < steps; ++k) result.steps.push_back(StepRecord{});
+    result.steps.assign(static_cast<size_t>(steps), StepRecord{});
+    result.worldSteps.assign(static_cast<size_t>(steps) * static_cast<size_t>(d.worlds), WorldStepRecord{});
     return;
   }
   static const bool useGraph = [] {
@@ -1402,6 +1508,7 @@ void DeviceWorld::run(long firstStep, Real dt, int steps, DeviceBatchResult& res
       r.impactEnd += impactBase, r.breakEnd += breakBase, r.logEnd += logBase;
       result.steps.push_back(r);
     }
+    result.worldSteps.insert(result.worldSteps.end(), d.h_worldRing, d.h_worldRing + static_cast<size_t>(done) * static_cast<size_t>(d.worlds));
     next += done;
     remaining -= done;
     if (stats.halt == kHaltBreak) break;

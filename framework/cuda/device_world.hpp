@@ -17,17 +17,26 @@ struct DeviceState;
 // One completed step's results, as the device's step graph writes them into its ring. The record
 // ends index the batch's record arrays: step s's impacts are [steps[s-1].impactEnd, steps[s].impactEnd).
 struct StepRecord {
-  int candidates, contacts;
+  int candidates, contacts;  // over all worlds
   int impactEnd, breakEnd, logEnd;
-  Vec2 vesselImpulse;                    // N s, this step's contact impulses on the vessel
-  Vec2 vesselPosition, vesselVelocity;   // after the step
+};
+
+// One world's share of a completed step. A device state holds one world per case: one for a run,
+// several when a sweep batches its cases (upload's worldOf); bodies of two worlds never touch.
+struct WorldStepRecord {
+  int contacts;
+  Vec2 vesselImpulse;                    // N s, this step's contact impulses on the world's vessel
+  Vec2 vesselPosition, vesselVelocity;   // after the step (zero in a world without a vessel)
   Real vesselAngle;
 };
 
 // What a run of steps hands back: copied off the device once, through pinned buffers, at its end
-// (thesis 5.7). Records of a step are in device order (atomic counters): the caller orders them.
+// (thesis 5.7). Records of a step are in device order (atomic counters): the caller orders them
+// (and, with several worlds, tells them apart by their body ids).
 struct DeviceBatchResult {
+  int worlds = 1;
   std::vector<StepRecord> steps;
+  std::vector<WorldStepRecord> worldSteps;  // steps.size() x worlds: step s's world w at s * worlds + w
   std::vector<ImpactRecord> impacts;
   std::vector<BreakRequest> breaks;
   std::vector<LogRecord> logs;
@@ -48,26 +57,38 @@ class DeviceWorld {
   void setBroadphase(std::unique_ptr<CudaBroadphase> broadphase);
   const CudaBroadphase* broadphase() const;
 
-  // The whole host world to the device (set-up, after breaks and re-sorts).
-  void upload(const World& world, int vesselDof, int vesselSlot);
+  // The whole host world to the device (set-up, after breaks and re-sorts). worldOf[i] is body i's
+  // world (empty: all in world 0); vesselSlots[w] world w's vessel (-1: none) and vesselDofs[w]
+  // its degrees of freedom; the number of worlds is vesselSlots.size(). Bodies of different worlds
+  // never make a pair, and each world's bodies should keep the order of its own run (ascending
+  // slots), so that its sums are those of that run: then each world steps bit for bit as alone.
+  void upload(const World& world, const std::vector<int>& worldOf, const std::vector<int>& vesselSlots, const std::vector<int>& vesselDofs);
+  // One world holding everything (a single run).
+  void upload(const World& world, int vesselDof, int vesselSlot) { upload(world, {}, {vesselSlot}, {vesselDof}); }
+  int worlds() const;
+  // Each device slot's world, on the host (follows re-sorts and edits).
+  const std::vector<int>& worldOfSlots() const;
   // Re-sorts the bodies along the curve on the device, as World::curveOrder + World::permute do on
-  // the host, bit for bit. Returns the order (new slot k holds old slot order[k]) so that the host
+  // the host, bit for bit: world by world (each world's curve over its own bodies' box), worlds in
+  // ascending order. Returns the order (new slot k holds old slot order[k]) so that the host
   // can apply it to its mirror when it next needs it. The captured graph stays valid unless a
   // device broadphase could not follow the new order (CudaBroadphase::reorder): then
   // *broadphaseFollowed is false and the caller uploads the world.
   std::vector<int> reorderAlongCurve(bool* broadphaseFollowed);
   // Positions, angles and velocities back into the host world (the rest changes on the device only
-  // through editBodies, which the host made first).
+  // through editBodies, which the host made first). One world only.
   void download(World& world) const;
   // The same for a few bodies only: device slot deviceSlots[k] into host row hostSlots[k] (the
   // topology phase reads only the bodies its requests name).
   void downloadKinematics(const std::vector<int>& deviceSlots, const std::vector<int>& hostSlots, World& world) const;
   // A topology edit, replayed on the device without moving the world: the bodies at removedSlots
-  // (ascending) leave, the others keep their order and their state, and the bodies after[firstAdded..]
-  // (made on the host by World::addBody) are appended. `after` is the host world after the same
-  // edit. Returns false when the device broadphase could not follow (CudaBroadphase::edited): the
-  // caller then hands it the world in the device's order (uploadBroadphase).
-  bool editBodies(const std::vector<int>& removedSlots, const World& after, int firstAdded, int vesselDof);
+  // (ascending) leave, the others keep their order and their state, and the bodies
+  // added[firstAdded..] (made on the host by World::addBody) are appended, body k of them into world
+  // addedWorlds[k] (empty: world 0). vesselDofs: per world, as upload's. Returns false when the
+  // device broadphase could not follow (CudaBroadphase::edited): the caller then hands it the
+  // world in the device's order (uploadBroadphase).
+  bool editBodies(const std::vector<int>& removedSlots, const World& added, int firstAdded, const std::vector<int>& addedWorlds,
+                  const std::vector<int>& vesselDofs);
   // The device broadphase rebuilds its per-body storage from the host world (in the device's order).
   void uploadBroadphase(const World& world);
   // Steps kept on the device between two copies to the host (the ring's length), and threads per

@@ -545,3 +545,82 @@ TEST(CudaBackend, ReSortOnTheDeviceGivesTheHostsCurveOrder) {
   for (int k = 0; k < static_cast<int>(order.size()); ++k) ASSERT_EQ(order[k], k) << "slot " << k;
   EXPECT_NE(before, w.id);  // the re-sort moved bodies (the pack moved in 200 steps)
 }
+
+// Cases run together in one device state (gem sweep's batches on a GPU): each must step exactly as
+// it does alone, bit for bit, though they differ in field, ice, thrust (a Params of its own per
+// world) and in how their floes break (each world's edits, re-sorts and new ids are its own).
+TEST(CudaBackend, CasesRunTogetherStepExactlyAsAlone) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  const std::vector<std::vector<std::string>> variants = {
+      {},
+      {"field.thickness=0.25", "vessel.bollard_thrust=370e3", "simulation.seed=5"},
+      {"domain.x=[0.0, 240.0]", "field.thickness=0.25", "field.concentration=0.3"},
+  };
+  std::vector<Scenario> scenarios;
+  for (size_t k = 0; k < variants.size(); ++k) {
+    std::vector<std::string> overrides = variants[k];
+    overrides.insert(overrides.end(), {"simulation.steps=420", "simulation.broadphase=\"uniform_grid\""});
+    scenarios.push_back(loadScenario(dir.write("case" + std::to_string(k) + ".toml", kBusyScene), overrides));
+  }
+  std::vector<const Scenario*> pointers;
+  for (const Scenario& s : scenarios) pointers.push_back(&s);
+  std::vector<std::unique_ptr<CudaSimulation>> together = CudaSimulation::together(pointers);
+  ASSERT_EQ(together.size(), 3u);
+  EXPECT_EQ(together[0]->casesOnDevice(), 3);
+  std::vector<std::unique_ptr<CudaSimulation>> alone;
+  for (const Scenario& s : scenarios) alone.push_back(std::make_unique<CudaSimulation>(s));
+
+  std::vector<long> impacts(3, 0);
+  for (long step = 0; step < 420; ++step) {
+    for (auto& sim : together) sim->step();  // every case's step before any case's next
+    for (size_t k = 0; k < 3; ++k) {
+      CudaSimulation& a = *alone[k];
+      CudaSimulation& b = *together[k];
+      a.step();
+      SCOPED_TRACE(::testing::Message() << "case " << k << ", step " << step);
+      ASSERT_EQ(a.contactCount(), b.contactCount());
+      ASSERT_EQ(a.impacts().size(), b.impacts().size());
+      for (size_t i = 0; i < a.impacts().size(); ++i) {
+        ASSERT_EQ(a.impacts()[i].floeId, b.impacts()[i].floeId);
+        ASSERT_EQ(a.impacts()[i].force, b.impacts()[i].force);
+      }
+      impacts[k] += static_cast<long>(a.impacts().size());
+      const VesselSample va = a.vessel(), vb = b.vessel();
+      ASSERT_EQ(va.position.x, vb.position.x);
+      ASSERT_EQ(va.velocity.x, vb.velocity.x);
+      ASSERT_EQ(a.vesselIceForce().x, b.vesselIceForce().x);
+      ASSERT_EQ(a.floesBroken(), b.floesBroken());
+    }
+    if (step + 1 == 200)  // a batch ends at the re-sort: the worlds may be read there
+      for (size_t k = 0; k < 3; ++k) EXPECT_EQ(alone[k]->hostWorld().id, together[k]->hostWorld().id);
+  }
+  for (size_t k = 0; k < 3; ++k) {
+    SCOPED_TRACE(::testing::Message() << "case " << k);
+    const State a = capture(*alone[k], impacts[k]), b = capture(*together[k], impacts[k]);
+    ASSERT_EQ(a.ids, b.ids);
+    EXPECT_EQ(0, std::memcmp(a.values.data(), b.values.data(), a.values.size() * sizeof(Real)));
+    EXPECT_EQ(alone[k]->rubbleMass(), together[k]->rubbleMass());
+    EXPECT_GT(impacts[k], 0);
+  }
+  // The cases differ (else this proves little), and the thinner ice broke in two of them.
+  EXPECT_NE(impacts[0], impacts[1]);
+  EXPECT_GT(together[1]->floesBroken(), 0);
+  EXPECT_GT(together[2]->floesBroken(), 0);
+}
+
+TEST(CudaBackend, CasesThatCannotShareADeviceStateAreRefused) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  const std::string grid = "simulation.broadphase=\"uniform_grid\"";
+  const Scenario a = test::scenarioFromToml(dir, kBusyScene, {grid});
+  const Scenario longer = test::scenarioFromToml(dir, kBusyScene, {grid, "simulation.steps=301"});
+  const Scenario kept = test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"variable_radius\""});
+  EXPECT_NE(CudaSimulation::batchKey(a), "");
+  EXPECT_EQ(CudaSimulation::batchKey(kept), "");
+  EXPECT_THROW(CudaSimulation::together({&a, &longer}), BackendUnsupported);
+  EXPECT_THROW(CudaSimulation::together({&a, &kept}), BackendUnsupported);
+  // What a sweep varies (thrust, ice, the field) does not keep cases apart.
+  EXPECT_EQ(CudaSimulation::batchKey(a),
+            CudaSimulation::batchKey(test::scenarioFromToml(dir, kBusyScene, {grid, "vessel.bollard_thrust=1e5", "field.thickness=0.7"})));
+}
