@@ -193,6 +193,9 @@ int main(int argc, char** argv) {
   sweepCommand->add_option("--out", sweep.outDir, "sweep folder (default runs/NAME)");
   sweepCommand->add_option("--jobs", sweep.jobs, "cases run at once (default: all cores)");
   sweepCommand->add_option("--case-index", sweep.caseIndex, "run only case I (0-based), e.g. in a job array");
+  sweepCommand->add_option("--batch", sweep.batch,
+                           "on a GPU, the most cases run together in one device state (default 0: automatic; 1: one case at a time)")
+      ->check(CLI::NonNegativeNumber);
   sweepCommand->add_flag("--quiet", sweep.quiet, "no progress");
 
   try {

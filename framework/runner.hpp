@@ -2,7 +2,10 @@
 // observers, MODEL.md 8 phase 7). Files are written under temporary names and renamed, so a
 // crash leaves only whole files; summary.json is written last, and only after a complete run.
 #pragma once
+#include <functional>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "framework/scenario.hpp"
 #include "framework/stepper.hpp"
@@ -30,9 +33,20 @@ struct RunSummary {
   // Over the steady part of the transit: the whole hull within the domain's x range.
   Stats shipSpeedInIce, netThrustInIce;
   std::string outputDir;
+  int casesOnDevice = 1;  // > 1: run together with other cases in one device state (wallTime is theirs together)
 };
 
 RunSummary runScenario(const Scenario& scenario, const RunOptions& options);
+
+// Scenarios whose steppers share one device state (a sweep's batch on a GPU, made by the backend's
+// makeTogether): stepped together, every one's step k before any one's step k + 1, each writing its
+// own outputs exactly as runScenario does (wall_time_s is the batch's). They must have the same
+// number of steps. Returns, per scenario, "" when it completed, else why it failed; a failure of
+// the shared stepping fails every case still running, and each keeps what it wrote.
+// progress(step, steps), when given, is called after each step.
+std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>& scenarios,
+                                              std::vector<std::unique_ptr<Stepper>> steppers,
+                                              const std::function<void(long step, long steps)>& progress = {});
 
 std::string summaryJson(const RunSummary& s);
 

@@ -57,6 +57,12 @@ struct BackendEntry {
   // `worker` modulo the device count (a sweep's workers, over MPI ranks and threads, spread over the
   // GPUs of their node). Empty for a backend without devices.
   std::function<void(int worker)> useDeviceForWorker;
+  // Sweeps on a device: cases whose batchKey is the same and not "" may run together in one device
+  // state (makeTogether: a stepper each, stepped together by runScenariosTogether), each exactly as
+  // alone. deviceCount: the devices this process sees. All three empty for the CPU.
+  std::function<std::string(const Scenario&)> batchKey;
+  std::function<std::vector<std::unique_ptr<Stepper>>(const std::vector<const Scenario*>&)> makeTogether;
+  std::function<int()> deviceCount;
 };
 
 void registerBackend(BackendEntry entry);

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -98,6 +99,56 @@ std::string formatDuration(double seconds) {
   return s >= 3600 ? fmt::format("{}h{:02}m", s / 3600, (s / 60) % 60) : fmt::format("{}m{:02}s", s / 60, s % 60);
 }
 
+// The sweep's work, in units a worker takes at once: a case alone, or cases that run together in
+// one device state (a backend with makeTogether; cases with the same batchKey). batch: the most
+// cases per device state (0: automatic, 1: none together). Automatic: up to kMostTogether, and
+// each group split over the node's devices (under MPI, over the ranks) so that every one has work.
+constexpr size_t kMostTogether = 128;
+
+std::vector<std::vector<size_t>> workUnits(const SweepDefinition& sweep, const std::vector<fs::path>& dirs, const std::vector<size_t>& todo,
+                                           int batch, int ranks) {
+  std::vector<std::vector<size_t>> units;
+  std::map<std::pair<std::string, std::string>, std::vector<size_t>> groups;  // (backend, key) -> cases, in order
+  std::vector<std::pair<std::string, std::string>> groupOrder;
+  for (size_t i : todo) {
+    const BackendEntry* backend = nullptr;
+    std::string key;
+    if (batch != 1) {
+      try {
+        const Scenario s = loadCase(sweep.cases[i], dirs[i]);
+        backend = findBackend(resolveBackend(s.backend));
+        if (backend && backend->makeTogether && backend->batchKey) key = backend->batchKey(s);
+      } catch (const InputError&) {
+        key.clear();  // a backend that is not there: the case runs alone, and its run says why it cannot
+      }
+    }
+    if (key.empty()) {
+      units.push_back({i});
+      continue;
+    }
+    const auto id = std::make_pair(backend->name, key);
+    if (!groups.count(id)) groupOrder.push_back(id);
+    groups[id].push_back(i);
+  }
+  for (const auto& id : groupOrder) {
+    const std::vector<size_t>& cases = groups[id];
+    const size_t most = batch > 1 ? static_cast<size_t>(batch) : kMostTogether;
+    size_t parts = (cases.size() + most - 1) / most;
+    if (batch <= 0) {
+      const BackendEntry* backend = findBackend(id.first);
+      const size_t spread = ranks > 0 ? static_cast<size_t>(ranks) : static_cast<size_t>(backend->deviceCount ? std::max(1, backend->deviceCount()) : 1);
+      parts = std::max(parts, std::min(cases.size(), spread));
+    }
+    // Consecutive cases, the parts as equal as can be.
+    for (size_t p = 0, at = 0; p < parts; ++p) {
+      const size_t size = cases.size() / parts + (p < cases.size() % parts ? 1 : 0);
+      units.emplace_back(cases.begin() + static_cast<std::ptrdiff_t>(at), cases.begin() + static_cast<std::ptrdiff_t>(at + size));
+      at += size;
+    }
+  }
+  return units;
+}
+
 // What the workers share: the queue of cases to run and the tally.
 struct SweepState {
   std::mutex mutex;
@@ -147,9 +198,13 @@ int runSweep(const SweepOptions& options) {
   }
   // Every rank must see the same list before any of them starts changing case folders.
   mpi.sumOverRanks(0);
-  // Under MPI a rank runs one case at a time unless --jobs says otherwise (one rank per core).
+  const std::vector<std::vector<size_t>> units = workUnits(sweep, dirs, todo, options.batch, mpi.active() ? mpi.size() : 0);
+  size_t together = 0;
+  for (const auto& unit : units)
+    if (unit.size() > 1) together += unit.size();
+  // Under MPI a rank runs one unit at a time unless --jobs says otherwise (one rank per core).
   const unsigned cores = mpi.active() ? 1u : std::max(1u, std::thread::hardware_concurrency());
-  const size_t jobs = std::min<size_t>(options.jobs > 0 ? static_cast<size_t>(options.jobs) : cores, std::max<size_t>(todo.size(), 1));
+  const size_t jobs = std::min<size_t>(options.jobs > 0 ? static_cast<size_t>(options.jobs) : cores, std::max<size_t>(units.size(), 1));
   fs::create_directories(outDir / "cases");
   const bool terminal = !options.quiet && isatty(fileno(stderr));
   if (!options.quiet && mpi.rank() == 0) {
@@ -157,6 +212,8 @@ int runSweep(const SweepOptions& options) {
     if (options.caseIndex >= 0) std::printf(", running case %ld only", options.caseIndex);
     if (mpi.active()) std::printf("; %zu to run on %d MPI ranks x %zu thread%s", todo.size(), mpi.size(), jobs, jobs == 1 ? "" : "s");
     else std::printf("; %zu to run on %zu thread%s", todo.size(), jobs, jobs == 1 ? "" : "s");
+    if (together) std::printf(" (%zu of them in %zu device run%s of several cases)", together, units.size() - (todo.size() - together),
+                              units.size() - (todo.size() - together) == 1 ? "" : "s");
     if (skipped) std::printf(", %zu already complete", skipped);
     if (stale) std::printf(", %zu complete but changed since (run again)", stale);
     std::printf("\n  folder %s\n", outDir.string().c_str());
@@ -165,55 +222,81 @@ int runSweep(const SweepOptions& options) {
 
   SweepState state;
   const auto start = std::chrono::steady_clock::now();
-  // Under mpirun the ranks share one counter (cases go to whichever rank is free); alone, the
+  // Under mpirun the ranks share one counter (units go to whichever rank is free); alone, the
   // threads of this process share theirs.
-  auto claim = [&]() { return mpi.active() ? mpi.next(todo.size()) : state.next++; };
+  auto claim = [&]() { return mpi.active() ? mpi.next(units.size()) : state.next++; };
+  // A case's folder, ready for its run: the old summary goes first (a scenario.toml beside a
+  // summary of another scenario would pass for complete if this run failed before writing its own).
+  auto prepareCase = [&](size_t i) {
+    Scenario s = loadCase(sweep.cases[i], dirs[i]);
+    fs::create_directories(dirs[i]);
+    fs::remove(dirs[i] / "summary.json");
+    writeFileAtomically(dirs[i] / "scenario.toml", texts[i]);
+    return s;
+  };
+  auto finished = [&](size_t i, const std::string& failure, double seconds, size_t with) {
+    std::lock_guard lock(state.mutex);
+    --state.running;
+    ++state.finished;
+    const SweepCase& c = sweep.cases[i];
+    if (!failure.empty()) state.failures.emplace_back(c.name, failure);
+    if (!options.quiet && !terminal) {
+      const std::string who = mpi.active() ? fmt::format("rank {} ", mpi.rank()) : std::string();
+      const std::string how = with > 1 ? fmt::format(" (with {} cases in one device state)", with) : std::string();
+      if (failure.empty()) std::printf("  %s[%zu/%zu] %s  %.1f s%s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), seconds, how.c_str());
+      else std::printf("  %s[%zu/%zu] %s  FAILED: %s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), failure.c_str());
+      std::fflush(stdout);
+    }
+    state.changed.notify_all();
+  };
+  auto message = [](auto&& body) -> std::string {
+    try {
+      body();
+      return "";
+    } catch (const std::exception& e) {
+      return e.what();
+    } catch (...) {
+      return "unknown error";
+    }
+  };
   // Worker w of this node (its rank's local index x threads + its thread) runs on device w modulo
   // the node's devices, for every backend that has devices: one GPU per rank, or per thread.
   auto worker = [&](size_t thread) {
     const int node = mpi.localRank() * static_cast<int>(jobs) + static_cast<int>(thread);
     for (const std::string& name : backendNames())
       if (const BackendEntry* b = findBackend(name); b && b->useDeviceForWorker) b->useDeviceForWorker(node);
-    for (size_t k = claim(); k < todo.size(); k = claim()) {
-      const size_t i = todo[k];
-      const SweepCase& c = sweep.cases[i];
+    for (size_t k = claim(); k < units.size(); k = claim()) {
+      const std::vector<size_t>& unit = units[k];
       {
         std::lock_guard lock(state.mutex);
-        ++state.running;
+        state.running += unit.size();
       }
-      const auto caseStart = std::chrono::steady_clock::now();
-      std::string failure;
-      try {
-        Scenario s = loadCase(c, dirs[i]);
-        fs::create_directories(dirs[i]);
-        // The old summary goes first: a scenario.toml beside a summary of another scenario would
-        // pass for complete if this run failed before writing its own.
-        fs::remove(dirs[i] / "summary.json");
-        writeFileAtomically(dirs[i] / "scenario.toml", texts[i]);
-        RunOptions runOptions;
-        runOptions.quiet = true;
-        runScenario(s, runOptions);
-      } catch (const std::exception& e) {
-        failure = e.what();
-      } catch (...) {
-        failure = "unknown error";
+      const auto unitStart = std::chrono::steady_clock::now();
+      if (unit.size() == 1) {
+        const std::string failure = message([&] {
+          RunOptions runOptions;
+          runOptions.quiet = true;
+          runScenario(prepareCase(unit[0]), runOptions);
+        });
+        finished(unit[0], failure, std::chrono::duration<double>(std::chrono::steady_clock::now() - unitStart).count(), 1);
+        continue;
       }
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - caseStart).count();
-      std::lock_guard lock(state.mutex);
-      --state.running;
-      ++state.finished;
-      if (!failure.empty()) state.failures.emplace_back(c.name, failure);
-      if (!options.quiet && !terminal) {
-        const std::string who = mpi.active() ? fmt::format("rank {} ", mpi.rank()) : std::string();
-        if (failure.empty()) std::printf("  %s[%zu/%zu] %s  %.1f s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), seconds);
-        else std::printf("  %s[%zu/%zu] %s  FAILED: %s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), failure.c_str());
-        std::fflush(stdout);
-      }
-      state.changed.notify_all();
+      // Cases run together in one device state (workUnits grouped them by the backend's batchKey).
+      std::vector<Scenario> scenarios;
+      std::vector<const Scenario*> pointers;
+      std::vector<std::string> failures(unit.size());
+      std::string shared = message([&] {
+        for (size_t i : unit) scenarios.push_back(prepareCase(i));
+        for (const Scenario& s : scenarios) pointers.push_back(&s);
+        const BackendEntry* backend = findBackend(resolveBackend(scenarios.front().backend));
+        failures = runScenariosTogether(pointers, backend->makeTogether(pointers));
+      });
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - unitStart).count();
+      for (size_t j = 0; j < unit.size(); ++j) finished(unit[j], shared.empty() ? failures[j] : shared, seconds, unit.size());
     }
   };
   std::vector<std::thread> threads;
-  for (size_t t = 0; t < jobs && t < todo.size(); ++t) threads.emplace_back(worker, t);
+  for (size_t t = 0; t < jobs && t < units.size(); ++t) threads.emplace_back(worker, t);
   if (terminal && !todo.empty() && !mpi.active()) {
     std::unique_lock lock(state.mutex);
     while (state.finished < todo.size()) {

@@ -57,6 +57,13 @@
 // complete, so the last task to finish writes the full table (or run the sweep once more: all
 // complete cases are skipped and the table is gathered).
 //
+// On a GPU (backend cuda, or auto with a device), cases that differ only in what their worlds hold
+// (the field, the ice, the vessel's thrust: not dt, steps, outputs' frames, the events enabled or
+// the broadphase, which must be uniform_grid) run together in one device state, a world each, so
+// that a sweep of small cases fills the device: up to 128 per state, or --batch N; --batch 1 runs
+// one case at a time. Each case's results are bit for bit those of its run alone; its summary's
+// wall_time_s is the batch's and cases_on_device says how many shared it.
+//
 // Every case's scenario is loaded and validated before any runs, so a typo fails fast: the error
 // names the sweep file's line and column of the offending key. A case that fails while running is
 // reported with its message, the others go on, and the exit status is 1.
@@ -70,6 +77,7 @@ struct SweepOptions {
   std::string outDir;      // default: beside the sweep file, "runs/<sweep name>"
   int jobs = 0;            // parallel cases; 0 = the number of cores
   long caseIndex = -1;     // run only this case (job arrays); -1 = all
+  int batch = 0;           // on a GPU, the most cases run together in one device state; 0 = automatic, 1 = none
   bool quiet = false;
 };
 

@@ -668,9 +668,16 @@ void CudaSimulation::followReorder(const std::vector<int>& order) {
 
 // The backend's entry: listed by `gem info`, chosen by --backend cuda and by backend = "auto".
 static const bool kRegistered = [] {
-  registerBackend(BackendEntry{"cuda", [] { return cudaAvailable(); }, [] { return cudaDeviceName(); },
-                               [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CudaSimulation>(s); },
-                               useCudaDeviceForWorker});
+  registerBackend(BackendEntry{
+      "cuda", [] { return cudaAvailable(); }, [] { return cudaDeviceName(); },
+      [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CudaSimulation>(s); }, useCudaDeviceForWorker,
+      CudaSimulation::batchKey,
+      [](const std::vector<const Scenario*>& scenarios) {
+        std::vector<std::unique_ptr<Stepper>> steppers;
+        for (auto& s : CudaSimulation::together(scenarios)) steppers.push_back(std::move(s));
+        return steppers;
+      },
+      deviceCount});
   return true;
 }();
 

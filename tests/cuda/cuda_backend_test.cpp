@@ -624,3 +624,45 @@ TEST(CudaBackend, CasesThatCannotShareADeviceStateAreRefused) {
   EXPECT_EQ(CudaSimulation::batchKey(a),
             CudaSimulation::batchKey(test::scenarioFromToml(dir, kBusyScene, {grid, "vessel.bollard_thrust=1e5", "field.thickness=0.7"})));
 }
+
+// `gem sweep` on a GPU runs its cases together in one device state: every case's outputs must be
+// byte for byte those of the same sweep run one case at a time (--batch 1), and its summary the
+// same but for the wall time and the count of cases that shared the device.
+TEST(CudaBackend, SweepRunsItsCasesTogetherWithTheOutputsOfSingleRuns) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  dir.write("busy.toml", kBusyScene);
+  const auto sweep = dir.write("together.toml", R"([sweep]
+base = "busy.toml"
+set = { "simulation.steps" = 300, "simulation.backend" = "cuda", "simulation.broadphase" = "uniform_grid" }
+[parameters]
+"vessel.bollard_thrust" = [370e3, 740e3]
+"field.thickness" = [0.25, 0.4]
+)");
+  const auto together = dir.path() / "together", single = dir.path() / "single";
+  ASSERT_EQ(0, test::runGem("sweep " + sweep.string() + " --out " + together.string(), dir.path() / "log1.txt"))
+      << test::readFile(dir.path() / "log1.txt");
+  ASSERT_EQ(0, test::runGem("sweep " + sweep.string() + " --batch 1 --out " + single.string(), dir.path() / "log2.txt"))
+      << test::readFile(dir.path() / "log2.txt");
+  EXPECT_NE(test::readFile(dir.path() / "log1.txt").find("4 of them in 1 device run"), std::string::npos) << test::readFile(dir.path() / "log1.txt");
+  auto withoutTiming = [](std::string json) {
+    for (const char* key : {"\"wall_time_s\"", "\"real_time_factor\"", "\"cases_on_device\""}) {
+      const size_t at = json.find(key);
+      if (at != std::string::npos) json.erase(at, json.find('\n', at) - at);
+    }
+    return json;
+  };
+  int cases = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(together / "cases")) {
+    const std::string name = entry.path().filename().string();
+    SCOPED_TRACE(name);
+    ++cases;
+    for (const char* file : {"timeseries.csv", "impacts.csv", "state.csv"})
+      EXPECT_EQ(test::readFile(entry.path() / file), test::readFile(single / "cases" / name / file)) << file;
+    const std::string a = test::readFile(entry.path() / "summary.json"), b = test::readFile(single / "cases" / name / "summary.json");
+    EXPECT_NE(a.find("\"cases_on_device\": 4"), std::string::npos) << a;
+    EXPECT_NE(b.find("\"cases_on_device\": 1"), std::string::npos) << b;
+    EXPECT_EQ(withoutTiming(a), withoutTiming(b));
+  }
+  EXPECT_EQ(cases, 4);
+}
