@@ -9,6 +9,8 @@
 
 #include "framework/errors.hpp"
 #include "framework/runner.hpp"
+#include "framework/simulation.hpp"
+#include "framework/stepper.hpp"
 #include "framework/sweep.hpp"
 #include "framework/sweep_file.hpp"
 #include "framework/sweep_summary.hpp"
@@ -355,3 +357,113 @@ INSTANTIATE_TEST_SUITE_P(
                  "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n[[cases]]\nname = \"a\"\nset = { vessel.bollard_thrust = 2.0 }\n",
                  {"bad_sweep.toml:7:", "also varied"}}),
     [](const auto& info) { return std::string(info.param.name); });
+
+namespace {
+
+// A stand-in for a device backend that runs cases together in one state (CUDA's
+// CudaSimulation::together needs a GPU; its own tests run there): CPU simulations registered under
+// "cuda" while the test runs, each checking that the cases of its batch are stepped in lockstep.
+struct Batch {
+  std::vector<Stepper*> members;
+  bool outOfStep = false;
+};
+
+class LockstepStepper final : public Stepper {
+ public:
+  LockstepStepper(const Scenario& s, std::shared_ptr<Batch> batch) : m_sim(s), m_batch(std::move(batch)) {}
+  void step() override {
+    // Every case's step k before any case's step k + 1: no case is behind this one.
+    for (Stepper* other : m_batch->members)
+      if (other->stepIndex() < m_sim.stepIndex()) m_batch->outOfStep = true;
+    m_sim.step();
+  }
+  long stepIndex() const override { return m_sim.stepIndex(); }
+  Real time() const override { return m_sim.time(); }
+  const World& hostWorld() override { return m_sim.hostWorld(); }
+  VesselSample vessel() override { return m_sim.vessel(); }
+  const std::vector<ImpactRecord>& impacts() const override { return m_sim.impacts(); }
+  int contactCount() const override { return m_sim.contactCount(); }
+  Vec2 vesselIceForce() const override { return m_sim.vesselIceForce(); }
+  double rubbleMass() const override { return m_sim.rubbleMass(); }
+  long floesBroken() const override { return m_sim.floesBroken(); }
+  std::string device() const override { return m_sim.device(); }
+  std::string backend() const override { return m_sim.backend(); }
+
+ private:
+  Simulation m_sim;
+  std::shared_ptr<Batch> m_batch;
+};
+
+struct TogetherBackend {
+  std::vector<std::shared_ptr<Batch>> batches;
+  const BackendEntry* previous;
+  BackendEntry saved;
+  TogetherBackend() : previous(findBackend("cuda")) {
+    if (previous) saved = *previous;
+    registerBackend(BackendEntry{
+        "cuda", [] { return true; }, [] { return std::string("stand-in"); },
+        [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); }, nullptr,
+        [](const Scenario& s) { return "steps=" + std::to_string(s.steps); },
+        [this](const std::vector<const Scenario*>& scenarios) {
+          auto batch = std::make_shared<Batch>();
+          std::vector<std::unique_ptr<Stepper>> steppers;
+          for (const Scenario* s : scenarios) {
+            steppers.push_back(std::make_unique<LockstepStepper>(*s, batch));
+            batch->members.push_back(steppers.back().get());
+          }
+          batches.push_back(batch);
+          return steppers;
+        },
+        [] { return 1; }});
+  }
+  ~TogetherBackend() {
+    // Put back what was there (the real CUDA backend in a CUDA build), or one that is never available.
+    if (previous) registerBackend(saved);
+    else registerBackend(BackendEntry{"cuda", [] { return false; }, [] { return std::string("none"); }, nullptr, nullptr});
+  }
+};
+
+}  // namespace
+
+// Cases that a device backend runs together (one state, stepped in lockstep by
+// runScenariosTogether) must write what single runs write; --batch caps a state's cases and
+// --batch 1 runs each alone.
+TEST(Sweep, CasesRunTogetherWriteTheOutputsOfSingleRuns) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path cpu = dir.write("cpu.toml", std::string(kProduct) + "\n");
+  std::string together = kProduct;
+  together.replace(together.find("set = {"), 7, "set = { \"simulation.backend\" = \"cuda\", ");
+  const fs::path file = dir.write("together.toml", together);
+  ASSERT_EQ(sweep(cpu, dir.path() / "cpu"), 0);
+  TogetherBackend backend;
+  auto run = [&](const std::string& name, int batch) {
+    SweepOptions o;
+    o.sweepFile = file.string();
+    o.outDir = (dir.path() / name).string();
+    o.jobs = 2;
+    o.batch = batch;
+    o.quiet = true;
+    return runSweep(o);
+  };
+  ASSERT_EQ(run("all", 0), 0);
+  ASSERT_EQ(backend.batches.size(), 1u);
+  EXPECT_EQ(backend.batches[0]->members.size(), 4u);
+  ASSERT_EQ(run("pairs", 2), 0);
+  ASSERT_EQ(backend.batches.size(), 3u);
+  EXPECT_EQ(backend.batches[1]->members.size(), 2u);
+  ASSERT_EQ(run("alone", 1), 0);
+  EXPECT_EQ(backend.batches.size(), 3u);  // no case ran together with another
+  for (const auto& batch : backend.batches) EXPECT_FALSE(batch->outOfStep);
+
+  for (const auto& entry : fs::directory_iterator(dir.path() / "cpu" / "cases")) {
+    const std::string name = entry.path().filename().string();
+    SCOPED_TRACE(name);
+    for (const char* run : {"all", "pairs", "alone"})
+      for (const char* file : {"timeseries.csv", "impacts.csv", "state.csv"})
+        EXPECT_EQ(test::readFile(entry.path() / file), test::readFile(dir.path() / run / "cases" / name / file)) << run << " " << file;
+    EXPECT_EQ(readSummaryJson(dir.path() / "all" / "cases" / name / "summary.json").at("cases_on_device"), "4");
+    EXPECT_EQ(readSummaryJson(dir.path() / "pairs" / "cases" / name / "summary.json").at("cases_on_device"), "2");
+    EXPECT_EQ(readSummaryJson(dir.path() / "alone" / "cases" / name / "summary.json").at("cases_on_device"), "1");
+  }
+}
