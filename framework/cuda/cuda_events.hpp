@@ -116,8 +116,11 @@ class WorldParams {
   Params* m_perWorld = nullptr;
 };
 
+// A copy, not a reference: a reference that may point at a kernel parameter makes the compiler
+// address the parameter space generically, which compute-sanitizer reported as an out-of-bounds
+// global read in kernels of a graph's WHILE body (the pair kernel of ship_impact).
 template <class Params>
-__device__ inline const Params& paramsOf(const Params& first, const Params* perWorld, const int* world, int body) {
+__device__ inline Params paramsOf(const Params& first, const Params* perWorld, const int* world, int body) {
   return perWorld ? perWorld[world[body]] : first;
 }
 
@@ -127,7 +130,8 @@ __global__ void pairEventKernel(Params params, const Params* perWorld, DevicePai
   if (k >= d.count || k >= *d.liveCount) return;
   const StepContext ctx = *d.ctx;
   const int a = d.contactA[k];
-  Event::apply(paramsOf(params, perWorld, d.world, a), d.bodies[a], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], ctx, d.sink);
+  const Params p = paramsOf(params, perWorld, d.world, a);
+  Event::apply(p, d.bodies[a], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], ctx, d.sink);
 }
 
 template <class Event, class Params>
@@ -135,7 +139,8 @@ __global__ void soloEventKernel(Params params, const Params* perWorld, DeviceSol
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= d.count) return;
   const StepContext ctx = *d.ctx;
-  Event::apply(paramsOf(params, perWorld, d.world, i), d.bodies[i], d.changes[i], ctx);
+  const Params p = paramsOf(params, perWorld, d.world, i);
+  Event::apply(p, d.bodies[i], d.changes[i], ctx);
 }
 
 template <class Event, class Params>
@@ -143,7 +148,8 @@ __global__ void motionKernel(Params params, const Params* perWorld, DeviceMotion
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= d.count) return;
   const StepContext ctx = *d.ctx;
-  Event::apply(paramsOf(params, perWorld, d.world, i), d.bodies[i], ctx);
+  const Params p = paramsOf(params, perWorld, d.world, i);
+  Event::apply(p, d.bodies[i], ctx);
 }
 
 template <class Event>
