@@ -156,6 +156,7 @@ struct SweepState {
   std::atomic<size_t> next{0};
   size_t finished = 0, running = 0;
   std::vector<std::pair<std::string, std::string>> failures;  // case name, message
+  std::map<size_t, double> together;  // unit -> cases' worth done, for units of cases run together
 };
 
 }  // namespace
@@ -289,9 +290,22 @@ int runSweep(const SweepOptions& options) {
         for (size_t i : unit) scenarios.push_back(prepareCase(i));
         for (const Scenario& s : scenarios) pointers.push_back(&s);
         const BackendEntry* backend = findBackend(resolveBackend(scenarios.front().backend));
-        failures = runScenariosTogether(pointers, backend->makeTogether(pointers));
+        // Their progress, for the status line: the cases' worth done so far (every percent).
+        long shown = -1;
+        auto progress = [&](long step, long steps) {
+          const long percent = 100 * step / std::max(steps, 1L);
+          if (percent == shown) return;
+          shown = percent;
+          std::lock_guard lock(state.mutex);
+          state.together[k] = static_cast<double>(unit.size()) * static_cast<double>(step) / static_cast<double>(std::max(steps, 1L));
+        };
+        failures = runScenariosTogether(pointers, backend->makeTogether(pointers), progress);
       });
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - unitStart).count();
+      {
+        std::lock_guard lock(state.mutex);
+        state.together.erase(k);
+      }
       for (size_t j = 0; j < unit.size(); ++j) finished(unit[j], shared.empty() ? failures[j] : shared, seconds, unit.size());
     }
   };
@@ -301,7 +315,10 @@ int runSweep(const SweepOptions& options) {
     std::unique_lock lock(state.mutex);
     while (state.finished < todo.size()) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const double eta = state.finished ? elapsed / state.finished * (todo.size() - state.finished) : NAN;
+      // Cases running together count by how far their steps are.
+      double done = static_cast<double>(state.finished);
+      for (const auto& [unit, worth] : state.together) done += worth;
+      const double eta = done > 0 ? elapsed / done * (static_cast<double>(todo.size()) - done) : NAN;
       std::fprintf(stderr, "\r  cases %zu/%zu done, %zu running%s, elapsed %s, ETA %s   ", state.finished, todo.size(),
                    state.running, state.failures.empty() ? "" : fmt::format(", {} failed", state.failures.size()).c_str(),
                    formatDuration(elapsed).c_str(), formatDuration(eta).c_str());

@@ -105,4 +105,5 @@ exit $status
 RUN
 chmod +x "$stage/run.sh"
 cp "$root/scripts/gpu-record.sh" "$stage/record.sh"  # the README's record run (bench tables, ncu, host timing)
+cp "$root/scripts/gpu-load-study.sh" "$stage/load_study.sh"  # the README's load-study timing (batched and not)
 du -sh "$stage"

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -429,12 +430,32 @@ std::vector<std::unique_ptr<CudaSimulation>> CudaSimulation::together(const std:
                                            : "scenarios " + scenarios.front()->file.string() + " and " + s->file.string() +
                                                  " differ in what cases run together must share: " + key + " | " + own);
   }
-  std::vector<std::unique_ptr<CudaSimulation>> members;
+  // The cases' set-up (parsing, field generation: CPU work, tens of ms each for the load study's
+  // fields) on the host's cores, every thread on this thread's device.
+  const size_t count = scenarios.size();
+  std::vector<std::unique_ptr<CudaSimulation>> members(count);
+  std::vector<std::exception_ptr> errors(count);
+  const int device = bindThreadToDevice();
+  std::atomic<size_t> next{0};
+  auto setUp = [&] {
+    if (cudaSetDevice(device) != cudaSuccess) return;  // the constructor's own CUDA calls then say why
+    for (size_t i = next++; i < count; i = next++) {
+      try {
+        members[i].reset(new CudaSimulation(*scenarios[i], Member{}));
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  const size_t helpers = std::min<size_t>(count, std::max(1u, std::thread::hardware_concurrency())) - 1;
+  for (size_t t = 0; t < helpers; ++t) threads.emplace_back(setUp);
+  setUp();
+  for (std::thread& t : threads) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
   std::vector<CudaSimulation*> raw;
-  for (const Scenario* s : scenarios) {
-    members.push_back(std::unique_ptr<CudaSimulation>(new CudaSimulation(*s, Member{})));
-    raw.push_back(members.back().get());
-  }
+  for (const auto& m : members) raw.push_back(m.get());
   auto batch = std::make_shared<CudaBatch>(raw, members.front()->m_deviceOrdinal);
   for (auto& m : members) m->m_batch = batch;
   for (size_t w = 0; w < members.size(); ++w) members[w]->m_world = static_cast<int>(w);
