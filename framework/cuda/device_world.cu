@@ -728,24 +728,19 @@ __global__ void beginBatchKernel(StepStats* s) {
   s->halt = kRunning;
 }
 
-// A step's start: its context (the host's formula, time = index x dt) and the counters it may rewind to.
-__global__ void beginStepKernel(const BatchControl* c, StepStats* s, StepContext* ctx) {
+// One block for the start and the end of a step: its threads share the worlds' records (a lone
+// run has one; a sweep's batch one per case), and no launch is added per step for them.
+static unsigned stepEdgeThreads(int worlds) { return static_cast<unsigned>(std::min(std::max(worlds, 32), 1024)); }
+
+// A step's start: its context (the host's formula, time = index x dt), the counters it may rewind
+// to, and each world's record emptied.
+__global__ void beginStepKernel(const BatchControl* c, StepStats* s, StepContext* ctx, int worlds, WorldStepRecord* worldStats) {
+  for (int w = threadIdx.x; w < worlds; w += blockDim.x) worldStats[w] = WorldStepRecord{0, {0, 0}, {0, 0}, {0, 0}, 0};
+  if (threadIdx.x != 0) return;
   const long step = c->firstStep + s->stepsDone;
   *ctx = StepContext{c->dt, static_cast<Real>(step) * c->dt, step};
   s->impactBegin = s->impactCount, s->breakBegin = s->breakCount, s->logBegin = s->logCount;
   s->overflow = 0;
-}
-
-// ... and each world's share of it.
-__global__ void beginWorldsKernel(int worlds, WorldStepRecord* worldStats) {
-  const int w = blockIdx.x * blockDim.x + threadIdx.x;
-  if (w < worlds) worldStats[w] = WorldStepRecord{0, {0, 0}, {0, 0}, {0, 0}, 0};
-}
-
-// The worlds' records of a completed step into the ring, beside the step's (endStepKernel, next).
-__global__ void recordWorldsKernel(int worlds, const StepStats* s, const WorldStepRecord* worldStats, WorldStepRecord* ring) {
-  const int w = blockIdx.x * blockDim.x + threadIdx.x;
-  if (w < worlds && !s->overflow) ring[static_cast<size_t>(s->stepsDone) * worlds + w] = worldStats[w];
 }
 
 // After the pair events: records past a buffer's end fail the step like too many candidates do.
@@ -756,7 +751,14 @@ __global__ void checkRecordsKernel(StepStats* s, int capacity) {
 // A step's end: its record into the ring, and whether the loop goes on. It stops when the batch is
 // done, after a step that asked for a break (the host's topology phase comes next), or at a step
 // that overflowed (rewound: the host grows the buffers and runs it again).
-__global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, const BatchControl* c, StepStats* s, StepRecord* ring) {
+__global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, const BatchControl* c, StepStats* s, StepRecord* ring,
+                              int worlds, const WorldStepRecord* worldStats, WorldStepRecord* worldRing) {
+  // The worlds' records beside the step's, at its place in the ring (read before thread 0 moves on).
+  const int done = s->stepsDone;
+  if (!s->overflow)
+    for (int w = threadIdx.x; w < worlds; w += blockDim.x) worldRing[static_cast<size_t>(done) * worlds + w] = worldStats[w];
+  __syncthreads();
+  if (threadIdx.x != 0) return;
   if (s->overflow) {
     s->impactCount = s->impactBegin, s->breakCount = s->breakBegin, s->logCount = s->logBegin;
     s->halt = kHaltOverflow;
@@ -1243,9 +1245,7 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   CubCalls cubCalls{d, d.temp.get(), bytes, false};
   StepStats* stats = d.stats.get();
 
-  beginStepKernel<<<1, 1, 0, s>>>(d.control.get(), stats, d.ctx.get());
-  GEM_CUDA_CHECK_LAUNCH();
-  beginWorldsKernel<<<blocksFor(d.worlds), kBlock, 0, s>>>(d.worlds, d.worldStats.get());
+  beginStepKernel<<<1, stepEdgeThreads(d.worlds), 0, s>>>(d.control.get(), stats, d.ctx.get(), d.worlds, d.worldStats.get());
   GEM_CUDA_CHECK_LAUNCH();
 
   // 1. World vertices, boxes, views, cell keys.
@@ -1346,9 +1346,8 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   GEM_CUDA_CHECK_LAUNCH();
   commitContactsKernel<<<blocksFor(capacity, block), block, 0, s>>>(capacity, d.sortedKeys.get(), d.previousKeys.get(), stats);
   GEM_CUDA_CHECK_LAUNCH();
-  recordWorldsKernel<<<blocksFor(d.worlds), kBlock, 0, s>>>(d.worlds, stats, d.worldStats.get(), d.worldRing.get());
-  GEM_CUDA_CHECK_LAUNCH();
-  endStepKernel<<<1, 1, 0, s>>>(loop, inGraph, d.control.get(), stats, d.ring.get());
+  endStepKernel<<<1, stepEdgeThreads(d.worlds), 0, s>>>(loop, inGraph, d.control.get(), stats, d.ring.get(), d.worlds,
+                                                       d.worldStats.get(), d.worldRing.get());
   GEM_CUDA_CHECK_LAUNCH();
 }
 
