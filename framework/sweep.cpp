@@ -299,7 +299,19 @@ int runSweep(const SweepOptions& options) {
           std::lock_guard lock(state.mutex);
           state.together[k] = static_cast<double>(unit.size()) * static_cast<double>(step) / static_cast<double>(std::max(steps, 1L));
         };
-        failures = runScenariosTogether(pointers, backend->makeTogether(pointers), progress);
+        std::vector<std::unique_ptr<Stepper>> steppers;
+        try {
+          steppers = backend->makeTogether(pointers);
+        } catch (const BackendUnsupported& e) {
+          // Cases the backend cannot hold together after all (too many ids for one state, say):
+          // each runs alone, as with --batch 1.
+          if (!options.quiet) std::fprintf(stderr, "gem sweep: %s; running those %zu cases one at a time\n", e.what(), unit.size());
+          RunOptions runOptions;
+          runOptions.quiet = true;
+          for (size_t j = 0; j < unit.size(); ++j) failures[j] = message([&] { runScenario(scenarios[j], runOptions); });
+          return;
+        }
+        failures = runScenariosTogether(pointers, std::move(steppers), progress);
       });
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - unitStart).count();
       {

@@ -396,6 +396,7 @@ class LockstepStepper final : public Stepper {
 
 struct TogetherBackend {
   std::vector<std::shared_ptr<Batch>> batches;
+  bool refuse = false;  // makeTogether throws BackendUnsupported, as CUDA's does for a state too full
   const BackendEntry* previous;
   BackendEntry saved;
   TogetherBackend() : previous(findBackend("cuda")) {
@@ -405,6 +406,7 @@ struct TogetherBackend {
         [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); }, nullptr,
         [](const Scenario& s) { return "steps=" + std::to_string(s.steps); },
         [this](const std::vector<const Scenario*>& scenarios) {
+          if (refuse) throw BackendUnsupported("these cases cannot share a state");
           auto batch = std::make_shared<Batch>();
           std::vector<std::unique_ptr<Stepper>> steppers;
           for (const Scenario* s : scenarios) {
@@ -454,16 +456,20 @@ TEST(Sweep, CasesRunTogetherWriteTheOutputsOfSingleRuns) {
   EXPECT_EQ(backend.batches[1]->members.size(), 2u);
   ASSERT_EQ(run("alone", 1), 0);
   EXPECT_EQ(backend.batches.size(), 3u);  // no case ran together with another
+  backend.refuse = true;  // the backend turns the group down: its cases run one at a time
+  ASSERT_EQ(run("refused", 0), 0);
+  EXPECT_EQ(backend.batches.size(), 3u);
   for (const auto& batch : backend.batches) EXPECT_FALSE(batch->outOfStep);
 
   for (const auto& entry : fs::directory_iterator(dir.path() / "cpu" / "cases")) {
     const std::string name = entry.path().filename().string();
     SCOPED_TRACE(name);
-    for (const char* run : {"all", "pairs", "alone"})
+    for (const char* run : {"all", "pairs", "alone", "refused"})
       for (const char* file : {"timeseries.csv", "impacts.csv", "state.csv"})
         EXPECT_EQ(test::readFile(entry.path() / file), test::readFile(dir.path() / run / "cases" / name / file)) << run << " " << file;
     EXPECT_EQ(readSummaryJson(dir.path() / "all" / "cases" / name / "summary.json").at("cases_on_device"), "4");
     EXPECT_EQ(readSummaryJson(dir.path() / "pairs" / "cases" / name / "summary.json").at("cases_on_device"), "2");
     EXPECT_EQ(readSummaryJson(dir.path() / "alone" / "cases" / name / "summary.json").at("cases_on_device"), "1");
+    EXPECT_EQ(readSummaryJson(dir.path() / "refused" / "cases" / name / "summary.json").at("cases_on_device"), "1");
   }
 }
