@@ -433,8 +433,11 @@ struct TogetherBackend {
 TEST(Sweep, CasesRunTogetherWriteTheOutputsOfSingleRuns) {
   TempDir dir;
   dir.write("base.toml", kBase);
-  const fs::path cpu = dir.write("cpu.toml", std::string(kProduct) + "\n");
-  std::string together = kProduct;
+  // Frames too: a device state's cases write theirs from the shared state.
+  std::string withFrames = kProduct;
+  withFrames.replace(withFrames.find("set = {"), 7, "set = { \"output.frame_every\" = 10, \"output.formats\" = [\"ice\"], ");
+  const fs::path cpu = dir.write("cpu.toml", withFrames);
+  std::string together = withFrames;
   together.replace(together.find("set = {"), 7, "set = { \"simulation.backend\" = \"cuda\", ");
   const fs::path file = dir.write("together.toml", together);
   ASSERT_EQ(sweep(cpu, dir.path() / "cpu"), 0);
@@ -464,8 +467,9 @@ TEST(Sweep, CasesRunTogetherWriteTheOutputsOfSingleRuns) {
   for (const auto& entry : fs::directory_iterator(dir.path() / "cpu" / "cases")) {
     const std::string name = entry.path().filename().string();
     SCOPED_TRACE(name);
+    EXPECT_FALSE(test::readFile(entry.path() / "frames.ice").empty());
     for (const char* run : {"all", "pairs", "alone", "refused"})
-      for (const char* file : {"timeseries.csv", "impacts.csv", "state.csv"})
+      for (const char* file : {"timeseries.csv", "impacts.csv", "state.csv", "frames.ice"})
         EXPECT_EQ(test::readFile(entry.path() / file), test::readFile(dir.path() / run / "cases" / name / file)) << run << " " << file;
     EXPECT_EQ(readSummaryJson(dir.path() / "all" / "cases" / name / "summary.json").at("cases_on_device"), "4");
     EXPECT_EQ(readSummaryJson(dir.path() / "pairs" / "cases" / name / "summary.json").at("cases_on_device"), "2");

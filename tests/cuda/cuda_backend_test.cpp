@@ -657,7 +657,8 @@ set = { "simulation.steps" = 300, "simulation.backend" = "cuda", "simulation.bro
     const std::string name = entry.path().filename().string();
     SCOPED_TRACE(name);
     ++cases;
-    for (const char* file : {"timeseries.csv", "impacts.csv", "state.csv"})
+    EXPECT_FALSE(test::readFile(entry.path() / "frames.ice").empty());  // frames every 10 steps, read from the shared state
+    for (const char* file : {"timeseries.csv", "impacts.csv", "state.csv", "frames.ice"})
       EXPECT_EQ(test::readFile(entry.path() / file), test::readFile(single / "cases" / name / file)) << file;
     const std::string a = test::readFile(entry.path() / "summary.json"), b = test::readFile(single / "cases" / name / "summary.json");
     EXPECT_NE(a.find("\"cases_on_device\": 4"), std::string::npos) << a;
