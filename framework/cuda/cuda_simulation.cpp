@@ -253,10 +253,12 @@ CudaBatch::~CudaBatch() {
   if (!timing || timing[0] != '1') return;
   const HostTimes& t = times;
   const int bodies = static_cast<int>(m_device->worldOfSlots().size());  // the cases may be gone already
+  const auto [captures, captureSeconds] = m_device->captures();
   std::fprintf(stderr,
-               "gem cuda timing, %ld steps, %d bodies in %d case%s: batches %ld in %.3f s (device steps, copy-back); topology %ld in "
-               "%.3f s (fetch %.3f, events %.3f, device edit %.3f, bookkeeping %.3f); re-sorts %ld in %.3f s; record ordering %.3f s\n",
-               m_stepsDone, bodies, worlds(), worlds() == 1 ? "" : "s", t.batches, t.batch, t.topologies,
+               "gem cuda timing, %ld steps, %d bodies in %d case%s: batches %ld in %.3f s (device steps, copy-back; of it, %ld graph "
+               "captures in %.3f s); topology %ld in %.3f s (fetch %.3f, events %.3f, device edit %.3f, bookkeeping %.3f); re-sorts %ld "
+               "in %.3f s; record ordering %.3f s\n",
+               m_stepsDone, bodies, worlds(), worlds() == 1 ? "" : "s", t.batches, t.batch, captures, captureSeconds, t.topologies,
                t.fetch + t.events + t.edit + t.bookkeeping, t.fetch, t.events, t.edit, t.bookkeeping, t.resorts, t.resort, t.ordering);
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "framework/cuda/cuda_events.hpp"
@@ -98,6 +99,9 @@ class DeviceWorld {
   // copies their results off. Stops early after a step that asked for a break (the host's topology
   // phase comes next). A step that overflowed a buffer is redone, bit-identically, with more room.
   void run(long firstStep, Real dt, int steps, DeviceBatchResult& result);
+  // Step graphs captured and instantiated so far, and the host's seconds for them (a change of
+  // the body count, a topology edit, makes the next batch capture anew).
+  std::pair<long, double> captures() const;
 
  private:
   std::unique_ptr<DeviceState> m_state;
