@@ -105,8 +105,7 @@ std::string formatDuration(double seconds) {
 // each group split over the node's devices (under MPI, over the ranks) so that every one has work.
 constexpr size_t kMostTogether = 128;
 
-std::vector<std::vector<size_t>> workUnits(const SweepDefinition& sweep, const std::vector<fs::path>& dirs, const std::vector<size_t>& todo,
-                                           int batch, int ranks) {
+std::vector<std::vector<size_t>> workUnits(const std::vector<Scenario>& scenarios, const std::vector<size_t>& todo, int batch, int ranks) {
   std::vector<std::vector<size_t>> units;
   std::map<std::pair<std::string, std::string>, std::vector<size_t>> groups;  // (backend, key) -> cases, in order
   std::vector<std::pair<std::string, std::string>> groupOrder;
@@ -115,7 +114,7 @@ std::vector<std::vector<size_t>> workUnits(const SweepDefinition& sweep, const s
     std::string key;
     if (batch != 1) {
       try {
-        const Scenario s = loadCase(sweep.cases[i], dirs[i]);
+        const Scenario& s = scenarios[i];
         backend = findBackend(resolveBackend(s.backend));
         if (backend && backend->makeTogether && backend->batchKey) key = backend->batchKey(s);
       } catch (const InputError&) {
@@ -173,9 +172,11 @@ int runSweep(const SweepOptions& options) {
   // Every case is loaded before any runs: a typo in the sweep fails now, not hours in.
   std::vector<fs::path> dirs;
   std::vector<std::string> texts;
+  std::vector<Scenario> scenarios;  // as each case will run
   for (const SweepCase& c : sweep.cases) {
     dirs.push_back(outDir / "cases" / c.name);
-    texts.push_back(scenarioText(sweep, c, validateCase(sweep, c, dirs.back())));
+    scenarios.push_back(validateCase(sweep, c, dirs.back()));
+    texts.push_back(scenarioText(sweep, c, scenarios.back()));
   }
 
   std::vector<size_t> selected;
@@ -199,7 +200,7 @@ int runSweep(const SweepOptions& options) {
   }
   // Every rank must see the same list before any of them starts changing case folders.
   mpi.sumOverRanks(0);
-  const std::vector<std::vector<size_t>> units = workUnits(sweep, dirs, todo, options.batch, mpi.active() ? mpi.size() : 0);
+  const std::vector<std::vector<size_t>> units = workUnits(scenarios, todo, options.batch, mpi.active() ? mpi.size() : 0);
   size_t together = 0;
   for (const auto& unit : units)
     if (unit.size() > 1) together += unit.size();
@@ -229,7 +230,7 @@ int runSweep(const SweepOptions& options) {
   // A case's folder, ready for its run: the old summary goes first (a scenario.toml beside a
   // summary of another scenario would pass for complete if this run failed before writing its own).
   auto prepareCase = [&](size_t i) {
-    Scenario s = loadCase(sweep.cases[i], dirs[i]);
+    Scenario s = scenarios[i];  // loaded once, before any case ran
     fs::create_directories(dirs[i]);
     fs::remove(dirs[i] / "summary.json");
     writeFileAtomically(dirs[i] / "scenario.toml", texts[i]);
