@@ -164,6 +164,38 @@ __global__ void gatherByOrderKernel(long long count, int width, const int* order
   to[k] = from[static_cast<long long>(order[k / width]) * width + k % width];
 }
 
+// A device strategy built on the kept list (fixed_radius, variable_radius, triangulation_mesh): the
+// list follows re-sorts and topology edits on the device, so a strategy says only how it uploads
+// and which filter its enqueue() applies; one with per-body storage of its own extends reorder()
+// and edited().
+class KeptListBroadphase : public CudaBroadphase {
+ public:
+  explicit KeptListBroadphase(Real skin) : m_list(skin) {}
+  void reserve(cudaStream_t) override { m_list.reserve(); }
+  bool reorder(const int* order, int n, cudaStream_t stream) override {
+    m_list.reorder(order, n, stream);
+    return true;
+  }
+  bool edited(const int* keptOrder, int kept, const World& after, int firstAdded, cudaStream_t stream) override {
+    std::vector<Real> half;
+    std::vector<unsigned char> always;
+    appendedListInputs(after, firstAdded, m_list.skin(), half, always);
+    m_list.edited(keptOrder, kept, half, always, stream);
+    return true;
+  }
+  long rebuilds() const override { return m_list.rebuilds(); }
+
+ protected:
+  // The list of the whole world: each body's reach R + skin / 2 (|c_a - c_b| <= the sum of two
+  // reaches at the build, as variable_radius.cpp), or one global radius where fixedRadius > 0.
+  void uploadList(const World& world, Real fixedRadius) {
+    std::vector<Real> half(world.radius.begin(), world.radius.end());
+    for (Real& h : half) h += m_list.skin() / 2;
+    m_list.upload(world, half, fixedRadius);
+  }
+  DeviceNeighbourList m_list;
+};
+
 // The plain circle test of variable_radius and fixed_radius: nothing on top.
 struct AcceptAll {
 #if defined(__CUDACC__)

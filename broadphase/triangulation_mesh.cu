@@ -46,15 +46,13 @@ struct TrianglesOverlap {
 #endif
 };
 
-class DeviceTriangulationMesh final : public CudaBroadphase {
+class DeviceTriangulationMesh final : public KeptListBroadphase {
  public:
-  explicit DeviceTriangulationMesh(const BroadphaseSettings& s) : m_list(checkedSettings(s).skin) {}
+  explicit DeviceTriangulationMesh(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin) {}
   void upload(const World& world) override {
     const int n = world.size();
     m_rows = n;
-    std::vector<Real> half(world.radius.begin(), world.radius.end());
-    for (Real& h : half) h += m_list.skin() / 2;
-    m_list.upload(world, half, 0);
+    uploadList(world, 0);
     std::vector<int> count(static_cast<size_t>(std::max(n, 1)), 0);
     std::vector<int> triangles(static_cast<size_t>(std::max(n, 1)) * kMaxTriangles * 3, 0);
     for (int i = 0; i < n; ++i)
@@ -62,9 +60,8 @@ class DeviceTriangulationMesh final : public CudaBroadphase {
     m_count.upload(count.data(), count.size());
     m_triangles.upload(triangles.data(), triangles.size());
   }
-  void reserve(cudaStream_t) override { m_list.reserve(); }
   bool reorder(const int* order, int n, cudaStream_t stream) override {
-    m_list.reorder(order, n, stream);
+    KeptListBroadphase::reorder(order, n, stream);
     if (n == 0) return true;
     // Each body's triangles (indices into its own vertices) follow it.
     const long long rows = n, width = kMaxTriangles * 3;
@@ -80,10 +77,7 @@ class DeviceTriangulationMesh final : public CudaBroadphase {
     return true;
   }
   bool edited(const int* keptOrder, int kept, const World& after, int firstAdded, cudaStream_t stream) override {
-    std::vector<Real> half;
-    std::vector<unsigned char> always;
-    appendedListInputs(after, firstAdded, m_list.skin(), half, always);
-    m_list.edited(keptOrder, kept, half, always, stream);
+    KeptListBroadphase::edited(keptOrder, kept, after, firstAdded, stream);
     // The survivors' triangles follow them; only the new bodies are ear-clipped (on the host).
     const long long width = kMaxTriangles * 3, added = after.size() - firstAdded, n = kept + added;
     const long long before = static_cast<long long>(m_rows);
@@ -118,10 +112,8 @@ class DeviceTriangulationMesh final : public CudaBroadphase {
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
     m_list.enqueue(bodies, sink, stream, TrianglesOverlap{m_count.get(), m_triangles.get()});
   }
-  long rebuilds() const override { return m_list.rebuilds(); }
 
  private:
-  DeviceNeighbourList m_list;
   DeviceArray<int> m_count, m_triangles;
   DeviceArray<int> m_countBefore, m_trianglesBefore;  // reorder()'s and edited()'s copies
   int m_rows = 0;  // bodies the triangle arrays hold

@@ -7,34 +7,13 @@
 namespace gem::cuda {
 namespace {
 
-class DeviceVariableRadius final : public CudaBroadphase {
+class DeviceVariableRadius final : public KeptListBroadphase {
  public:
-  explicit DeviceVariableRadius(const BroadphaseSettings& s) : m_list(checkedSettings(s).skin) {}
-  void upload(const World& world) override {
-    // |c_a - c_b| <= (R_a + skin / 2) + (R_b + skin / 2), as variable_radius.cpp.
-    std::vector<Real> half(world.radius.begin(), world.radius.end());
-    for (Real& h : half) h += m_list.skin() / 2;
-    m_list.upload(world, half, 0);
-  }
-  void reserve(cudaStream_t) override { m_list.reserve(); }
-  bool reorder(const int* order, int n, cudaStream_t stream) override {
-    m_list.reorder(order, n, stream);
-    return true;
-  }
-  bool edited(const int* keptOrder, int kept, const World& after, int firstAdded, cudaStream_t stream) override {
-    std::vector<Real> half;
-    std::vector<unsigned char> always;
-    appendedListInputs(after, firstAdded, m_list.skin(), half, always);
-    m_list.edited(keptOrder, kept, half, always, stream);
-    return true;
-  }
+  explicit DeviceVariableRadius(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin) {}
+  void upload(const World& world) override { uploadList(world, 0); }  // |c_a - c_b| <= (R_a + skin / 2) + (R_b + skin / 2)
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
     m_list.enqueue(bodies, sink, stream, AcceptAll{});
   }
-  long rebuilds() const override { return m_list.rebuilds(); }
-
- private:
-  DeviceNeighbourList m_list;
 };
 
 }  // namespace
