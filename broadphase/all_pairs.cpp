@@ -1,7 +1,7 @@
 // all_pairs: every pair whose bounding circles overlap, |c_a - c_b| <= R_a + R_b, found by testing
 // all n (n - 1) / 2 pairs at every call. No kept list, no skin, nothing to go stale: the reference
 // the other strategies are checked against, and the thesis's first GPU structure (5.1).
-#include "framework/registry.hpp"
+#include "framework/api/registry.hpp"
 
 namespace gem {
 namespace {

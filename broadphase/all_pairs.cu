@@ -3,9 +3,9 @@
 // the b > a in strides; the grid's rows wrap past its y limit.
 #include <algorithm>
 
-#include "framework/cuda/cuda_events.hpp"
-#include "framework/cuda/device_broadphase.hpp"
-#include "framework/registry.hpp"
+#include "framework/api/cuda_events.hpp"
+#include "framework/api/device_broadphase.hpp"
+#include "framework/api/registry.hpp"
 
 namespace gem::cuda {
 namespace {

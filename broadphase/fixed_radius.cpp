@@ -7,8 +7,8 @@
 // listing more pairs, which is the thesis's point of comparison.
 #include <algorithm>
 
-#include "broadphase/neighbour_list.hpp"
-#include "framework/registry.hpp"
+#include "broadphase/kept_list/neighbour_list.hpp"
+#include "framework/api/registry.hpp"
 
 namespace gem {
 namespace {

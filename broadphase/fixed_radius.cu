@@ -3,8 +3,8 @@
 // checked and filtered on the device by device_neighbour_list.cuh. The global radius is fixed at
 // each upload; a break keeps it (every pair's reach is at least R_a + R_b + skin, which covers any
 // piece, whatever the largest floe is now).
-#include "broadphase/device_neighbour_list.cuh"
-#include "framework/registry.hpp"
+#include "broadphase/kept_list/device_neighbour_list.cuh"
+#include "framework/api/registry.hpp"
 
 namespace gem::cuda {
 namespace {

@@ -16,9 +16,9 @@
 #include <cstdint>
 #include <unordered_map>
 
-#include "broadphase/neighbour_list.hpp"
+#include "broadphase/kept_list/neighbour_list.hpp"
 #include "broadphase/triangle_overlap.hpp"
-#include "framework/registry.hpp"
+#include "framework/api/registry.hpp"
 #include "geometry/triangulate.hpp"
 
 namespace gem {

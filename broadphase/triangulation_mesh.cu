@@ -8,9 +8,9 @@
 //     meets the other's box overlapping any such triangle of the other (trianglesOverlap, GEM_HD),
 //     the world vertices being the step's own (phase 1).
 // The eps and the box test are the CPU's (broadphase/triangle_overlap.hpp).
-#include "broadphase/device_neighbour_list.cuh"
+#include "broadphase/kept_list/device_neighbour_list.cuh"
 #include "broadphase/triangle_overlap.hpp"
-#include "framework/registry.hpp"
+#include "framework/api/registry.hpp"
 #include "geometry/triangulate.hpp"
 
 namespace gem::cuda {

@@ -24,8 +24,8 @@
 #include <cmath>
 #include <cstdint>
 
-#include "broadphase/neighbour_list.hpp"
-#include "framework/registry.hpp"
+#include "broadphase/kept_list/neighbour_list.hpp"
+#include "framework/api/registry.hpp"
 
 namespace gem {
 namespace {

@@ -2,7 +2,7 @@
 // 2): a loose grid rebuilt every step from the boxes, each body's partners written already sorted
 // by (a, b), so it needs no kept list and no sort of its pairs. Its entry here is a factory that
 // returns no strategy object, which DeviceWorld reads as "use the built-in grid".
-#include "framework/cuda/device_broadphase.hpp"
+#include "framework/api/device_broadphase.hpp"
 
 namespace gem::cuda {
 

@@ -4,8 +4,8 @@
 // Built by sweep and prune along x (the thesis's GPU kernel tested every pair, one thread per floe;
 // the list is the same): O(n + pairs whose x spans overlap), which is lean in a channel, long in x,
 // but about n^1.5 in a square field; uniform_grid builds the very same list in O(n + pairs).
-#include "broadphase/neighbour_list.hpp"
-#include "framework/registry.hpp"
+#include "broadphase/kept_list/neighbour_list.hpp"
+#include "framework/api/registry.hpp"
 
 namespace gem {
 namespace {

@@ -1,8 +1,8 @@
 // variable_radius on the device: the kept list of variable_radius.cpp (|c_a - c_b| <= R_a + R_b +
 // skin at the build, R_a + R_b each step), built, checked and filtered on the device by
 // device_neighbour_list.cuh. Everything runs on the device, inside the step's graph.
-#include "broadphase/device_neighbour_list.cuh"
-#include "framework/registry.hpp"
+#include "broadphase/kept_list/device_neighbour_list.cuh"
+#include "framework/api/registry.hpp"
 
 namespace gem::cuda {
 namespace {

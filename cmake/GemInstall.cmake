@@ -1,6 +1,6 @@
 # cmake --install BUILD --prefix P: the SDK a plugin is built against (docs/plugins.md).
 #   P/bin/gem, P/lib/libgem_core.so (and libgem_cuda.so with the CUDA backend),
-#   P/include/gem/{geometry,events,framework,broadphase}/*.hpp,
+#   P/include/gem/{geometry,events,framework,broadphase}/**.hpp,
 #   P/lib/cmake/gem/: gemConfig.cmake (find_package(gem)), gemTargets.cmake (gem::gem_core,
 #   gem::gem, gem::gem_cuda), GemPlugin.cmake (gem_add_plugin).
 include(GNUInstallDirs)
@@ -17,8 +17,10 @@ endif()
 # What an event or broadphase may include: the geometry, the event API and every event header (a
 # plugin may build on a built-in evaluator), the framework's headers, and the broadphase interface.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/geometry ${PROJECT_SOURCE_DIR}/events ${PROJECT_SOURCE_DIR}/framework
-  DESTINATION ${GEM_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.hpp")
-install(FILES ${PROJECT_SOURCE_DIR}/broadphase/broadphase.hpp DESTINATION ${GEM_INSTALL_INCLUDEDIR}/broadphase)
+  ${PROJECT_SOURCE_DIR}/broadphase DESTINATION ${GEM_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.hpp" PATTERN "*.cuh"
+  PATTERN deprecated EXCLUDE)
+# The forwarding headers of GEM 0.1's include paths ("framework/event_api.hpp"), for one release.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/framework/api/deprecated/ DESTINATION ${GEM_INSTALL_INCLUDEDIR})
 
 # gem finds libgem_core (and libgem_cuda) beside it, wherever the prefix is.
 set_target_properties(gem PROPERTIES INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")

@@ -2,7 +2,7 @@
 # Builds a GEM plugin: a MODULE library libNAME.so that gem loads at run time (docs/plugins.md).
 # It gets GEM's headers, its definitions (real type, version) and GEM_BUILDING_PLUGIN, which turns the
 # GEM_REGISTER_* macros (GEM_REGISTER_CUDA_* included) into entries of the plugin's own list
-# (framework/plugin_api.hpp). Symbols are hidden but for the two entry points, so plugins never see
+# (framework/api/plugin_api.hpp). Symbols are hidden but for the two entry points, so plugins never see
 # each other's helpers.
 #
 # CUDA_SOURCES are built only where both GEM and this project have CUDA: GEM built with its CUDA

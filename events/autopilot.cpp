@@ -1,10 +1,10 @@
 // Autopilot: set heading and track from [vessel]; gains from [events.autopilot] or the defaults.
 #include "events/autopilot.hpp"
 
-#include "framework/registry.hpp"
-#include "framework/scenario.hpp"
-#include "framework/table_reader.hpp"
-#include "framework/vessel.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/scenario/scenario.hpp"
+#include "framework/api/table_reader.hpp"
+#include "framework/world/vessel.hpp"
 
 namespace gem {
 

@@ -1,8 +1,8 @@
 // Drag: parameters from [events.drag] and registration.
 #include "events/drag.hpp"
 
-#include "framework/registry.hpp"
-#include "framework/table_reader.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/api/table_reader.hpp"
 
 namespace gem {
 

@@ -1,8 +1,8 @@
 // Host-only: reads an EnvironmentalForce's parameters, shared by wind.cpp and current.cpp.
 #pragma once
 #include "events/environmental_force.hpp"
-#include "framework/registry.hpp"
-#include "framework/table_reader.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/api/table_reader.hpp"
 
 namespace gem {
 

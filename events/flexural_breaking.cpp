@@ -4,8 +4,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "framework/table_reader.hpp"
-#include "framework/world.hpp"
+#include "framework/api/table_reader.hpp"
+#include "framework/world/world.hpp"
 #include "geometry/split.hpp"
 
 namespace gem {

@@ -10,7 +10,7 @@
 // A floe is broken at most once per step; a cut that misses the floe leaves it whole.
 // Host only: it changes the set of bodies.
 #pragma once
-#include "framework/registry.hpp"
+#include "framework/api/registry.hpp"
 
 namespace gem {
 

@@ -1,7 +1,7 @@
 #include "events/impact.hpp"
 
-#include "framework/registry.hpp"
-#include "framework/table_reader.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/api/table_reader.hpp"
 
 namespace gem {
 

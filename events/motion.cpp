@@ -1,6 +1,6 @@
 #include "events/motion.hpp"
 
-#include "framework/registry.hpp"
+#include "framework/api/registry.hpp"
 
 namespace gem {
 

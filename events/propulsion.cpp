@@ -1,9 +1,9 @@
 // Propulsion: thrust and open-water speed come from [vessel]; [events.propulsion] only turns it off.
 #include "events/propulsion.hpp"
 
-#include "framework/registry.hpp"
-#include "framework/scenario.hpp"
-#include "framework/table_reader.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/scenario/scenario.hpp"
+#include "framework/api/table_reader.hpp"
 
 namespace gem {
 

@@ -8,7 +8,7 @@
 #pragma once
 #include <cmath>
 
-#include "framework/event_api.hpp"
+#include "framework/api/event_api.hpp"
 
 namespace gem {
 

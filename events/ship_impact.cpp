@@ -3,10 +3,10 @@
 
 #include <algorithm>
 
-#include "framework/registry.hpp"
-#include "framework/scenario.hpp"
-#include "framework/table_reader.hpp"
-#include "framework/vessel.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/scenario/scenario.hpp"
+#include "framework/api/table_reader.hpp"
+#include "framework/world/vessel.hpp"
 
 namespace gem {
 

@@ -14,8 +14,10 @@ namespace gem {
 // (cmake -DGEM_REAL=float); tests state their tolerances for each.
 #if defined(GEM_REAL_FLOAT)
 using Real = float;
+#define GEM_REAL_NAME "float"
 #else
 using Real = double;
+#define GEM_REAL_NAME "double"
 #endif
 
 // Floes have 3 to 19 vertices (MODEL.md 1: "fewer than twenty sides"); the vessel and walls

@@ -33,6 +33,7 @@ done
 # The CUDA runtime of the build (13.0, as on the GPU machine) travels too: a match is then certain.
 cp -L "$(ldd "$stage/lib/libgem_cuda.so" | awk '/libcudart/{print $3}')" "$stage/lib/"
 cp -r "$root/scenarios" "$stage/scenarios"
+mkdir -p "$stage/tests" && cp -r "$root/tests/golden" "$stage/tests/golden"  # the CUDA golden hashes
 # The shear_current, rafting_onset and sweep_and_prune plugins with their CUDA parts
 # (tests/cuda/plugin_cuda_test.cpp and broadphase_cuda_test.cpp run them on the device).
 mkdir -p "$stage/cuda_plugins"

@@ -12,8 +12,8 @@
 #include <fmt/format.h>
 #include <pugixml.hpp>
 
-#include "framework/analyze.hpp"
-#include "framework/errors.hpp"
+#include "framework/analysis/analyze.hpp"
+#include "framework/api/errors.hpp"
 #include "test_support.hpp"
 
 using namespace gem;

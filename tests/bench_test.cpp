@@ -1,4 +1,4 @@
-// gem bench's time-per-step tables (framework/bench.hpp) through the gem binary, tiny runs on the
+// gem bench's time-per-step tables (bench/bench.hpp) through the gem binary, tiny runs on the
 // CPU: the CSV's header and rows, the --csv directory rule, and bad input (exit 2). The CUDA rows
 // are timed on a GPU machine (scripts/stage-gpu.sh runs gem bench --table all).
 #include <gtest/gtest.h>

@@ -2,7 +2,7 @@
 // propose a superset of the truly overlapping pairs (exact separating axes, written here), sorted,
 // unique, a < b, never two walls; keep doing so while bodies move (the rebuild rule), rebuild only
 // when the rule asks, and after invalidate(). Filtered by exact overlap, all agree with all_pairs.
-#include "broadphase/broadphase.hpp"
+#include "framework/api/broadphase.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,10 +14,10 @@
 #include <utility>
 #include <vector>
 
-#include "broadphase/neighbour_list.hpp"
-#include "framework/errors.hpp"
-#include "framework/registry.hpp"
-#include "framework/world.hpp"
+#include "broadphase/kept_list/neighbour_list.hpp"
+#include "framework/api/errors.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/world/world.hpp"
 
 namespace gem {
 namespace {

@@ -2,7 +2,7 @@
 // logs at contact onset agrees with the direct evaluation of MODEL.md 5 within 2 %.
 #include <gtest/gtest.h>
 
-#include "framework/calibration.hpp"
+#include "framework/app/calibration.hpp"
 
 using namespace gem;
 

@@ -3,9 +3,9 @@
 
 #include <cstring>
 
-#include "framework/ice_file.hpp"
-#include "framework/registry.hpp"
-#include "framework/simulation.hpp"
+#include "framework/field/ice_file.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/step/simulation.hpp"
 #include "test_support.hpp"
 
 using namespace gem;

@@ -5,8 +5,8 @@
 #include <random>
 
 #include "events/ship_impact.hpp"
-#include "framework/simulation.hpp"
-#include "framework/vessel.hpp"
+#include "framework/step/simulation.hpp"
+#include "framework/world/vessel.hpp"
 #include "test_support.hpp"
 
 using namespace gem;

@@ -1,7 +1,7 @@
-// Generated fields (framework/field_generator.hpp): the eight thesis fields of Table 6.1, the
+// Generated fields (framework/field/field_generator.hpp): the eight thesis fields of Table 6.1, the
 // load-study field of 6.2.2.2 with its three thickness groups, determinism, validity (convex,
 // inside, never closer than minGap) and the input errors.
-#include "framework/field_generator.hpp"
+#include "framework/field/field_generator.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include <map>
 #include <string>
 
-#include "framework/errors.hpp"
+#include "framework/api/errors.hpp"
 #include "geometry/sat.hpp"
 
 namespace gem {

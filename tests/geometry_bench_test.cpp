@@ -1,4 +1,4 @@
-// gem bench --table intersection | triangulation (framework/geometry_bench.hpp) through the gem
+// gem bench --table intersection | triangulation (bench/geometry_bench.hpp) through the gem
 // binary, at small sizes: the CPU columns, the CSV, and on a build without a device the GPU
 // columns saying "no CUDA device" (with a device, the GPU's results are checked against the CPU's).
 #include <gtest/gtest.h>

@@ -1,5 +1,6 @@
-// The .ice reader and writer (framework/ice_file.hpp) and the atomic writes under them.
-#include "framework/ice_file.hpp"
+// The .ice reader and writer (framework/field/ice_file.hpp) and the atomic writes under them.
+#include "framework/field/ice_file.hpp"
+#include "framework/output/ice_file_writer.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -10,8 +11,8 @@
 #include <map>
 #include <sstream>
 
-#include "framework/atomic_file.hpp"
-#include "framework/errors.hpp"
+#include "framework/output/atomic_file.hpp"
+#include "framework/api/errors.hpp"
 
 namespace gem {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <cstdlib>
 
-#include "framework/mpi_work.hpp"
+#include "framework/app/mpi_work.hpp"
 #include "test_support.hpp"
 
 using gem::test::TempDir;

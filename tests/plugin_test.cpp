@@ -7,7 +7,7 @@
 #include <cstring>
 #include <string>
 
-#include "framework/plugin_loader.hpp"
+#include "framework/app/plugin_loader.hpp"
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -78,6 +78,20 @@ TEST(PluginErrors, EachExitsWithStatus2NamingTheFileAndTheCause) {
   }
 }
 
+// A plugin built for the other real type that calls GEM functions taking a Real: refused for its
+// real type, from its note, before the dynamic linker could fail on those symbols.
+TEST(PluginErrors, AnotherRealTypeIsRefusedBeforeItsSymbolsAreBound) {
+  TempDir dir;
+  const fs::path log = dir.path() / "log.txt";
+  const std::string file = plugin("other_real_type");
+  EXPECT_EQ(gem::test::runGem("info --plugin " + file, log), 2);
+  const std::string text = readFile(log);
+  EXPECT_TRUE(contains(text, file + ": refused, it was built for another GEM: real type " + (sizeof(gem::Real) == 8 ? "float" : "double")))
+      << text;
+  EXPECT_FALSE(contains(text, "undefined symbol")) << text;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
+}
+
 TEST(PluginErrors, ScenarioEntryGetsTheScenariosFileLineAndColumn) {
   TempDir dir;
   fs::copy_file(plugin("abi_mismatch"), dir.path() / "libabi.so");
@@ -132,6 +146,21 @@ TEST(PluginRegistry, NameClashIsAnErrorUnlessTheScenarioOverrides) {
   const double vxOverride = vx(dir.path() / "over" / "state.csv"), vxPlain = vx(dir.path() / "plain" / "state.csv");
   EXPECT_GT(vxPlain, 0.8);
   EXPECT_LT(vxOverride, 0.5 * vxPlain);
+}
+
+// A plugin written against GEM 0.1's include paths (tests/plugins/old_layout.cpp) still builds,
+// through the deprecated forwarding headers, loads and runs: its event pushes the floe towards +y.
+TEST(PluginSdk, APluginOfTheOldLayoutStillBuildsAndRuns) {
+  TempDir dir;
+  const fs::path scenario = dir.write("old.toml", kFloe + "[[plugins]]\npath = \"" + plugin("old_layout") +
+                                                        "\"\n[events.sideways_push]\naccel = 1.0\n[events.drag]\nenabled = false\n");
+  ASSERT_EQ(gem::test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / "out").string(), dir.path() / "log"), 0)
+      << readFile(dir.path() / "log");
+  // state.csv: id,kind,x,y,angle,vx,vy,...: 20 steps of 0.1 s at 1 m/s^2 give vy = 2 m/s.
+  std::string row = readFile(dir.path() / "out" / "state.csv");
+  row = row.substr(row.find('\n') + 1);
+  for (int k = 0; k < 6; ++k) row = row.substr(row.find(',') + 1);
+  EXPECT_NEAR(std::stod(row.substr(0, row.find(','))), 2.0, 1e-9);
 }
 
 // The SDK from the build, as a user does it: install, build each example out of tree, run it.

@@ -1,4 +1,4 @@
-// The fits of gem analyze (framework/statistics.hpp): maximum-likelihood Weibull and lognormal
+// The fits of gem analyze (framework/analysis/statistics.hpp): maximum-likelihood Weibull and lognormal
 // recover known parameters from samples, the log-log power law is exact on noiseless data, and
 // degenerate inputs give ok == false with finite placeholders (never NaN, never a throw).
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-#include "framework/statistics.hpp"
+#include "framework/analysis/statistics.hpp"
 
 using namespace gem;
 

@@ -7,13 +7,13 @@
 
 #include <toml++/toml.h>
 
-#include "framework/errors.hpp"
-#include "framework/runner.hpp"
-#include "framework/simulation.hpp"
-#include "framework/stepper.hpp"
-#include "framework/sweep.hpp"
-#include "framework/sweep_file.hpp"
-#include "framework/sweep_summary.hpp"
+#include "framework/api/errors.hpp"
+#include "framework/app/runner.hpp"
+#include "framework/step/simulation.hpp"
+#include "framework/step/stepper.hpp"
+#include "framework/app/sweep.hpp"
+#include "framework/scenario/sweep_file.hpp"
+#include "framework/analysis/sweep_summary.hpp"
 #include "test_support.hpp"
 
 using namespace gem;

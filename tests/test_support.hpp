@@ -8,7 +8,7 @@
 #include <random>
 #include <string>
 
-#include "framework/scenario.hpp"
+#include "framework/scenario/scenario.hpp"
 
 namespace gem::test {
 

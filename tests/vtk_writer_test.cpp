@@ -1,5 +1,5 @@
-// The ParaView writer (framework/vtk_writer.hpp): parse what it wrote and check the structure.
-#include "framework/vtk_writer.hpp"
+// The ParaView writer (framework/output/vtk_writer.hpp): parse what it wrote and check the structure.
+#include "framework/output/vtk_writer.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

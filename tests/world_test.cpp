@@ -1,6 +1,6 @@
 // World: removing bodies keeps the survivors' order and every array in step (a break in a world of
 // 10^5 bodies or more compacts the arrays on helper threads, which this also covers).
-#include "framework/world.hpp"
+#include "framework/world/world.hpp"
 
 #include <gtest/gtest.h>
 

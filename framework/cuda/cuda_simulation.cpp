@@ -15,12 +15,12 @@
 
 #include <fmt/format.h>
 
-#include "framework/cuda/cuda_check.hpp"
+#include "framework/api/cuda_check.hpp"
 #include "framework/cuda/device_world.hpp"
-#include "framework/log_channel.hpp"
-#include "framework/registry.hpp"
-#include "framework/simulation.hpp"
-#include "framework/stepper.hpp"
+#include "framework/api/log_channel.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/step/simulation.hpp"
+#include "framework/step/stepper.hpp"
 
 namespace gem {
 

@@ -1,5 +1,5 @@
 // The device phases of a step (see cuda_simulation.hpp for the list). Semantics copied from
-// framework/simulation.cpp, the reference: any difference in what is summed, or in which order,
+// framework/step/simulation.cpp, the reference: any difference in what is summed, or in which order,
 // is a bug (the CUDA-vs-CPU tests compare the two).
 #include "framework/cuda/device_world.hpp"
 
@@ -21,7 +21,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "framework/cuda/cuda_check.hpp"
+#include "framework/api/cuda_check.hpp"
 #include "geometry/contact.hpp"
 
 namespace gem::cuda {

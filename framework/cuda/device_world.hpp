@@ -7,9 +7,9 @@
 #include <utility>
 #include <vector>
 
-#include "framework/cuda/cuda_events.hpp"
-#include "framework/cuda/device_broadphase.hpp"
-#include "framework/world.hpp"
+#include "framework/api/cuda_events.hpp"
+#include "framework/api/device_broadphase.hpp"
+#include "framework/world/world.hpp"
 
 namespace gem::cuda {
 

@@ -6,11 +6,11 @@
 #include <memory>
 #include <string>
 
-#include "framework/log_channel.hpp"
-#include "framework/plugin_api.hpp"
-#include "framework/registry.hpp"
-#include "framework/scenario.hpp"
-#include "framework/table_reader.hpp"
+#include "framework/api/log_channel.hpp"
+#include "framework/api/plugin_api.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/scenario/scenario.hpp"
+#include "framework/api/table_reader.hpp"
 
 GEM_PLUGIN("rafting_onset", "1.0.0")
 

@@ -1,9 +1,9 @@
 // shear_current: parameters from [events.shear_current], registration, and the plugin's export.
 #include "shear_current.hpp"
 
-#include "framework/plugin_api.hpp"
-#include "framework/registry.hpp"
-#include "framework/table_reader.hpp"
+#include "framework/api/plugin_api.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/api/table_reader.hpp"
 
 GEM_PLUGIN("shear_current", "1.0.0")
 

@@ -7,13 +7,13 @@
 // The order of the intervals is kept between steps and re-sorted by insertion, which is linear in
 // n when bodies moved little (the coherence SAP is known for). Conservative: a pair whose
 // polygons overlap has overlapping bounding circles, so overlapping x intervals. Pairs come out
-// sorted by (a, b) with a < b (broadphase/broadphase.hpp).
+// sorted by (a, b) with a < b (framework/api/broadphase.hpp).
 #include <algorithm>
 #include <vector>
 
-#include "broadphase/broadphase.hpp"
-#include "framework/plugin_api.hpp"
-#include "framework/registry.hpp"
+#include "framework/api/broadphase.hpp"
+#include "framework/api/plugin_api.hpp"
+#include "framework/api/registry.hpp"
 
 GEM_PLUGIN("sweep_and_prune", "1.0.0")
 

@@ -8,9 +8,9 @@
 
 #include <algorithm>
 
-#include "framework/cuda/cuda_events.hpp"
-#include "framework/cuda/device_broadphase.hpp"
-#include "framework/registry.hpp"
+#include "framework/api/cuda_events.hpp"
+#include "framework/api/device_broadphase.hpp"
+#include "framework/api/registry.hpp"
 
 namespace gem {
 namespace {

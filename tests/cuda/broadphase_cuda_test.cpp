@@ -1,4 +1,4 @@
-// Device broadphases (framework/cuda/device_broadphase.hpp, broadphase/*.cu): every strategy gives
+// Device broadphases (framework/api/device_broadphase.hpp, broadphase/*.cu): every strategy gives
 // the very trajectories of the device grid, bit for bit, since the pairs are sorted by (a, b) and the
 // narrowphase drops what the CPU prefilter drops; kept lists rebuild on the device by MODEL.md 9's
 // rule; a plugin's broadphase runs on the device with its own device part, and one without a device
@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "framework/cuda/cuda_simulation.hpp"
-#include "framework/cuda/device_broadphase.hpp"
-#include "framework/plugin_loader.hpp"
-#include "framework/registry.hpp"
-#include "framework/simulation.hpp"
+#include "framework/api/device_broadphase.hpp"
+#include "framework/app/plugin_loader.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/step/simulation.hpp"
 #include "../test_support.hpp"
 #include "cuda_test_support.hpp"
 

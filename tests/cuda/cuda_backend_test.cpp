@@ -19,7 +19,7 @@
 #include <thread>
 
 #include "framework/cuda/cuda_simulation.hpp"
-#include "framework/simulation.hpp"
+#include "framework/step/simulation.hpp"
 #include "../test_support.hpp"
 #include "cuda_test_support.hpp"
 

@@ -9,11 +9,11 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "framework/cuda/cuda_events.hpp"
+#include "framework/api/cuda_events.hpp"
 #include "framework/cuda/cuda_simulation.hpp"
-#include "framework/plugin_loader.hpp"
-#include "framework/registry.hpp"
-#include "framework/simulation.hpp"
+#include "framework/app/plugin_loader.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/step/simulation.hpp"
 #include "../test_support.hpp"
 #include "cuda_test_support.hpp"
 

@@ -2,9 +2,9 @@
 // scenario's [[plugins]] entry says override = true. Its drag is the built-in evaluator with a
 // 100 times the default C_d, so a run shows which one ran.
 #include "events/drag.hpp"
-#include "framework/plugin_api.hpp"
-#include "framework/registry.hpp"
-#include "framework/table_reader.hpp"
+#include "framework/api/plugin_api.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/api/table_reader.hpp"
 
 GEM_PLUGIN("drag_clash", "0.0.1")
 

@@ -3,10 +3,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "framework/event_api.hpp"
-#include "framework/plugin_api.hpp"
-#include "framework/registry.hpp"
-#include "framework/table_reader.hpp"
+#include "framework/api/event_api.hpp"
+#include "framework/api/plugin_api.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/api/table_reader.hpp"
 
 GEM_PLUGIN("fail_midway", "0.0.1")
 

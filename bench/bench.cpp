@@ -1,0 +1,458 @@
+#include "bench/bench.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "framework/output/atomic_file.hpp"
+#include "framework/api/errors.hpp"
+#include "framework/field/field_generator.hpp"
+#include "bench/geometry_bench.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/step/simulation.hpp"
+#include "framework/step/stepper.hpp"
+
+namespace fs = std::filesystem;
+
+namespace gem {
+
+std::string cpuName() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown CPU";
+}
+
+const std::vector<std::string>& benchTables() {
+  static const std::vector<std::string> tables{"step", "fields", "blocks", "copyback", "scaling", "intersection", "triangulation", "all"};
+  return tables;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+Scenario thesisField(const char* file) {
+  const fs::path path = fs::path(GEM_SOURCE_DIR) / "scenarios" / "thesis" / file;
+  Scenario s = loadScenario(path);
+  s.output.frameEvery = 0;
+  return s;
+}
+
+// N random floes at 40 % in a square-ish channel, the vessel entering it. The domain's area holds
+// N floes of the thesis's size statistics (E[s^2] = 6.9^2 + 3.9^2 m^2).
+Scenario largeField(int floes) {
+  Scenario s = thesisField("random_35.toml");
+  const Real area = floes * Real(6.9 * 6.9 + 3.9 * 3.9) / Real(0.4);
+  const Real width = std::max<Real>(200, std::round(std::sqrt(area) / 100) * 100);
+  s.domain = Domain{0, std::ceil(area / width), -width / 2, width / 2};
+  s.randomField.domain = s.domain;
+  s.randomField.count = floes;
+  s.randomField.concentration = Real(0.4);
+  return s;
+}
+
+// A case: "456" (hexagons), "824" (random, 50 %) or a floe count N (random, 40 %).
+struct CaseKey {
+  std::string key, name;
+  long floes;  // the random field's count; 0 for the thesis fields
+};
+
+CaseKey parseCase(const std::string& key) {
+  if (key == "456") return {key, "456 hexagons (46 %)", 0};
+  if (key == "824") return {key, "824 random (50 %)", 0};
+  size_t used = 0;
+  long n = 0;
+  try {
+    n = std::stol(key, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != key.size() || n < 10 || n > 10000000)
+    throw InputError(fmt::format("gem bench --cases {}: valid cases are 456, 824 (the thesis fields) or a floe count "
+                                 "from 10 to 10^7 (random convex floes at 40 %), e.g. 10000 100000 1000000", key));
+  int power = 0;
+  for (long m = n; m % 10 == 0 && m > 1; m /= 10) ++power;
+  const bool powerOfTen = n == static_cast<long>(std::llround(std::pow(10.0, power)));
+  return {key, powerOfTen && power >= 4 ? fmt::format("10^{} random (40 %)", power) : fmt::format("{} random (40 %)", n), n};
+}
+
+// Scenarios of the cases, a large field generated once per run (10^6 floes take seconds) and
+// handed to every row as explicit floes: buildWorld adds them in the generator's order.
+class CaseScenarios {
+ public:
+  Scenario get(const CaseKey& c) {
+    if (c.key == "456") return thesisField("hexagons_46.toml");
+    if (c.key == "824") return thesisField("random_50.toml");
+    Scenario s = largeField(static_cast<int>(c.floes));
+    auto it = m_fields.find(c.floes);
+    if (it == m_fields.end()) {
+      const auto start = Clock::now();
+      if (c.floes >= 50000) std::fprintf(stderr, "gem bench: generating %s...\n", c.name.c_str());
+      it = m_fields.emplace(c.floes, generateRandomConvexField(s.randomField)).first;
+      if (c.floes >= 50000) std::fprintf(stderr, "gem bench: generated %s in %.1f s\n", c.name.c_str(), secondsSince(start));
+    }
+    s.fieldKind = "none";
+    s.floes = it->second;
+    return s;
+  }
+
+ private:
+  std::map<long, std::vector<BodySpec>> m_fields;
+};
+
+// Seconds per step: the median of 5 chunks after a warm-up. Large fields get fewer steps, so that
+// one case stays within a minute on a slow backend. A device backend runs steps in batches of
+// copy_back_every, cut at each re-sort (every 200 steps): it is timed over whole periods of that
+// pattern from a period's start, so every chunk holds the same batches (and the copies).
+double timePerStep(Stepper& sim, const Scenario& s, long requested, int bodies) {
+  const long steps = std::clamp<long>(requested * 1000 / std::max(bodies, 1), std::min<long>(10, requested), requested);
+  long chunk = std::max<long>(1, steps / 5), warm = std::min<long>(100, steps);
+  if (sim.backend() != "cpu") {
+    const long period = s.mortonSort ? 200 : std::max(1, s.copyBackEvery);
+    auto roundUp = [&](long n) { return (std::max<long>(n, 1) + period - 1) / period * period; };
+    chunk = roundUp(chunk), warm = roundUp(warm);
+  }
+  for (long k = 0; k < warm; ++k) sim.step();
+  std::vector<double> perStep;
+  for (int r = 0; r < 5; ++r) {
+    const auto start = Clock::now();
+    for (long k = 0; k < chunk; ++k) sim.step();  // step() returns once the step is done (device synced)
+    perStep.push_back(secondsSince(start) / chunk);
+  }
+  std::sort(perStep.begin(), perStep.end());
+  return perStep[perStep.size() / 2];
+}
+
+struct Row {
+  std::string caseName, backend, broadphase, param;
+  int bodies = 0, floes = 0;
+  double seconds = 0;  // per step
+  double dt = 0.1;
+  std::string device;
+};
+
+// One printed table and its CSV (rewritten after every row, so a run cut short keeps its rows).
+class Table {
+ public:
+  Table(std::string name, std::string paramColumn, std::string csvPath)
+      : m_name(std::move(name)), m_param(std::move(paramColumn)), m_csvPath(std::move(csvPath)) {
+    m_csv = "case,backend,broadphase," + (m_param.empty() ? "" : m_param + ",") +
+            "bodies,floes,ms_per_step,steps_per_s,floe_steps_per_s,real_time_factor,device\n";
+  }
+  void printHeader() const {
+    std::printf("%-20s %-7s %-18s ", "case", "backend", "broadphase");
+    if (!m_param.empty()) std::printf("%15s ", m_param.c_str());
+    std::printf("%8s %10s %10s %14s %12s  %s\n", "bodies", "ms/step", "steps/s", "floe-steps/s", "x real time", "device");
+  }
+  void add(const Row& r) {
+    const double t = r.seconds, realTime = r.dt / t;
+    std::printf("%-20s %-7s %-18s ", r.caseName.c_str(), r.backend.c_str(), r.broadphase.c_str());
+    if (!m_param.empty()) std::printf("%15s ", r.param.c_str());
+    std::printf("%8d %10.4f %10.0f %14.3g %12.0f  %s\n", r.bodies, t * 1e3, 1 / t, r.floes / t, realTime, r.device.c_str());
+    std::fflush(stdout);
+    m_csv += fmt::format("\"{}\",{},{},{}{},{},{:.6f},{:.1f},{:.6g},{:.1f},\"{}\"\n", r.caseName, r.backend, r.broadphase,
+                         m_param.empty() ? "" : r.param + ",", r.bodies, r.floes, t * 1e3, 1 / t, r.floes / t, realTime, r.device);
+    if (!m_csvPath.empty()) writeFileAtomically(m_csvPath, m_csv);
+    m_rows.push_back(r);
+  }
+  const std::vector<Row>& rows() const { return m_rows; }
+  // An empty table still leaves its header in the CSV.
+  void finish() const {
+    if (!m_csvPath.empty() && m_rows.empty()) writeFileAtomically(m_csvPath, m_csv);
+    if (!m_csvPath.empty()) std::printf("CSV: %s\n", m_csvPath.c_str());
+  }
+
+ private:
+  std::string m_name, m_param, m_csvPath, m_csv;
+  std::vector<Row> m_rows;
+};
+
+// Times one row: the case's scenario on a backend and broadphase, with a CUDA setting changed.
+Row timeRow(CaseScenarios& scenarios, const CaseKey& c, const std::string& backend, const std::string& broadphase, long steps,
+            const std::string& param = "", std::optional<int> blockSize = {}, std::optional<int> copyBackEvery = {}) {
+  Scenario s = scenarios.get(c);
+  s.backend = backend;
+  s.broadphase = broadphase;
+  if (blockSize) s.cudaBlockSize = *blockSize;
+  if (copyBackEvery) s.copyBackEvery = *copyBackEvery;
+  s.steps = std::max<long>(s.steps, 2 * steps + 1000);  // no batch cut at the scenario's end inside the timing
+  const bool large = c.floes >= 50000;
+  const auto start = Clock::now();
+  if (large)
+    std::fprintf(stderr, "gem bench: %s, %s, %s%s%s...\n", c.name.c_str(), backend.c_str(), broadphase.c_str(),
+                 param.empty() ? "" : ", ", param.c_str());
+  std::unique_ptr<Stepper> sim = makeStepper(s);
+  Row r;
+  r.caseName = c.name, r.backend = backend, r.broadphase = broadphase, r.param = param;
+  r.bodies = sim->hostWorld().size();
+  r.floes = sim->hostWorld().count(BodyKind::Floe);
+  r.dt = s.dt;
+  r.seconds = timePerStep(*sim, s, steps, r.bodies);
+  r.device = backend == "cpu" ? cpuName() + " (one core)" : sim->device();
+  if (large) std::fprintf(stderr, "gem bench: ... done in %.1f s\n", secondsSince(start));
+  return r;
+}
+
+// Built-in broadphases, the thesis's first (variable radius, the reference of the comparisons).
+std::vector<std::string> builtInBroadphases() {
+  std::vector<std::string> names;
+  for (const char* n : {"variable_radius", "fixed_radius", "uniform_grid", "triangulation_mesh", "all_pairs"})
+    for (const BroadphaseEntry* b : Registry::global().broadphases())
+      if (b->name == n && b->origin == "built-in") names.push_back(n);
+  for (const BroadphaseEntry* b : Registry::global().broadphases())
+    if (b->origin == "built-in" && std::find(names.begin(), names.end(), b->name) == names.end()) names.push_back(b->name);
+  return names;
+}
+
+bool cudaUsable() {
+  const BackendEntry* cuda = findBackend("cuda");
+  return cuda && cuda->available();
+}
+
+// What one run of a table is given: its CSV path, the backends it may use, and whether a table
+// that cannot run (no CUDA) is skipped with a line (gem bench --table all) rather than an error.
+struct TableRun {
+  const BenchOptions& options;
+  CaseScenarios& scenarios;
+  std::string csvPath;
+  bool partOfAll = false;
+  bool skipCuda = false;  // --table all with no device and no --backend: the CPU rows only
+};
+
+std::vector<CaseKey> casesOf(const BenchOptions& o, std::vector<std::string> defaults) {
+  std::vector<CaseKey> cases;
+  for (const std::string& k : o.cases.empty() ? defaults : o.cases) cases.push_back(parseCase(k));
+  return cases;
+}
+
+// The table's backends: --backend, else its defaults less cuda where --table all found no device.
+// Each is checked now (a backend without a device is an InputError that says so); `allowed`
+// limits them (blocks and copyback sweep CUDA settings). Empty: the table is skipped.
+std::vector<std::string> backendsOf(const TableRun& run, const std::string& table, std::vector<std::string> defaults,
+                                    const std::vector<std::string>& allowed) {
+  std::vector<std::string> backends = run.options.backends.empty() ? defaults : run.options.backends;
+  if (run.skipCuda) backends.erase(std::remove(backends.begin(), backends.end(), "cuda"), backends.end());
+  std::vector<std::string> out;
+  for (const std::string& b : backends) {
+    if (std::find(allowed.begin(), allowed.end(), b) == allowed.end()) {
+      if (run.partOfAll) continue;
+      throw InputError(fmt::format("gem bench --table {}: --backend {}: this table times {} only", table, b,
+                                   fmt::join(allowed, ", ")));
+    }
+    try {
+      resolveBackend(b);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("gem bench --table {}: {}{}", table, e.what(),
+                                   run.options.backends.empty() && std::find(allowed.begin(), allowed.end(), "cpu") != allowed.end()
+                                       ? " (--backend cpu times the CPU rows alone)"
+                                       : ""));
+    }
+    out.push_back(b);
+  }
+  if (out.empty())
+    std::printf("%s table skipped: %s\n", table.c_str(),
+                run.skipCuda ? "it needs the CUDA backend and there is no CUDA device" : "no backend of --backend applies");
+  return out;
+}
+
+std::string caseList(const std::vector<CaseKey>& cases) {
+  std::vector<std::string> names;
+  for (const CaseKey& c : cases) names.push_back(c.name);
+  return fmt::format("{}", fmt::join(names, ", "));
+}
+
+void printTiming(const BenchOptions& o) {
+  std::printf("%ld timed steps per case (fewer for large fields; whole 200-step periods on a device) after a warm-up; "
+              "median of 5 chunks; real time at the scenario's dt (0.1 s)\n", o.steps);
+}
+
+// --table step: every case x backend x broadphase (the README's table).
+void stepTable(const TableRun& run) {
+  const BenchOptions& o = run.options;
+  const auto cases = casesOf(o, {"456", "824", "10000"});
+  const auto backends = backendsOf(run, "step", {"cpu"}, {"cpu", "cuda"});
+  const std::vector<std::string> broadphases = o.broadphases.empty() ? std::vector<std::string>{"variable_radius"} : o.broadphases;
+  std::printf("gem bench: ");
+  printTiming(o);
+  Table table("step", "", run.csvPath);
+  table.printHeader();
+  for (const CaseKey& c : cases)
+    for (const std::string& backend : backends)
+      for (const std::string& broadphase : broadphases) table.add(timeRow(run.scenarios, c, backend, broadphase, o.steps));
+  table.finish();
+}
+
+// Each broadphase's speed against variable_radius on the same case and backend.
+void printAgainstVariableRadius(const std::vector<Row>& rows) {
+  for (const Row& base : rows) {
+    if (base.broadphase != "variable_radius") continue;
+    std::string line;
+    for (const Row& r : rows)
+      if (r.caseName == base.caseName && r.backend == base.backend && r.broadphase != base.broadphase)
+        line += fmt::format("{}{} {:.2f}x", line.empty() ? "" : ", ", r.broadphase, base.seconds / r.seconds);
+    if (!line.empty())
+      std::printf("against variable_radius, %s on %s (speed, >1 faster): %s\n", base.caseName.c_str(), base.backend.c_str(), line.c_str());
+  }
+}
+
+// --table fields (thesis 5.4, 5.5): the thesis fields on the CPU and the GPU, every broadphase.
+void fieldsTable(const TableRun& run) {
+  const BenchOptions& o = run.options;
+  const auto cases = casesOf(o, {"456", "824"});
+  const auto backends = backendsOf(run, "fields", {"cpu", "cuda"}, {"cpu", "cuda"});
+  if (backends.empty()) return;
+  const std::vector<std::string> broadphases = o.broadphases.empty() ? builtInBroadphases() : o.broadphases;
+  std::printf("gem bench --table fields: time per step CPU vs GPU on %s; fixed vs variable radius, and uniform grid, "
+              "triangulation mesh and all pairs against variable radius\n", caseList(cases).c_str());
+  printTiming(o);
+  Table table("fields", "", run.csvPath);
+  table.printHeader();
+  for (const CaseKey& c : cases)
+    for (const std::string& backend : backends)
+      for (const std::string& broadphase : broadphases) table.add(timeRow(run.scenarios, c, backend, broadphase, o.steps));
+  printAgainstVariableRadius(table.rows());
+  table.finish();
+}
+
+// --table blocks and --table copyback: one CUDA setting swept per case.
+void sweepTable(const TableRun& run, const std::string& name) {
+  const BenchOptions& o = run.options;
+  const bool blocks = name == "blocks";
+  const auto cases = casesOf(o, blocks ? std::vector<std::string>{"3584", "7168"} : std::vector<std::string>{"824", "100000"});
+  const auto backends = backendsOf(run, name, {"cuda"}, {"cuda"});
+  if (backends.empty()) return;
+  std::vector<int> values = blocks ? o.blockSizes : o.copyBackEvery;
+  if (values.empty()) values = blocks ? std::vector<int>{32, 64, 128, 256, 512, 1024} : std::vector<int>{1, 2, 4, 8, 16, 32, 64, 128};
+  const std::vector<std::string> broadphases = o.broadphases.empty() ? std::vector<std::string>{"variable_radius"} : o.broadphases;
+  if (blocks)
+    std::printf("gem bench --table blocks: CUDA threads per block (simulation.cuda_block_size) on %s\n", caseList(cases).c_str());
+  else
+    std::printf("gem bench --table copyback: CUDA steps between copies of results to the host (simulation.copy_back_every, "
+                "thesis 5.7) on %s; the time per step includes the copies\n", caseList(cases).c_str());
+  printTiming(o);
+  Table table(name, blocks ? "block_size" : "copy_back_every", run.csvPath);
+  table.printHeader();
+  for (const CaseKey& c : cases)
+    for (const std::string& backend : backends)
+      for (const std::string& broadphase : broadphases)
+        for (int v : values)
+          table.add(blocks ? timeRow(run.scenarios, c, backend, broadphase, o.steps, std::to_string(v), v)
+                           : timeRow(run.scenarios, c, backend, broadphase, o.steps, std::to_string(v), {}, v));
+  table.finish();
+}
+
+// --table scaling (thesis 5.6): 10^4 to 10^6 floes per broadphase on the GPU; the CPU at 10^4 and
+// 10^5 with variable radius, for the GPU/CPU ratio.
+void scalingTable(const TableRun& run) {
+  const BenchOptions& o = run.options;
+  const auto cases = casesOf(o, {"10000", "100000", "1000000"});
+  const auto backends = backendsOf(run, "scaling", {"cuda", "cpu"}, {"cpu", "cuda"});
+  if (backends.empty()) return;
+  constexpr long kAllPairsMax = 10000;
+  std::printf("gem bench --table scaling: %s; every built-in broadphase on the GPU, "
+              "variable_radius on the CPU up to 10^5 floes; all_pairs only up to 10^4 floes\n", caseList(cases).c_str());
+  printTiming(o);
+  Table table("scaling", "", run.csvPath);
+  table.printHeader();
+  for (const CaseKey& c : cases)
+    for (const std::string& backend : backends) {
+      // The CPU rows: variable radius up to 10^5 unless --broadphase or --cases ask for more.
+      if (backend == "cpu" && o.cases.empty() && c.floes > 100000) continue;
+      const std::vector<std::string> broadphases =
+          !o.broadphases.empty() ? o.broadphases
+          : backend == "cpu"     ? std::vector<std::string>{"variable_radius"}
+                                 : builtInBroadphases();
+      for (const std::string& broadphase : broadphases) {
+        if (broadphase == "all_pairs" && c.floes > kAllPairsMax) {
+          std::printf("%-20s %-7s %-18s skipped: all_pairs tests N^2/2 pairs, timed only up to 10^4 floes\n", c.name.c_str(),
+                      backend.c_str(), broadphase.c_str());
+          continue;
+        }
+        table.add(timeRow(run.scenarios, c, backend, broadphase, o.steps));
+      }
+    }
+  // GPU/CPU speed ratio where a case has both on one broadphase.
+  for (const Row& cpu : table.rows()) {
+    if (cpu.backend != "cpu") continue;
+    for (const Row& gpu : table.rows())
+      if (gpu.backend != "cpu" && gpu.caseName == cpu.caseName && gpu.broadphase == cpu.broadphase)
+        std::printf("GPU/CPU speed, %s, %s: %.1fx (%s %.4g ms, cpu %.4g ms per step)\n", cpu.caseName.c_str(),
+                    cpu.broadphase.c_str(), cpu.seconds / gpu.seconds, gpu.backend.c_str(), gpu.seconds * 1e3, cpu.seconds * 1e3);
+  }
+  table.finish();
+}
+
+void geometryTable(const TableRun& run, const std::string& name) {
+  runGeometryBench(GeometryBenchOptions{name, run.options.sizes, run.csvPath, run.options.reps});
+  if (!run.csvPath.empty()) std::printf("CSV: %s\n", run.csvPath.c_str());
+}
+
+void runTable(const TableRun& run, const std::string& name) {
+  if (name == "step") stepTable(run);
+  else if (name == "fields") fieldsTable(run);
+  else if (name == "blocks" || name == "copyback") sweepTable(run, name);
+  else if (name == "scaling") scalingTable(run);
+  else geometryTable(run, name);
+}
+
+// --csv: a file for one table; a directory with TABLE.csv for "all", or when it is a directory
+// already or ends in '/'.
+std::string csvPathFor(const BenchOptions& o, const std::string& table) {
+  if (o.csv.empty()) return "";
+  if (o.table == "all" || o.csv.back() == '/' || fs::is_directory(o.csv)) {
+    fs::create_directories(o.csv);
+    return (fs::path(o.csv) / (table + ".csv")).string();
+  }
+  return o.csv;
+}
+
+}  // namespace
+
+int runBench(const BenchOptions& o) {
+  const auto& tables = benchTables();
+  if (std::find(tables.begin(), tables.end(), o.table) == tables.end())
+    throw InputError(fmt::format("gem bench --table {}: valid tables are {}", o.table, fmt::join(tables, ", ")));
+  if (o.steps < 1) throw InputError("gem bench --steps: must be at least 1");
+  for (int b : o.blockSizes)
+    if (b < 32 || b > 1024 || b % 32) throw InputError(fmt::format("gem bench --blocks {}: a multiple of 32 from 32 to 1024", b));
+  for (int k : o.copyBackEvery)
+    if (k < 1) throw InputError(fmt::format("gem bench --copy-back {}: must be at least 1", k));
+  if (!o.blockSizes.empty() && o.table != "blocks" && o.table != "all")
+    throw InputError("gem bench --blocks: applies to --table blocks (or all)");
+  if (!o.copyBackEvery.empty() && o.table != "copyback" && o.table != "all")
+    throw InputError("gem bench --copy-back: applies to --table copyback (or all)");
+  for (const std::string& c : o.cases) parseCase(c);  // bad input before any timing
+  for (const std::string& b : o.broadphases) Registry::global().broadphase(b);
+
+  CaseScenarios scenarios;
+  if (o.table != "all") {
+    runTable(TableRun{o, scenarios, csvPathFor(o, o.table)}, o.table);
+    return 0;
+  }
+  if (!o.cases.empty() || !o.broadphases.empty())
+    throw InputError("gem bench --table all: each table has its own cases and broadphases; name one table to choose them");
+  const bool skipCuda = o.backends.empty() && !cudaUsable();
+  const std::vector<std::string> all{"fields", "blocks", "copyback", "scaling", "intersection", "triangulation"};
+  std::printf("gem bench --table all: %s\n", fmt::format("{}", fmt::join(all, ", ")).c_str());
+  if (skipCuda)
+    std::printf("** CUDA rows skipped: %s; the CPU rows and columns run **\n",
+                findBackend("cuda") ? "no CUDA device found on this machine" : "this build has no CUDA backend");
+  for (const std::string& name : all) {
+    std::printf("\n== %s\n", name.c_str());
+    std::fflush(stdout);
+    runTable(TableRun{o, scenarios, csvPathFor(o, name), true, skipCuda}, name);
+  }
+  return 0;
+}
+
+}  // namespace gem

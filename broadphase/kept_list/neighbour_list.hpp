@@ -1,0 +1,125 @@
+// The machinery every kept-list broadphase shares (MODEL.md 9, thesis 5.1 and 5.4): a flat list of
+// pairs built with a skin, the never-miss rebuild rule, and the per-step filter that turns the kept
+// list into this step's candidates.
+//
+// Why a skin makes a kept list safe: a strategy lists every pair whose centroids were within
+// R_a + R_b + skin at the build. Two bodies can only touch while their bounding circles overlap,
+// |c_a - c_b| <= R_a + R_b, and since the build the centroid distance has changed by at most
+// d_a + d_b, d the bound on how far any point of a body has moved. So while d_a + d_b <= skin for
+// every pair, every touching pair is still listed. MODEL.md's rule ("rebuild before any body can
+// have moved more than half the skin") keeps every d <= skin / 2, which guarantees that.
+//
+// Here a body that passes half the skin does not force a rebuild at once: it becomes *direct*,
+// its listed pairs are ignored, and it is tested against every body each step (one O(n) pass of
+// bounding circles, merged into the sorted candidates). For the bodies still listed every d stays
+// <= skin / 2, so the list stays complete for them, and the direct pass covers the rest: nothing
+// is missed. The vessel is always direct (it moves at several m/s through resting ice and would
+// set the rebuild rate alone), and so are the few floes it is shoving; the list is rebuilt when
+// more than kMaxDirect bodies are direct.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "framework/api/broadphase.hpp"
+
+namespace gem {
+
+// The rebuild fires a hair before d_1st + d_2nd reaches the skin, so that rounding in the distances
+// of the build and of the check can never let a pair on the very edge of the list slip out. Shared
+// with the device lists (device_neighbour_list.cuh).
+constexpr Real kRebuildTrigger = Real(1) - Real(1e-6);
+
+// A listed pair: the two slots and the square of R_a + R_b, fixed between builds (a body keeps its
+// shape while it keeps its id), so the per-step filter streams one array and gathers only x, y.
+struct ListedPair {
+  int a, b;
+  Real reach2;
+};
+
+class NeighbourList {
+ public:
+  explicit NeighbourList(Real skin) : m_skin(skin) {}
+
+  Real skin() const { return m_skin; }
+  // True when the list must be rebuilt: never built, invalidated, body count or identities changed,
+  // or more than kMaxDirect bodies have become direct. Otherwise marks every body that has moved
+  // more than half the skin since the build as direct. One pass over the bodies.
+  bool update(const World& world);
+  int directCount() const { return static_cast<int>(m_directList.size()); }
+  static constexpr int kMaxDirect = 8;
+  void invalidate() { m_valid = false; }
+  long rebuilds() const { return m_rebuilds; }
+
+  // Building: begin, add each pair once (a != b, either order), finish. finish() drops wall-wall
+  // pairs (two immovable bodies never interact), sorts by (a, b) when the pairs did not come in
+  // order, and records the reference state of every body.
+  void begin();
+  void add(int a, int b) { m_raw.push_back({a < b ? a : b, a < b ? b : a, 0}); }
+  void finish(const World& world);
+
+  // This step's candidates: the listed pairs whose bounding circles overlap now, in list order
+  // (sorted). Clears out first.
+  void filterByCircles(const World& world, std::vector<CandidatePair>& out);
+  const std::vector<ListedPair>& pairs() const { return m_pairs; }
+
+ private:
+  void sortRaw(int bodyCount);
+
+  Real m_skin;
+  bool m_valid = false;
+  long m_rebuilds = 0;
+  std::vector<ListedPair> m_raw, m_pairs;
+  std::vector<CandidatePair> m_filtered;
+  std::vector<int> m_count;
+  // Reference state at the last build, by slot.
+  std::vector<Real> m_x0, m_y0, m_angle0;
+  std::vector<std::int64_t> m_id0;
+  // Direct bodies, tested against every body each step by filterByCircles: the vessels, and the
+  // bodies that moved more than half the skin since the build.
+  std::vector<char> m_direct;
+  std::vector<int> m_directList;
+  std::vector<CandidatePair> m_directPairs;
+};
+
+// Base of the kept-list strategies: rebuild when the rule asks, then filter. A strategy says only
+// how it builds (and, for triangulation_mesh, how it filters).
+class KeptListBroadphase : public Broadphase {
+ public:
+  explicit KeptListBroadphase(Real skin) : m_list(skin) {}
+  void findCandidates(const World& world, std::vector<CandidatePair>& pairs) override;
+  void invalidate() override { m_list.invalidate(); }
+  long rebuilds() const override { return m_list.rebuilds(); }
+  // The kept list itself, for tests and benchmarks.
+  const NeighbourList& list() const { return m_list; }
+
+ protected:
+  // Adds every pair the strategy lists between m_list.begin() and m_list.finish(), which the base calls.
+  virtual void build(const World& world, NeighbourList& list) = 0;
+  virtual void filter(const World& world, std::vector<CandidatePair>& pairs) { m_list.filterByCircles(world, pairs); }
+  NeighbourList m_list;
+};
+
+// The settings after a check: negative or non-finite lengths are an InputError naming the key.
+BroadphaseSettings checkedSettings(const BroadphaseSettings& settings);
+
+// The largest bounding radius among floes, else among all movable bodies, else 0: the size scale
+// of fixed_radius and uniform_grid. Walls (long, immovable) and the vessel would make it useless.
+Real largestFloeRadius(const World& world);
+
+// Sweep and prune along x, the build of variable_radius, fixed_radius and triangulation_mesh: lists
+// every pair with |c_a - c_b| <= max(floor, h_a + h_b), h one length per body and floor one length
+// for all. Each body spans [x - e, x + e] with e = max(floor / 2, h), so a pair the rule accepts
+// always has overlapping spans. The order of the last build is kept: bodies move little, so it is
+// nearly sorted and an insertion sort fixes it in about O(n). The sweep reads sorted copies of
+// x, y, h, so its inner loop walks memory in order.
+class SweepAndPrune {
+ public:
+  void build(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list);
+
+ private:
+  std::vector<int> m_order, m_slot;
+  std::vector<Real> m_lo, m_sortedLo, m_x, m_y, m_h, m_hi;  // m_lo by slot, the rest by sorted position
+};
+
+}  // namespace gem

@@ -1,0 +1,25 @@
+// Gathering a sweep: reading the runs' summary.json files and writing summary.csv (sweep.hpp).
+#pragma once
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "framework/scenario/sweep_file.hpp"
+
+namespace gem {
+
+// The flat numbers and strings of a summary.json (the subset of JSON GEM writes: objects, numbers,
+// strings, true/false/null; arrays are skipped), nested objects flattened to "ship_speed.mean".
+// Numbers keep their text as written; null is "". Throws std::runtime_error if malformed.
+std::map<std::string, std::string> readSummaryJson(const std::filesystem::path& file);
+
+// The summary quantities of summary.csv, after name and the varied keys.
+const std::vector<std::string>& sweepSummaryColumns();
+
+// Writes DIR/summary.csv (atomically) from every case whose folder holds a summary.json, in case
+// order; returns the number of rows. caseDirs[i] is the folder of case i.
+int writeSweepSummary(const SweepDefinition& sweep, const std::filesystem::path& csv,
+                      const std::vector<std::filesystem::path>& caseDirs);
+
+}  // namespace gem

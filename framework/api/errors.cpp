@@ -1,0 +1,14 @@
+#include "framework/api/errors.hpp"
+
+#include <fmt/format.h>
+
+namespace gem {
+
+std::string InputError::format(const std::string& file, int line, int column, const std::string& message) {
+  if (file.empty()) return message;
+  if (line > 0 && column > 0) return fmt::format("{}:{}:{}: {}", file, line, column, message);
+  if (line > 0) return fmt::format("{}:{}: {}", file, line, message);
+  return fmt::format("{}: {}", file, message);
+}
+
+}  // namespace gem

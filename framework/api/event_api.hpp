@@ -1,0 +1,202 @@
+// What an event sees and writes. Host+device: event headers include only this and geometry/.
+// A solo event sees one body (SoloBody) and adds to its velocity change (VelocityChange).
+// A two-body event sees both bodies and their contact (PairBody, PairContact) and adds to the
+// contact's own impulse slot (PairSlot); each body later sums its slots in a fixed order, so no
+// floating-point atomics are ever needed (DESIGN.md "Writing an event").
+#pragma once
+#include <cstdint>
+
+#include "geometry/contact.hpp"
+#include "framework/world/body_kind.hpp"
+#include "framework/world/constants.hpp"
+#include "geometry/polygon.hpp"
+
+namespace gem {
+
+
+
+struct StepContext {
+  Real dt;    // s
+  Real time;  // s, at the start of the step
+  long step;  // index of the step being taken, from 0
+};
+
+// One body at the start of the step, as solo events see it.
+struct SoloBody {
+  BodyKind kind;
+  int dof;  // 3 for floes, 1 or 3 for the vessel, 0 for walls
+  Vec2 position;
+  Real angle;
+  Vec2 velocity;
+  Real omega;
+  Real mass, area, thickness;
+};
+
+// What solo events add up for one body during a step (MODEL.md 2: velocities change first).
+struct VelocityChange {
+  Vec2 dv;
+  Real domega;
+};
+
+// One body as the motion event sees it: it owns the position update (MODEL.md 2).
+struct MotionBody {
+  BodyKind kind;
+  int dof;
+  Vec2 position;
+  Real angle;
+  Vec2 velocity;
+  Real omega;
+};
+
+// One body of a contact pair. vertices are its world vertices for this step.
+struct PairBody {
+  BodyKind kind;
+  int dof;
+  std::int64_t id;
+  Vec2 position;
+  Real angle;
+  Vec2 velocity;
+  Real omega;
+  Real mass, invMass, invInertia;
+  Real gyration2;                // r_z^2, m^2
+  Real gyrationX2, gyrationY2;   // principal r_x^2, r_y^2, m^2 (MODEL.md 5)
+  Real principalAngle;           // world angle of the principal x axis, rad
+  Real area, thickness;
+  const Vec2* vertices;
+  int vertexCount;
+};
+
+// The PairBody view of body i of a structure of arrays with World's member names: World on the
+// host, the device arrays on the GPU. One definition, so both backends see identical bodies.
+template <class Arrays>
+GEM_HD inline PairBody pairBodyOf(const Arrays& a, int i, int dof, const Vec2* vertices, int vertexCount) {
+  PairBody b;
+  b.kind = a.kind[i];
+  b.dof = dof;
+  b.id = a.id[i];
+  b.position = Vec2{a.x[i], a.y[i]};
+  b.angle = a.angle[i];
+  b.velocity = Vec2{a.vx[i], a.vy[i]};
+  b.omega = a.omega[i];
+  b.mass = a.mass[i];
+  b.invMass = a.invMass[i];
+  b.invInertia = a.invInertia[i];
+  b.gyration2 = a.gyration2[i];
+  b.gyrationX2 = a.gyrationX2[i];
+  b.gyrationY2 = a.gyrationY2[i];
+  b.principalAngle = a.angle[i] + a.principalAngle[i];  // world angle of the principal x axis
+  b.area = a.area[i];
+  b.thickness = a.thickness[i];
+  b.vertices = vertices;
+  b.vertexCount = vertexCount;
+  return b;
+}
+
+// A contact between bodies a and b (a's slot < b's slot); geometry.normal points from a into b.
+struct PairContact {
+  Contact geometry;
+  bool onset;  // the pair was not in contact in the previous step
+};
+
+// The impulse of all two-body events of one contact: +impulse acts on b at the contact point,
+// -impulse on a (equal and opposite, MODEL.md 4).
+struct PairSlot {
+  Vec2 impulse;  // N s
+};
+
+// A ship-ice impact at contact onset (MODEL.md 5), one row of impacts.csv.
+struct ImpactRecord {
+  Real time;
+  std::int64_t floeId;
+  Real floeMass, thickness, apexDeg, frameAngleDeg;
+  Vec2 point, normal;          // world contact point; normal from the vessel into the floe
+  Real xFromStem, yFromCenterline;
+  Real closingSpeed;           // V_n, m/s
+  Real force;                  // min(F_n, F_lim), N
+  Real forceLimit;             // F_lim, N (infinite when the edge cannot fail in bending)
+  bool broke;
+};
+
+// A floe to be cut by the flexural_breaking event in the topology phase (MODEL.md 6).
+struct BreakRequest {
+  std::int64_t floeId;
+  Vec2 point;      // contact point c
+  Vec2 normal;     // from the vessel into the floe
+  Real cuspLength; // m, distance of the cut from c along the normal
+};
+
+// A row that an event logs for its own output (a plugin's detector, say): the channel it was given
+// when its Params were parsed (framework/api/log_channel.hpp), the two bodies and up to six numbers.
+// Records are plain data so that device code can push them too; the host hands each one to its
+// channel's writer after the step, in contact order, on either backend.
+struct LogRecord {
+  int channel;
+  Real time;
+  std::int64_t idA, idB;
+  Real value[6];
+};
+
+// Where events append records. The CPU driver points these at host buffers; a device driver
+// points them at device buffers. Records past capacity are counted but dropped (the driver
+// grows the buffers and reports it), so a step never writes out of bounds.
+struct RecordSink {
+  ImpactRecord* impacts;
+  int impactCapacity;
+  int* impactCount;
+  BreakRequest* breaks;
+  int breakCapacity;
+  int* breakCount;
+  LogRecord* logs;
+  int logCapacity;
+  int* logCount;
+
+  // On the device many contacts push at once: an integer atomic counter (the CUDA driver then
+  // orders the records deterministically by floe slot, which is the CPU's contact order).
+  GEM_HD void push(const ImpactRecord& r) const {
+    const int k = next(impactCount);
+    if (k < impactCapacity) impacts[k] = r;
+  }
+  GEM_HD void push(const BreakRequest& r) const {
+    const int k = next(breakCount);
+    if (k < breakCapacity) breaks[k] = r;
+  }
+  GEM_HD void push(const LogRecord& r) const {
+    const int k = next(logCount);
+    if (k < logCapacity) logs[k] = r;
+  }
+  GEM_HD static int next(int* counter) {
+#if defined(__CUDA_ARCH__)
+    return atomicAdd(counter, 1);
+#else
+    return (*counter)++;
+#endif
+  }
+};
+
+// 1 / effective mass of a body for an impulse along unit n at point c (MODEL.md 4:
+// Co = l^2 + m^2 + eta^2 / r^2, M_e = M / Co). A 1-DOF vessel moves only along its heading, so
+// only the surge component of n counts and it cannot turn (choice: the constraint carries the
+// rest); walls are immovable.
+GEM_HD inline Real inverseEffectiveMass(const PairBody& b, Vec2 n, Vec2 c) {
+  if (b.dof == 0) return 0;
+  if (b.dof == 1) {
+    Vec2 surge{std::cos(b.angle), std::sin(b.angle)};
+    Real l = dot(n, surge);
+    return b.invMass * l * l;
+  }
+  Real eta = cross(c - b.position, n);  // moment arm (A.36)
+  return b.invMass * dot(n, n) + b.invInertia * eta * eta;
+}
+
+// Velocity of the material point of b at c: v + omega x (c - centroid).
+GEM_HD inline Vec2 pointVelocity(const PairBody& b, Vec2 c) {
+  return b.velocity + crossZ(b.omega, c - b.position);
+}
+
+// Closing speed along n at c, positive when the contact points approach (MODEL.md 4).
+GEM_HD inline Real closingSpeed(const PairBody& a, const PairBody& b, const PairContact& contact) {
+  Vec2 c = contact.geometry.point;
+  return dot(pointVelocity(a, c) - pointVelocity(b, c), contact.geometry.normal);
+}
+
+}  // namespace gem

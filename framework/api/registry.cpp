@@ -1,0 +1,142 @@
+#include "framework/api/registry.hpp"
+
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
+
+namespace gem {
+
+const char* eventPhaseName(EventPhase phase) {
+  switch (phase) {
+    case EventPhase::Pair: return "two-body";
+    case EventPhase::Solo: return "solo";
+    case EventPhase::Motion: return "motion";
+    case EventPhase::Topology: return "topology";
+  }
+  return "unknown";
+}
+
+Registry& Registry::global() {
+  static Registry registry;
+  return registry;
+}
+
+void Registry::addEvent(EventEntry entry) {
+  if (m_staging) {
+    entry.origin = m_staging->origin;
+    m_staging->events.push_back(std::move(entry));
+    return;
+  }
+  auto [it, inserted] = m_events.emplace(entry.name, entry);
+  if (!inserted)
+    throw InputError(fmt::format("event \"{}\" from {} clashes with the one from {}", entry.name, entry.origin, it->second.origin));
+}
+
+void Registry::addBroadphase(BroadphaseEntry entry) {
+  if (m_staging) {
+    entry.origin = m_staging->origin;
+    m_staging->broadphases.push_back(std::move(entry));
+    return;
+  }
+  auto [it, inserted] = m_broadphases.emplace(entry.name, entry);
+  if (!inserted)
+    throw InputError(fmt::format("broadphase \"{}\" from {} clashes with the one from {}", entry.name, entry.origin, it->second.origin));
+}
+
+void Registry::beginPlugin(const std::string& origin, bool allowOverride) {
+  m_staging = std::make_unique<Staging>();
+  m_staging->origin = origin;
+  m_staging->allowOverride = allowOverride;
+}
+
+void Registry::abortPlugin() { m_staging.reset(); }
+
+std::string Registry::pluginOrigin() const { return m_staging ? m_staging->origin : std::string("built-in"); }
+
+namespace {
+
+// A clash of a plugin's entry with one already there (or with another of its own entries).
+template <class Entry>
+void checkClashes(const char* kind, const std::vector<Entry>& staged, const std::map<std::string, Entry>& table, bool allowOverride) {
+  std::map<std::string, const Entry*> seen;
+  for (const Entry& e : staged) {
+    if (!seen.emplace(e.name, &e).second)
+      throw InputError(fmt::format("plugin {}: registers {} \"{}\" twice", e.origin, kind, e.name));
+    auto it = table.find(e.name);
+    if (it != table.end() && !allowOverride)
+      throw InputError(fmt::format("plugin {}: {} \"{}\" clashes with the one from {} (to replace it, give the plugin's "
+                                   "[[plugins]] entry override = true)",
+                                   e.origin, kind, e.name, it->second.origin));
+  }
+}
+
+}  // namespace
+
+void Registry::commitPlugin() {
+  std::unique_ptr<Staging> staging = std::move(m_staging);
+  if (!staging) return;
+  checkClashes("event", staging->events, m_events, staging->allowOverride);
+  checkClashes("broadphase", staging->broadphases, m_broadphases, staging->allowOverride);
+  for (EventEntry& e : staging->events) m_events.insert_or_assign(e.name, std::move(e));
+  for (BroadphaseEntry& b : staging->broadphases) m_broadphases.insert_or_assign(b.name, std::move(b));
+}
+
+const EventEntry* Registry::findEvent(const std::string& name) const {
+  auto it = m_events.find(name);
+  return it == m_events.end() ? nullptr : &it->second;
+}
+
+const EventEntry& Registry::event(const std::string& name) const {
+  if (auto* e = findEvent(name)) return *e;
+  throw InputError(fmt::format("unknown event \"{}\" (valid: {})", name, fmt::join(eventNames(), ", ")));
+}
+
+const BroadphaseEntry& Registry::broadphase(const std::string& name) const {
+  auto it = m_broadphases.find(name);
+  if (it != m_broadphases.end()) return it->second;
+  throw InputError(fmt::format("unknown broadphase \"{}\" (valid: {})", name, fmt::join(broadphaseNames(), ", ")));
+}
+
+std::vector<const EventEntry*> Registry::events() const {
+  std::vector<const EventEntry*> out;
+  for (EventPhase phase : {EventPhase::Pair, EventPhase::Solo, EventPhase::Motion, EventPhase::Topology})
+    for (const auto& [name, e] : m_events)
+      if (e.phase == phase) out.push_back(&e);
+  return out;
+}
+
+std::vector<const BroadphaseEntry*> Registry::broadphases() const {
+  std::vector<const BroadphaseEntry*> out;
+  for (const auto& [name, b] : m_broadphases) out.push_back(&b);
+  return out;
+}
+
+std::vector<std::string> Registry::eventNames() const {
+  std::vector<std::string> out;
+  for (const auto& [name, e] : m_events) out.push_back(name);
+  return out;
+}
+
+std::vector<std::string> Registry::broadphaseNames() const {
+  std::vector<std::string> out;
+  for (const auto& [name, b] : m_broadphases) out.push_back(name);
+  return out;
+}
+
+static PluginLibraryLoader& pluginLibraryLoader() {
+  static PluginLibraryLoader loader{nullptr, nullptr};
+  return loader;
+}
+
+void setPluginLibraryLoader(PluginLibraryLoader loader) { pluginLibraryLoader() = loader; }
+
+void requirePluginLibrary(const std::filesystem::path& path, bool allowOverride) {
+  if (!pluginLibraryLoader().load) throw InputError(path.string() + ": this program cannot load plugins (no plugin loader)");
+  pluginLibraryLoader().load(path, allowOverride);
+}
+
+void requireEnvironmentPluginLibraries() {
+  if (pluginLibraryLoader().loadEnvironment) pluginLibraryLoader().loadEnvironment();
+}
+
+}  // namespace gem

@@ -1,0 +1,260 @@
+// One registry of events and broadphases by name: built-ins register themselves at load time
+// with the macros below; plugins use the very same macros (DESIGN.md "Plugins", plugin_api.hpp).
+#pragma once
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "framework/api/broadphase.hpp"
+#include "framework/api/event_api.hpp"
+#if defined(GEM_BUILDING_PLUGIN)
+#include "framework/api/plugin_api.hpp"
+#endif
+
+namespace gem {
+
+class TableReader;
+struct Scenario;
+struct World;
+
+enum class EventPhase { Pair, Solo, Motion, Topology };
+const char* eventPhaseName(EventPhase phase);
+
+// What the scheduler hands a pair event each step: every body's view (by slot) and the contacts.
+struct PairPhaseData {
+  const PairBody* bodies;
+  const int* contactA;  // slot of body a of contact k
+  const int* contactB;
+  const PairContact* contacts;
+  PairSlot* slots;
+  int count;
+  StepContext ctx;
+  RecordSink sink;
+};
+
+struct SoloPhaseData {
+  const SoloBody* bodies;
+  VelocityChange* changes;
+  int count;
+  StepContext ctx;
+};
+
+struct MotionPhaseData {
+  MotionBody* bodies;
+  int count;
+  StepContext ctx;
+};
+
+// Topology events run on the host after motion (MODEL.md 8, phase 6). The contract, which lets the
+// CUDA backend keep its world on the device: an event reads the state of the bodies its requests
+// name (breaks[k].floeId) and only theirs (the CUDA backend fetches just those rows), and changes
+// the bodies only through World::removeBodies and World::addBody (the device then replays the edit).
+struct TopologyData {
+  struct World* world;
+  const BreakRequest* breaks;
+  int breakCount;
+  Real time;
+  // Outputs: what the event did, for the summary and the broadphase.
+  double rubbleMass = 0;   // kg removed as rubble this step
+  int floesBroken = 0;
+  bool changed = false;    // bodies were added or removed
+};
+
+class EventInstance {
+ public:
+  virtual ~EventInstance() = default;
+  virtual void runPairs(const PairPhaseData&) {}
+  virtual void runSolo(const SoloPhaseData&) {}
+  virtual void runMotion(const MotionPhaseData&) {}
+  virtual void runTopology(TopologyData&) {}
+  // The parsed Params, so that a device driver of the same event is made from the very same values.
+  virtual const void* params() const = 0;
+};
+
+// What an event's factory gets: its parameter table (strict) and the whole scenario
+// (propulsion and autopilot read the vessel from it).
+struct EventConfig {
+  TableReader& params;
+  const Scenario& scenario;
+};
+
+struct EventEntry {
+  std::string name, description, origin;
+  EventPhase phase;
+  bool enabledByDefault;
+  std::function<std::unique_ptr<EventInstance>(EventConfig&)> makeCpu;
+};
+
+struct BroadphaseEntry {
+  std::string name, description, origin;
+  std::function<std::unique_ptr<Broadphase>(const BroadphaseSettings&)> make;
+};
+
+class Registry {
+ public:
+  static Registry& global();
+  void addEvent(EventEntry entry);
+  void addBroadphase(BroadphaseEntry entry);
+  // Throw InputError listing the valid names when `name` is unknown.
+  const EventEntry& event(const std::string& name) const;
+  const BroadphaseEntry& broadphase(const std::string& name) const;
+  const EventEntry* findEvent(const std::string& name) const;
+  // In registration order of phase, then name.
+  std::vector<const EventEntry*> events() const;
+  std::vector<const BroadphaseEntry*> broadphases() const;
+  std::vector<std::string> eventNames() const;
+  std::vector<std::string> broadphaseNames() const;
+
+  // The plugin loader's side (framework/app/plugin_loader.cpp). Between beginPlugin and commitPlugin,
+  // added entries are held back and stamped with the plugin's origin; commitPlugin then enters
+  // them all, or none when a name clashes (InputError naming both origins) and the plugin may not
+  // override. abortPlugin drops them.
+  void beginPlugin(const std::string& origin, bool allowOverride);
+  void commitPlugin();
+  void abortPlugin();
+  // The origin of the plugin registering now (between beginPlugin and commit/abort), else
+  // "built-in". A plugin's CUDA drivers are keyed by it (framework/api/cuda_events.hpp).
+  std::string pluginOrigin() const;
+
+ private:
+  std::map<std::string, EventEntry> m_events;
+  std::map<std::string, BroadphaseEntry> m_broadphases;
+  struct Staging {
+    std::string origin;
+    bool allowOverride = false;
+    std::vector<EventEntry> events;
+    std::vector<BroadphaseEntry> broadphases;
+  };
+  std::unique_ptr<Staging> m_staging;  // non-null while a plugin registers
+};
+
+// The CPU drivers: the only loops over bodies and contacts (DESIGN.md "Folders").
+template <class Event>
+class CpuPairDriver final : public EventInstance {
+ public:
+  using Params = typename Event::Params;
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  explicit CpuPairDriver(const Params& p) : m_params(p) {}
+  void runPairs(const PairPhaseData& d) override {
+    for (int k = 0; k < d.count; ++k)
+      Event::apply(m_params, d.bodies[d.contactA[k]], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], d.ctx, d.sink);
+  }
+  const void* params() const override { return &m_params; }
+
+ private:
+  Params m_params;
+};
+
+template <class Event>
+class CpuSoloDriver final : public EventInstance {
+ public:
+  using Params = typename Event::Params;
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  explicit CpuSoloDriver(const Params& p) : m_params(p) {}
+  void runSolo(const SoloPhaseData& d) override {
+    for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.changes[i], d.ctx);
+  }
+  const void* params() const override { return &m_params; }
+
+ private:
+  Params m_params;
+};
+
+template <class Event>
+class CpuMotionDriver final : public EventInstance {
+ public:
+  using Params = typename Event::Params;
+  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  explicit CpuMotionDriver(const Params& p) : m_params(p) {}
+  void runMotion(const MotionPhaseData& d) override {
+    for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.ctx);
+  }
+  const void* params() const override { return &m_params; }
+
+ private:
+  Params m_params;
+};
+
+// Topology events work on the host World directly.
+template <class Event>
+class TopologyDriver final : public EventInstance {
+ public:
+  using Params = typename Event::Params;
+  explicit TopologyDriver(const Params& p) : m_params(p) {}
+  void runTopology(TopologyData& d) override { Event::apply(m_params, d); }
+  const void* params() const override { return &m_params; }
+
+ private:
+  Params m_params;
+};
+
+// Plugin libraries: a scenario names them ([[plugins]]) and GEM_PLUGIN_PATH lists folders of them.
+// The scenario parser only asks for them here, before it checks event and broadphase names; the
+// application's plugin loader (framework/app/plugin_loader.cpp, Boost.DLL) installs itself as the
+// one that loads them, so parsing never reaches up to the code that opens libraries.
+struct PluginLibraryLoader {
+  void (*load)(const std::filesystem::path& path, bool allowOverride);  // throws InputError
+  void (*loadEnvironment)();                                           // GEM_PLUGIN_PATH, once
+};
+void setPluginLibraryLoader(PluginLibraryLoader loader);
+// Both throw InputError when no loader is installed (a program without the plugin loader).
+void requirePluginLibrary(const std::filesystem::path& path, bool allowOverride);
+void requireEnvironmentPluginLibraries();
+
+// A built-in's registration, run when GEM's library loads.
+struct RegisterNow {
+  explicit RegisterNow(void (*add)(Registry&)) { add(Registry::global()); }
+};
+
+#ifndef GEM_ORIGIN
+#define GEM_ORIGIN "built-in"
+#endif
+
+#define GEM_CONCAT_INNER(a, b) a##b
+#define GEM_CONCAT(a, b) GEM_CONCAT_INNER(a, b)
+
+// One macro body for built-ins and plugins: ADD is a statement using `registry`. A built-in runs
+// it when GEM's library loads; a plugin (GEM_BUILDING_PLUGIN defined) only links it into its own
+// list, which the loader runs through gem_plugin_register once the descriptor has been accepted
+// (plugin_api.hpp).
+#if defined(GEM_BUILDING_PLUGIN)
+#define GEM_REGISTRATION(KIND, ADD)                                                              \
+  static void GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)(::gem::Registry & registry) { ADD; } \
+  static ::gem::PluginRegistrationNode GEM_CONCAT(GEM_CONCAT(gem_registration_, KIND), __LINE__){         \
+      &GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)}
+#else
+#define GEM_REGISTRATION(KIND, ADD)                                                              \
+  static void GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)(::gem::Registry & registry) { ADD; } \
+  static const ::gem::RegisterNow GEM_CONCAT(GEM_CONCAT(gem_registration_, KIND), __LINE__){              \
+      &GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)}
+#endif
+
+// Registers an event: EVENT is the evaluator struct, PARSE a function EventConfig& -> EVENT::Params.
+#define GEM_REGISTER_EVENT(DRIVER, PHASE, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)                        \
+  GEM_REGISTRATION(event_, registry.addEvent(::gem::EventEntry{                                            \
+      NAME, DESCRIPTION, GEM_ORIGIN, PHASE, ENABLED,                                                        \
+      [](::gem::EventConfig& config) -> std::unique_ptr<::gem::EventInstance> {                            \
+        return std::make_unique<DRIVER<EVENT>>(PARSE(config));                                             \
+      }}))
+#define GEM_REGISTER_PAIR_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
+  GEM_REGISTER_EVENT(::gem::CpuPairDriver, ::gem::EventPhase::Pair, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
+#define GEM_REGISTER_SOLO_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
+  GEM_REGISTER_EVENT(::gem::CpuSoloDriver, ::gem::EventPhase::Solo, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
+#define GEM_REGISTER_MOTION_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
+  GEM_REGISTER_EVENT(::gem::CpuMotionDriver, ::gem::EventPhase::Motion, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
+#define GEM_REGISTER_TOPOLOGY_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
+  GEM_REGISTER_EVENT(::gem::TopologyDriver, ::gem::EventPhase::Topology, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
+
+// Registers a broadphase class constructible from BroadphaseSettings.
+#define GEM_REGISTER_BROADPHASE(CLASS, NAME, DESCRIPTION)                                                  \
+  GEM_REGISTRATION(broadphase_, registry.addBroadphase(::gem::BroadphaseEntry{                             \
+      NAME, DESCRIPTION, GEM_ORIGIN,                                                                       \
+      [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::Broadphase> {                      \
+        return std::make_unique<CLASS>(s);                                                                 \
+      }}))
+
+}  // namespace gem

@@ -1,0 +1,156 @@
+#include "framework/api/table_reader.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
+
+namespace gem {
+
+TableReader::TableReader(const toml::table* table, std::string path, std::string file)
+    : m_table(table), m_path(std::move(path)), m_file(std::move(file)) {}
+
+bool TableReader::has(const std::string& key) const { return m_table && m_table->contains(key); }
+
+const toml::node* TableReader::node(const std::string& key) {
+  m_known.insert(key);
+  return m_table ? m_table->get(key) : nullptr;
+}
+
+void TableReader::accept(const std::string& key) { m_known.insert(key); }
+
+void TableReader::fail(const std::string& key, const std::string& message) const {
+  const toml::node* n = m_table ? m_table->get(key) : nullptr;
+  if (n) failAt(*n, fmt::format("{}: {}", keyPath(key), message));
+  if (m_table) {
+    const auto& src = m_table->source();
+    throw InputError(m_file, src.begin.line, src.begin.column, fmt::format("{}: {}", keyPath(key), message));
+  }
+  throw InputError(m_file, 0, 0, fmt::format("{}: {}", keyPath(key), message));
+}
+
+void TableReader::failAt(const toml::node& n, const std::string& message) const {
+  const auto& src = n.source();
+  throw InputError(m_file, static_cast<int>(src.begin.line), static_cast<int>(src.begin.column), message);
+}
+
+Real TableReader::toReal(const toml::node& n, const std::string& key) const {
+  double v;
+  if (auto f = n.value_exact<double>()) v = *f;
+  else if (auto i = n.value_exact<std::int64_t>()) v = static_cast<double>(*i);
+  else failAt(n, fmt::format("{}: expected a number, got {}", keyPath(key), toml::impl::node_type_friendly_names[static_cast<int>(n.type())]));
+  if (!std::isfinite(v)) failAt(n, fmt::format("{}: expected a finite number, got {}", keyPath(key), v));
+  return static_cast<Real>(v);
+}
+
+std::optional<Real> TableReader::findReal(const std::string& key) {
+  const toml::node* n = node(key);
+  if (!n) return std::nullopt;
+  return toReal(*n, key);
+}
+
+Real TableReader::getReal(const std::string& key, Real fallback) { return findReal(key).value_or(fallback); }
+
+Real TableReader::getPositive(const std::string& key, Real fallback) {
+  Real v = getReal(key, fallback);
+  if (!(v > 0)) fail(key, fmt::format("must be positive, got {}", v));
+  return v;
+}
+
+Real TableReader::getNonNegative(const std::string& key, Real fallback) {
+  Real v = getReal(key, fallback);
+  if (!(v >= 0)) fail(key, fmt::format("must not be negative, got {}", v));
+  return v;
+}
+
+std::int64_t TableReader::getInt(const std::string& key, std::int64_t fallback, std::int64_t min, std::int64_t max) {
+  const toml::node* n = node(key);
+  if (!n) return fallback;
+  auto i = n->value_exact<std::int64_t>();
+  if (!i) failAt(*n, fmt::format("{}: expected an integer", keyPath(key)));
+  if (*i < min || *i > max) failAt(*n, fmt::format("{}: must be in [{}, {}], got {}", keyPath(key), min, max, *i));
+  return *i;
+}
+
+bool TableReader::getBool(const std::string& key, bool fallback) {
+  const toml::node* n = node(key);
+  if (!n) return fallback;
+  auto b = n->value_exact<bool>();
+  if (!b) failAt(*n, fmt::format("{}: expected true or false", keyPath(key)));
+  return *b;
+}
+
+std::string TableReader::getString(const std::string& key, const std::string& fallback) {
+  const toml::node* n = node(key);
+  if (!n) return fallback;
+  auto s = n->value_exact<std::string>();
+  if (!s) failAt(*n, fmt::format("{}: expected a string", keyPath(key)));
+  return *s;
+}
+
+std::string TableReader::getChoice(const std::string& key, const std::string& fallback,
+                                   const std::vector<std::string>& choices) {
+  std::string v = getString(key, fallback);
+  for (const auto& c : choices)
+    if (c == v) return v;
+  fail(key, fmt::format("unknown value \"{}\" (valid: {})", v, fmt::join(choices, ", ")));
+}
+
+std::optional<std::vector<Real>> TableReader::findReals(const std::string& key) {
+  const toml::node* n = node(key);
+  if (!n) return std::nullopt;
+  const toml::array* a = n->as_array();
+  if (!a) failAt(*n, fmt::format("{}: expected an array of numbers", keyPath(key)));
+  std::vector<Real> out;
+  for (const toml::node& e : *a) out.push_back(toReal(e, key));
+  return out;
+}
+
+std::optional<Vec2> TableReader::findVec2(const std::string& key) {
+  auto v = findReals(key);
+  if (!v) return std::nullopt;
+  if (v->size() != 2) fail(key, fmt::format("expected [x, y], got {} numbers", v->size()));
+  return Vec2{(*v)[0], (*v)[1]};
+}
+
+std::optional<std::vector<Vec2>> TableReader::findPoints(const std::string& key) {
+  const toml::node* n = node(key);
+  if (!n) return std::nullopt;
+  const toml::array* a = n->as_array();
+  if (!a) failAt(*n, fmt::format("{}: expected an array of [x, y] points", keyPath(key)));
+  std::vector<Vec2> out;
+  for (const toml::node& e : *a) {
+    const toml::array* p = e.as_array();
+    if (!p || p->size() != 2) failAt(e, fmt::format("{}: expected [x, y]", keyPath(key)));
+    out.push_back({toReal(*p->get(0), key), toReal(*p->get(1), key)});
+  }
+  return out;
+}
+
+const toml::table* TableReader::findTable(const std::string& key) {
+  const toml::node* n = node(key);
+  if (!n) return nullptr;
+  if (!n->as_table()) failAt(*n, fmt::format("{}: expected a table", keyPath(key)));
+  return n->as_table();
+}
+
+const toml::array* TableReader::findArray(const std::string& key) {
+  const toml::node* n = node(key);
+  if (!n) return nullptr;
+  if (!n->as_array()) failAt(*n, fmt::format("{}: expected an array", keyPath(key)));
+  return n->as_array();
+}
+
+void TableReader::finish() const {
+  if (!m_table) return;
+  for (const auto& [k, v] : *m_table) {
+    std::string key(k.str());
+    if (m_known.count(key)) continue;
+    std::vector<std::string> valid(m_known.begin(), m_known.end());
+    failAt(v, fmt::format("unknown key \"{}\" (valid keys here: {})", keyPath(key),
+                          valid.empty() ? std::string("none") : fmt::format("{}", fmt::join(valid, ", "))));
+  }
+}
+
+}  // namespace gem

@@ -1,0 +1,225 @@
+// The gem command (SCENARIO.md "Command line"): run, check, info, bench.
+// Exit status: 0 success; 2 bad input (with file, line and column or key); 1 any other failure.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "framework/analysis/analyze.hpp"
+#include "bench/bench.hpp"
+#include "framework/app/calibration.hpp"
+#include "framework/api/errors.hpp"
+#include "framework/app/plugin_loader.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/app/runner.hpp"
+#include "framework/scenario/scenario.hpp"
+#include "framework/step/simulation.hpp"
+#include "framework/app/mpi_work.hpp"
+#include "framework/step/stepper.hpp"
+#include "framework/app/sweep.hpp"
+
+namespace fs = std::filesystem;
+using namespace gem;
+
+namespace {
+
+struct RunArguments {
+  std::string scenario, out, backend, broadphase;
+  double duration = 0;
+  long steps = 0;
+  std::vector<std::string> set;
+  bool quiet = false;
+};
+
+Scenario load(const RunArguments& a) {
+  std::vector<std::string> overrides = a.set;
+  if (!a.backend.empty()) overrides.push_back("simulation.backend=\"" + a.backend + "\"");
+  if (!a.broadphase.empty()) overrides.push_back("simulation.broadphase=\"" + a.broadphase + "\"");
+  Scenario s = loadScenario(a.scenario, overrides);
+  if (a.duration > 0) {
+    s.duration = static_cast<Real>(a.duration);
+    s.steps = std::lround(a.duration / s.dt);
+  }
+  if (a.steps > 0) {
+    s.steps = a.steps;
+    s.duration = static_cast<Real>(a.steps) * s.dt;
+  }
+  if (!a.out.empty()) s.output.dir = fs::absolute(a.out);
+  return s;
+}
+
+int commandRun(const RunArguments& a) {
+  const Scenario s = load(a);
+  RunOptions options;
+  options.quiet = a.quiet;
+  options.progress = isatty(fileno(stderr));
+  if (!a.quiet)
+    std::printf("gem run %s: %ld steps of %.3g s, backend %s, broadphase %s\n", a.scenario.c_str(), s.steps,
+                static_cast<double>(s.dt), resolveBackend(s.backend).c_str(), s.broadphase.c_str());
+  const RunSummary r = runScenario(s, options);
+  if (!a.quiet) {
+    std::printf("  floes          %d at start, %d at end (%ld broken, %.4g kg rubble)\n", r.floesInitial, r.floesFinal,
+                r.floesBroken, r.rubbleMass);
+    std::printf("  impacts        %ld ship-ice impacts", r.impacts);
+    if (r.impactForce.count) std::printf(", force mean %.3g kN, max %.3g kN", r.impactForce.mean / 1e3, r.impactForce.max / 1e3);
+    std::printf("\n");
+    if (r.shipSpeed.count)
+      std::printf("  ship speed     mean %.3f m/s (min %.3f, max %.3f); mean net thrust %.1f kN\n", r.shipSpeed.mean,
+                  r.shipSpeed.min, r.shipSpeed.max, r.netThrust.mean / 1e3);
+    std::printf("  wall time      %.3f s for %.1f s simulated: %.0fx real time (%.0f steps/s)\n", r.wallTime, r.simTime,
+                r.simTime / std::max(r.wallTime, 1e-9), r.steps / std::max(r.wallTime, 1e-9));
+    std::printf("  outputs        %s/ (summary.json, timeseries.csv, impacts.csv, state.csv, frames.pvd, frames.ice)\n",
+                r.outputDir.c_str());
+  }
+  return 0;
+}
+
+int commandCheck(const RunArguments& a) {
+  const Scenario s = load(a);
+  resolveBackend(s.backend);
+  Simulation sim(s);  // builds the field, checks every body and overlap, parses every event
+  if (!a.quiet)
+    std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(),
+              sim.world().size(), sim.world().count(BodyKind::Floe), s.vessel.present ? ", a vessel" : "", s.steps,
+              s.broadphase.c_str(), sim.events().size());
+  return 0;
+}
+
+// An entry's origin: "built-in", or for a plugin's "PATH (NAME VERSION)" on a line of its own.
+std::string originColumn(const std::string& origin) { return origin == "built-in" ? origin : "plugin"; }
+void printPluginOrigin(const std::string& origin) {
+  if (origin != "built-in") std::printf("  %-18s from %s\n", "", origin.c_str());
+}
+
+int commandInfo(const std::vector<std::string>& plugins) {
+  loadEnvironmentPlugins();
+  for (const std::string& p : plugins) loadPlugin(p);
+  std::printf("GEM %s (GPU Event Mechanics)\n", GEM_VERSION);
+  const BackendEntry* cuda = findBackend("cuda");
+  std::printf("build: real type %s, backends: %s%s\n", sizeof(Real) == 8 ? "double" : "float",
+              fmt::format("{}", fmt::join(backendNames(), ", ")).c_str(),
+              cuda ? ", CUDA architectures " GEM_CUDA_ARCHITECTURES : " (no CUDA backend in this build)");
+  std::printf("plugin ABI: version %d, compiler %s %s\n", GEM_PLUGIN_ABI_VERSION, GEM_COMPILER_ID, GEM_COMPILER_VERSION);
+  std::printf("sweeps across MPI ranks: %s\n", mpiBuilt() ? "yes" : "no (built without MPI)");
+  std::printf("devices: cpu");
+  if (cuda) std::printf(", %s", cuda->available() ? cuda->deviceName().c_str() : "no CUDA device found");
+  std::printf("\n\nevents (phase, default, origin):\n");
+  for (const EventEntry* e : Registry::global().events()) {
+    std::printf("  %-18s %-9s %-4s %-9s %s\n", e->name.c_str(), eventPhaseName(e->phase), e->enabledByDefault ? "on" : "off",
+                originColumn(e->origin).c_str(), e->description.c_str());
+    printPluginOrigin(e->origin);
+  }
+  std::printf("\nbroadphases (origin):\n");
+  for (const BroadphaseEntry* b : Registry::global().broadphases()) {
+    std::printf("  %-18s %-9s %s\n", b->name.c_str(), originColumn(b->origin).c_str(), b->description.c_str());
+    printPluginOrigin(b->origin);
+  }
+  const std::vector<LoadedPlugin> loaded = loadedPlugins();
+  std::printf("\nplugins loaded: %s\n", loaded.empty() ? "none (GEM_PLUGIN_PATH, [[plugins]] or gem info --plugin PATH)" : "");
+  for (const LoadedPlugin& p : loaded) std::printf("  %-18s %-9s %s\n", p.name.c_str(), p.version.c_str(), p.path.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"GEM: GPU Event Mechanics, ships in 2D pack ice"};
+  app.require_subcommand(1);
+  RunArguments args;
+  auto addRunOptions = [&](CLI::App* c) {
+    c->add_option("scenario", args.scenario, "scenario file (TOML)")->required();
+    c->add_option("--backend", args.backend, "auto, cpu or cuda");
+    c->add_option("--broadphase", args.broadphase, "broadphase strategy by name (see gem info)");
+    auto* duration = c->add_option("--duration", args.duration, "simulated time, s");
+    c->add_option("--steps", args.steps, "number of steps")->excludes(duration);
+    c->add_option("--set", args.set, "override a scenario key: --set simulation.dt=0.05")->take_all();
+  };
+  CLI::App* run = app.add_subcommand("run", "run a scenario and write its outputs");
+  addRunOptions(run);
+  run->add_option("--out", args.out, "run folder (default: output.dir of the scenario, else runs/NAME)");
+  run->add_flag("--quiet", args.quiet, "no progress line and no summary");
+  CLI::App* check = app.add_subcommand("check", "load and validate a scenario without running it");
+  addRunOptions(check);
+  check->add_flag("--quiet", args.quiet, "print nothing when the scenario is valid");
+  std::vector<std::string> infoPlugins;
+  CLI::App* info = app.add_subcommand("info", "version, build, devices, registered events and broadphases");
+  info->add_option("--plugin", infoPlugins, "load this plugin first (repeatable); GEM_PLUGIN_PATH's are loaded too");
+  BenchOptions bench;
+  CLI::App* benchCommand = app.add_subcommand(
+      "bench", "the thesis's Chapter 5 timings as tables, printed and as CSV, each row with its device (--table)");
+  benchCommand->add_option("--table", bench.table,
+                           "step: time per step of --cases on --backend (default);\n"
+                           "fields: 456 and 824 floes, cpu and cuda, every built-in broadphase;\n"
+                           "blocks: cuda_block_size 32..1024 on 3584 and 7168 floes (cuda);\n"
+                           "copyback: copy_back_every 1..128 on 824 and 10^5 floes (cuda);\n"
+                           "scaling: 10^4, 10^5, 10^6 floes, every broadphase on cuda, variable_radius on the cpu;\n"
+                           "intersection, triangulation: the geometry tables (thesis 5.2, 5.3);\n"
+                           "all: fields, blocks, copyback, scaling, intersection, triangulation (without a CUDA device "
+                           "the CUDA rows are skipped, saying so; each table its own cases and broadphases)");
+  benchCommand->add_option("--csv", bench.csv,
+                           "also write CSV: a FILE for one table; for --table all (or a PATH that is a directory or ends "
+                           "in /) a directory, created, with one TABLE.csv per table (fields.csv, blocks.csv, ...)");
+  benchCommand->add_option("--steps", bench.steps, "steps timed per case (default 2000; fewer for large fields)");
+  benchCommand->add_option("--cases", bench.cases,
+                           "456, 824 (thesis fields) or floe counts N (random, 40 %); default: the table's own "
+                           "(step: 456 824 10000)");
+  benchCommand->add_option("--backend", bench.backends, "backends to time: cpu, cuda (default: the table's own; step: cpu)");
+  benchCommand->add_option("--broadphase", bench.broadphases, "broadphases to time (default: the table's own; step: variable_radius)");
+  benchCommand->add_option("--blocks", bench.blockSizes, "blocks: block sizes (default 32 64 128 256 512 1024)");
+  benchCommand->add_option("--copy-back", bench.copyBackEvery, "copyback: intervals k (default 1 2 4 8 16 32 64 128)");
+  benchCommand->add_option("--sizes", bench.sizes, "intersection/triangulation: N per row (default the thesis's sizes)");
+  benchCommand->add_option("--reps", bench.reps, "intersection/triangulation: timed repetitions, median (default 50)");
+
+  std::string calibrationFile = std::string(GEM_SOURCE_DIR) + "/scenarios/thesis/calibration.toml", calibrationOut = "runs/calibration";
+  CLI::App* calibrateCommand = app.add_subcommand("calibrate", "the 32 calibration impacts of thesis 6.2.2.1: logged vs direct force");
+  calibrateCommand->add_option("scenario", calibrationFile, "base scenario (default scenarios/thesis/calibration.toml)");
+  calibrateCommand->add_option("--out", calibrationOut, "folder for calibration.csv");
+
+  AnalyzeOptions analyze;
+  CLI::App* analyzeCommand = app.add_subcommand("analyze", "impact-load statistics and plots of a run or sweep folder");
+  analyzeCommand->add_option("dir", analyze.dir, "run folder or sweep folder")->required();
+  analyzeCommand->add_option("--groups", analyze.groups, "case-name prefixes to analyse, e.g. 121,004,040,400")->delimiter(',');
+  analyzeCommand->add_flag("--quiet", analyze.quiet, "print nothing but errors");
+
+  SweepOptions sweep;
+  CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
+  sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
+  sweepCommand->add_option("--out", sweep.outDir, "sweep folder (default runs/NAME)");
+  sweepCommand->add_option("--jobs", sweep.jobs, "cases run at once (default: all cores)");
+  sweepCommand->add_option("--case-index", sweep.caseIndex, "run only case I (0-based), e.g. in a job array");
+  sweepCommand->add_option("--batch", sweep.batch,
+                           "on a GPU, the most cases run together in one device state (default 0: automatic; 1: one case at a time)")
+      ->check(CLI::NonNegativeNumber);
+  sweepCommand->add_flag("--quiet", sweep.quiet, "no progress");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  try {
+    // GEM_PLUGIN_PATH's plugins, for every command: a scenario, gem bench --broadphase or gem info
+    // may name what they add.
+    loadEnvironmentPlugins();
+    if (*run) return commandRun(args);
+    if (*check) return commandCheck(args);
+    if (*benchCommand) return runBench(bench);
+    if (*sweepCommand) return runSweep(sweep);
+    if (*analyzeCommand) return runAnalyze(analyze);
+    if (*calibrateCommand) return runCalibration(calibrationFile, calibrationOut, false) <= 0.02 ? 0 : 1;
+    return commandInfo(infoPlugins);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "gem: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gem: failed: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,299 @@
+#include "framework/app/runner.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "events/propulsion.hpp"
+#include "framework/output/atomic_file.hpp"
+#include "framework/api/errors.hpp"
+#include "framework/field/ice_file.hpp"
+#include "framework/output/ice_file_writer.hpp"
+#include "framework/step/stepper.hpp"
+#include "framework/output/vtk_writer.hpp"
+
+namespace gem {
+
+namespace {
+
+struct Accumulator {
+  double sum = 0, min = INFINITY, max = -INFINITY;
+  long count = 0;
+  void add(double v) {
+    sum += v, ++count;
+    min = std::min(min, v), max = std::max(max, v);
+  }
+  Stats stats() const { return count ? Stats{min, sum / count, max, count} : Stats{}; }
+};
+
+std::string jsonNumber(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
+
+std::string jsonStats(const Stats& s) {
+  if (s.count == 0) return R"({"min": null, "mean": null, "max": null})";
+  return fmt::format(R"({{"min": {}, "mean": {}, "max": {}}})", jsonNumber(s.min), jsonNumber(s.mean), jsonNumber(s.max));
+}
+
+std::string formatDuration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  return s >= 3600 ? fmt::format("{}h{:02}m", s / 3600, (s / 60) % 60) : fmt::format("{}m{:02}s", s / 60, s % 60);
+}
+
+void writeStateCsv(const std::filesystem::path& file, const World& w) {
+  AtomicFile out(file);
+  out.stream() << "id,kind,x,y,angle,vx,vy,omega,area,thickness,mass,vertices\n";
+  Vec2 v[kMaxVertices];
+  for (int i = 0; i < w.size(); ++i) {
+    const int n = w.worldVertices(i, v);
+    std::string vertices;
+    for (int k = 0; k < n; ++k) vertices += fmt::format("{}{:.9g} {:.9g}", k ? " " : "", v[k].x, v[k].y);
+    out.stream() << fmt::format("{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},\"{}\"\n", w.id[i],
+                                bodyKindName(w.kind[i]), w.x[i], w.y[i], w.angle[i], w.vx[i], w.vy[i], w.omega[i],
+                                w.area[i], w.thickness[i], w.mass[i], vertices);
+  }
+  out.commit();
+}
+
+}  // namespace
+
+std::string summaryJson(const RunSummary& s) {
+  return fmt::format(
+      "{{\n"
+      "  \"gem_version\": \"{}\",\n  \"steps\": {},\n  \"sim_time_s\": {},\n  \"wall_time_s\": {},\n"
+      "  \"real_time_factor\": {},\n  \"backend\": \"{}\",\n  \"broadphase\": \"{}\",\n  \"device\": \"{}\",\n"
+      "  \"floes_initial\": {},\n  \"floes_final\": {},\n  \"floes_broken\": {},\n"
+      "  \"ice_mass_initial_kg\": {},\n  \"ice_mass_final_kg\": {},\n  \"rubble_mass_kg\": {},\n"
+      "  \"cases_on_device\": {},\n  \"impacts\": {},\n  \"ship_speed\": {},\n  \"impact_force_n\": {},\n  \"net_thrust_n\": {},\n"
+      "  \"resistance_mean_n\": {},\n  \"ship_speed_in_ice\": {},\n  \"resistance_in_ice_n\": {}\n}}\n",
+      GEM_VERSION, s.steps, jsonNumber(s.simTime), jsonNumber(s.wallTime),
+      jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY), s.backend, s.broadphase, s.device,
+      s.floesInitial, s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial), jsonNumber(s.iceMassFinal),
+      jsonNumber(s.rubbleMass), s.casesOnDevice, s.impacts, jsonStats(s.shipSpeed), jsonStats(s.impactForce), jsonStats(s.netThrust),
+      s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null", jsonStats(s.shipSpeedInIce),
+      s.netThrustInIce.count ? jsonNumber(s.netThrustInIce.mean) : "null");
+}
+
+namespace {
+
+// One run's outputs, step by step (the observers, MODEL.md 8 phase 7): opened when it starts,
+// a row per step, the summary when it ends, and what it wrote kept if it fails.
+class ScenarioRun {
+ public:
+  // The stepper outlives the run (a case run together with others is stepped to the end even
+  // when its outputs fail).
+  ScenarioRun(const Scenario& scenario, Stepper& stepper)
+      : m_scenario(scenario),
+        m_stepper(&stepper),
+        m_dir(scenario.output.dir),
+        m_timeseries((std::filesystem::create_directories(m_dir), m_dir / "timeseries.csv")),
+        m_impacts(m_dir / "impacts.csv") {
+    Stepper& sim = *m_stepper;
+    m_summary.backend = sim.backend();  // "auto" may have fallen back to the cpu
+    m_summary.broadphase = scenario.broadphase;
+    m_summary.outputDir = scenario.output.dir.string();
+    m_summary.device = sim.device();
+    m_summary.floesInitial = sim.hostWorld().count(BodyKind::Floe);
+    m_summary.iceMassInitial = sim.hostWorld().floeMass();
+    std::filesystem::remove(m_dir / "summary.json");  // a stale summary must not describe this run
+
+    const OutputSpec& out = scenario.output;
+    m_frames = out.frameEvery > 0;
+    auto has = [&](const char* f) { return std::find(out.formats.begin(), out.formats.end(), f) != out.formats.end(); };
+    if (m_frames && has("vtk")) m_vtk = std::make_unique<VtkSeriesWriter>(m_dir);
+    if (m_frames && has("ice")) m_ice = std::make_unique<IceFileWriter>(m_dir / "frames.ice");
+    m_timeseries.stream() << "t,ship_x,ship_y,ship_heading,ship_speed,net_thrust,ice_force_x,contacts\n";
+    m_impacts.stream() << "t,floe_id,floe_mass,thickness,apex_deg,frame_angle_deg,x,y,nx,ny,x_from_stem,y_from_centerline,vn,fn,flim,broke\n";
+    const VesselSpec& vessel = scenario.vessel;
+    m_thrust = Propulsion::Params{vessel.bollardThrust,
+                                  vessel.bollardThrust / (vessel.openWaterSpeed * vessel.openWaterSpeed * vessel.openWaterSpeed)};
+    if (m_frames) writeFrames();
+  }
+
+  // The outputs of step k (0-based), which sim().step() has just run.
+  void record(long k) {
+    Stepper& sim = *m_stepper;
+    const Scenario& scenario = m_scenario;
+    for (const ImpactRecord& r : sim.impacts()) {
+      m_force.add(r.force);
+      m_impacts.stream() << fmt::format("{:.6g},{},{:.9g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{},{}\n",
+                                        r.time, r.floeId, r.floeMass, r.thickness, r.apexDeg, r.frameAngleDeg, r.point.x, r.point.y,
+                                        r.normal.x, r.normal.y, r.xFromStem, r.yFromCenterline, r.closingSpeed, r.force,
+                                        std::isfinite(r.forceLimit) ? fmt::format("{:.9g}", r.forceLimit) : "inf", r.broke ? 1 : 0);
+    }
+    const VesselSample vessel = sim.vessel();
+    const Vec2 forward{std::cos(vessel.heading), std::sin(vessel.heading)};
+    const Real surge = dot(vessel.velocity, forward);
+    if (vessel.present) {
+      m_speed.add(surge);
+      m_netThrust.add(Propulsion::netThrust(m_thrust, surge));
+      // The steady part of the transit (thesis 6.2.1.3): the whole hull inside the field's x range.
+      if (scenario.hasDomain && vessel.position.x - scenario.vessel.length / 2 >= scenario.domain.x0 &&
+          vessel.position.x + scenario.vessel.length / 2 <= scenario.domain.x1) {
+        m_speedInIce.add(surge);
+        m_netThrustInIce.add(Propulsion::netThrust(m_thrust, surge));
+      }
+    }
+    if ((k + 1) % scenario.output.timeseriesEvery == 0) {
+      if (vessel.present)
+        m_timeseries.stream() << fmt::format("{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n", sim.time(), vessel.position.x,
+                                             vessel.position.y, vessel.heading, surge, Propulsion::netThrust(m_thrust, surge),
+                                             sim.vesselIceForce().x, sim.contactCount());
+      else
+        m_timeseries.stream() << fmt::format("{:.6g},,,,,,,{}\n", sim.time(), sim.contactCount());
+    }
+    if (m_frames && (k + 1) % scenario.output.frameEvery == 0) writeFrames();
+  }
+
+  // The run is complete: the last files and summary.json (last of all).
+  RunSummary finish(double wallTime) {
+    Stepper& sim = *m_stepper;
+    m_summary.wallTime = wallTime;
+    m_summary.steps = m_scenario.steps;
+    m_summary.simTime = sim.time();
+    const World& world = sim.hostWorld();
+    m_summary.floesFinal = world.count(BodyKind::Floe);
+    m_summary.iceMassFinal = world.floeMass();
+    m_summary.rubbleMass = sim.rubbleMass();
+    m_summary.floesBroken = sim.floesBroken();
+    m_summary.impacts = m_force.count;
+    m_summary.shipSpeed = m_speed.stats();
+    m_summary.impactForce = m_force.stats();
+    m_summary.netThrust = m_netThrust.stats();
+    m_summary.shipSpeedInIce = m_speedInIce.stats();
+    m_summary.netThrustInIce = m_netThrustInIce.stats();
+    closeFiles();
+    writeStateCsv(m_dir / "state.csv", world);
+    writeFileAtomically(m_dir / "summary.json", summaryJson(m_summary));
+    return m_summary;
+  }
+
+  // The run failed: keep what it produced (whole rows only), but write no summary.json.
+  void abandon() { closeFiles(); }
+
+  RunSummary& summary() { return m_summary; }
+
+ private:
+  void writeFrames() {
+    Stepper& sim = *m_stepper;
+    if (m_vtk) m_vtk->addFrame(sim.hostWorld(), sim.time());
+    if (m_ice) m_ice->addFrame(sim.hostWorld(), sim.time());
+  }
+  void closeFiles() {
+    m_timeseries.commit();
+    m_impacts.commit();
+    if (m_vtk) m_vtk->finish();
+    if (m_ice) m_ice->finish();
+  }
+
+  const Scenario& m_scenario;
+  Stepper* m_stepper;
+  std::filesystem::path m_dir;
+  RunSummary m_summary;
+  bool m_frames = false;
+  std::unique_ptr<VtkSeriesWriter> m_vtk;
+  std::unique_ptr<IceFileWriter> m_ice;
+  AtomicFile m_timeseries, m_impacts;
+  Propulsion::Params m_thrust{};
+  Accumulator m_speed, m_force, m_netThrust, m_speedInIce, m_netThrustInIce;
+};
+
+}  // namespace
+
+RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
+  const std::unique_ptr<Stepper> stepper = makeStepper(scenario);  // bad input throws here, before anything is written
+  ScenarioRun run(scenario, *stepper);
+  Stepper& sim = *stepper;
+  const auto start = std::chrono::steady_clock::now();
+  auto lastProgress = start;
+  try {
+    for (long k = 0; k < scenario.steps; ++k) {
+      sim.step();
+      run.record(k);
+      if (options.progress && !options.quiet) {
+        const auto now = std::chrono::steady_clock::now();
+        if (now - lastProgress > std::chrono::milliseconds(250) || k + 1 == scenario.steps) {
+          lastProgress = now;
+          const double wall = std::chrono::duration<double>(now - start).count();
+          const double rate = (k + 1) / std::max(wall, 1e-9);
+          std::fprintf(stderr, "\r  step %ld/%ld  t = %.1f s  %.0f steps/s  %.0fx real time  ETA %s   ", k + 1,
+                       scenario.steps, static_cast<double>(sim.time()), rate, rate * scenario.dt,
+                       formatDuration((scenario.steps - k - 1) / rate).c_str());
+          std::fflush(stderr);
+        }
+      }
+    }
+  } catch (...) {
+    run.abandon();
+    throw;
+  }
+  if (options.progress && !options.quiet) std::fprintf(stderr, "\n");
+  return run.finish(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+}
+
+std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>& scenarios,
+                                              std::vector<std::unique_ptr<Stepper>> steppers,
+                                              const std::function<void(long step, long steps)>& progress) {
+  if (scenarios.size() != steppers.size() || scenarios.empty())
+    throw std::invalid_argument("runScenariosTogether: one stepper per scenario, one scenario at least");
+  const long steps = scenarios.front()->steps;
+  for (const Scenario* s : scenarios)
+    if (s->steps != steps) throw std::invalid_argument("runScenariosTogether: the scenarios must have the same number of steps");
+  const size_t count = scenarios.size();
+  std::vector<std::string> failures(count);
+  std::vector<std::unique_ptr<ScenarioRun>> runs(count);
+  for (size_t i = 0; i < count; ++i) {
+    try {
+      runs[i] = std::make_unique<ScenarioRun>(*scenarios[i], *steppers[i]);
+    } catch (const std::exception& e) {
+      failures[i] = e.what();
+    }
+  }
+  // A stepper left without its run (its outputs could not be opened) is still stepped: it shares
+  // the others' steps.
+  const auto start = std::chrono::steady_clock::now();
+  long k = 0;
+  try {
+    for (; k < steps; ++k) {
+      // Every case's step k before any case's step k + 1; then each one's outputs.
+      for (size_t i = 0; i < count; ++i) steppers[i]->step();
+      for (size_t i = 0; i < count; ++i) {
+        if (!runs[i] || !failures[i].empty()) continue;
+        try {
+          runs[i]->record(k);
+        } catch (const std::exception& e) {
+          failures[i] = e.what();
+          runs[i]->abandon();
+        }
+      }
+      if (progress) progress(k + 1, steps);
+    }
+  } catch (const std::exception& e) {
+    // The shared device state failed: every case that was still running fails with it.
+    for (size_t i = 0; i < count; ++i) {
+      if (!failures[i].empty()) continue;
+      failures[i] = fmt::format("step {} of cases run together on one device: {}", k, e.what());
+      if (runs[i]) runs[i]->abandon();
+    }
+    return failures;
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (size_t i = 0; i < count; ++i) {
+    if (!runs[i] || !failures[i].empty()) continue;
+    try {
+      runs[i]->summary().casesOnDevice = static_cast<int>(count);
+      runs[i]->finish(wall);
+    } catch (const std::exception& e) {
+      failures[i] = e.what();
+    }
+  }
+  return failures;
+}
+
+}  // namespace gem

@@ -1,0 +1,53 @@
+// Runs a scenario to its end and writes every output of SCENARIO.md into the run folder (the
+// observers, MODEL.md 8 phase 7). Files are written under temporary names and renamed, so a
+// crash leaves only whole files; summary.json is written last, and only after a complete run.
+#pragma once
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/scenario/scenario.hpp"
+#include "framework/step/stepper.hpp"
+
+namespace gem {
+
+struct RunOptions {
+  bool quiet = false;     // no progress line and no closing summary
+  bool progress = false;  // show a progress line (set when stderr is a terminal)
+};
+
+struct Stats {
+  double min = 0, mean = 0, max = 0;
+  long count = 0;
+};
+
+struct RunSummary {
+  long steps = 0;
+  double simTime = 0, wallTime = 0;
+  std::string backend, broadphase, device;
+  int floesInitial = 0, floesFinal = 0;
+  double iceMassInitial = 0, iceMassFinal = 0, rubbleMass = 0;
+  long impacts = 0, floesBroken = 0;
+  Stats shipSpeed, impactForce, netThrust;
+  // Over the steady part of the transit: the whole hull within the domain's x range.
+  Stats shipSpeedInIce, netThrustInIce;
+  std::string outputDir;
+  int casesOnDevice = 1;  // > 1: run together with other cases in one device state (wallTime is theirs together)
+};
+
+RunSummary runScenario(const Scenario& scenario, const RunOptions& options);
+
+// Scenarios whose steppers share one device state (a sweep's batch on a GPU, made by the backend's
+// makeTogether): stepped together, every one's step k before any one's step k + 1, each writing its
+// own outputs exactly as runScenario does (wall_time_s is the batch's). They must have the same
+// number of steps. Returns, per scenario, "" when it completed, else why it failed; a failure of
+// the shared stepping fails every case still running, and each keeps what it wrote.
+// progress(step, steps), when given, is called after each step.
+std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>& scenarios,
+                                              std::vector<std::unique_ptr<Stepper>> steppers,
+                                              const std::function<void(long step, long steps)>& progress = {});
+
+std::string summaryJson(const RunSummary& s);
+
+}  // namespace gem

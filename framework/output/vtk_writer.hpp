@@ -1,0 +1,38 @@
+// ParaView output (SCENARIO.md "Outputs"): one VTK XML PolyData file per frame,
+// runDir/frames/frame_NNNNNN.vtp, and the time series runDir/frames.pvd that lists them.
+// Each body is one polygon cell; points are its world vertices (z = 0). Cell data: id (Int64),
+// kind (Int32: 0 floe, 1 vessel, 2 wall), thickness (m), velocity (m/s, 3 components, z = 0),
+// angular_velocity (rad/s). ASCII, so the files diff and grep; every file is written atomically
+// and frames.pvd is rewritten after each frame, so a run that dies leaves a series that opens.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "framework/world/world.hpp"
+
+namespace gem {
+
+class VtkSeriesWriter {
+ public:
+  // Creates runDir/frames (and runDir) if needed; throws std::runtime_error when it cannot.
+  explicit VtkSeriesWriter(std::filesystem::path runDir);
+
+  // Writes the next frame_NNNNNN.vtp for simulation time `time` (s) and rewrites frames.pvd.
+  void addFrame(const World& world, double time);
+  // The .pvd is already whole after every frame; finish() only refuses later frames.
+  void finish();
+
+  int frameCount() const { return static_cast<int>(m_entries.size()); }
+
+ private:
+  struct Entry {
+    double time;
+    std::string file;  // relative to the run folder, as ParaView resolves it from the .pvd
+  };
+  std::filesystem::path m_runDir;
+  std::vector<Entry> m_entries;
+  bool m_finished = false;
+};
+
+}  // namespace gem

@@ -1,0 +1,315 @@
+#include "framework/scenario/scenario.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/api/table_reader.hpp"
+
+namespace fs = std::filesystem;
+
+namespace gem {
+
+namespace {
+
+// "a.b.c=VALUE": VALUE in TOML syntax (1.5, true, "x", [1, 2]); a bare word is taken as a string.
+void applyOverride(toml::table& root, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError(fmt::format("--set {}: expected KEY=VALUE, e.g. simulation.dt=0.05", assignment));
+  const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("value = " + text);
+  } catch (const toml::parse_error&) {
+    parsed = toml::table{{"value", text}};
+  }
+  toml::table* table = &root;
+  std::stringstream path(key);
+  std::string part;
+  std::vector<std::string> parts;
+  while (std::getline(path, part, '.')) parts.push_back(part);
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    toml::node* next = table->get(parts[i]);
+    if (!next) next = &table->insert_or_assign(parts[i], toml::table{}).first->second;
+    if (!next->is_table())
+      throw InputError(fmt::format("--set {}: {} is not a table", assignment, parts[i]));
+    table = next->as_table();
+  }
+  table->insert_or_assign(parts.back(), *parsed.get("value"));
+}
+
+Domain readDomain(TableReader& t, const Scenario& s) {
+  Domain d = s.domain;
+  if (auto x = t.findReals("x")) {
+    if (x->size() != 2 || !((*x)[0] < (*x)[1])) t.fail("x", "expected [x0, x1] with x0 < x1");
+    d.x0 = (*x)[0], d.x1 = (*x)[1];
+  }
+  if (auto y = t.findReals("y")) {
+    if (y->size() != 2 || !((*y)[0] < (*y)[1])) t.fail("y", "expected [y0, y1] with y0 < y1");
+    d.y0 = (*y)[0], d.y1 = (*y)[1];
+  }
+  return d;
+}
+
+void readField(TableReader& t, Scenario& s) {
+  s.fieldKind = t.getChoice("kind", "random_convex", {"random_convex", "hexagons", "file"});
+  if (s.fieldKind == "file") {
+    const std::string file = t.getString("file", "");
+    if (file.empty()) t.fail("file", "kind = \"file\" needs file = \"path/to/field.ice\"");
+    s.fieldFile = fs::path(file).is_absolute() ? fs::path(file) : s.file.parent_path() / file;
+    t.finish();
+    return;
+  }
+  const Real concentration = t.getPositive("concentration", s.fieldKind == "hexagons" ? Real(0.46) : Real(0.4));
+  const Real thickness = t.getPositive("thickness", Real(0.7));
+  const Real minGap = t.getNonNegative("min_gap", Real(0.05));
+  if (s.fieldKind == "hexagons") {
+    HexagonFieldSpec& h = s.hexagonField;
+    h.domain = s.domain;
+    h.concentration = concentration;
+    h.thickness = thickness;
+    h.minGap = minGap;
+    h.size = t.getPositive("size", Real(10.1));
+    h.rotationJitterDeg = t.getNonNegative("rotation_jitter_deg", 3);
+    h.seed = s.seed;
+  } else {
+    RandomFieldSpec& r = s.randomField;
+    r.domain = s.domain;
+    r.concentration = concentration;
+    r.thickness = thickness;
+    r.minGap = minGap;
+    r.count = static_cast<int>(t.getInt("count", 0, 0, 100000000));
+    r.sizeMean = t.getPositive("size_mean", r.sizeMean);
+    r.sizeSd = t.getNonNegative("size_sd", r.sizeSd);
+    r.sizeMin = t.getPositive("size_min", r.sizeMin);
+    r.sizeMax = t.getPositive("size_max", r.sizeMax);
+    r.minSides = static_cast<int>(t.getInt("min_sides", r.minSides, 3, kMaxFloeVertices));
+    r.maxSides = static_cast<int>(t.getInt("max_sides", r.maxSides, 3, kMaxFloeVertices));
+    r.maxAspect = t.getPositive("max_aspect", r.maxAspect);
+    r.seed = s.seed;
+    if (const toml::array* groups = t.findArray("groups")) {
+      for (size_t g = 0; g < groups->size(); ++g) {
+        const toml::table* gt = groups->get(g)->as_table();
+        if (!gt) t.failAt(*groups->get(g), "field.groups: expected tables { coverage = ..., thickness = ... }");
+        TableReader gr(gt, fmt::format("field.groups[{}]", g), s.fileName);
+        ThicknessGroup group{gr.getPositive("coverage", 0), gr.getPositive("thickness", 0)};
+        if (!gr.has("coverage") || !gr.has("thickness")) gr.fail("coverage", "each group needs coverage and thickness");
+        gr.finish();
+        r.groups.push_back(group);
+      }
+    }
+  }
+  t.finish();
+}
+
+void readFloes(const toml::array& floes, TableReader& parent, Scenario& s) {
+  for (size_t k = 0; k < floes.size(); ++k) {
+    const toml::table* ft = floes.get(k)->as_table();
+    if (!ft) parent.failAt(*floes.get(k), "floes: expected [[floes]] tables");
+    TableReader t(ft, fmt::format("floes[{}]", k), s.fileName);
+    BodySpec spec;
+    spec.kind = BodyKind::Floe;
+    auto vertices = t.findPoints("vertices");
+    if (!vertices) t.fail("vertices", "each floe needs vertices = [[x, y], ...]");
+    spec.vertices = *vertices;
+    spec.thickness = t.getReal("thickness", Real(0.7));
+    spec.velocity = t.findVec2("velocity").value_or(Vec2{0, 0});
+    spec.angularVelocity = t.getReal("angular_velocity", 0);
+    const auto& src = ft->source();
+    spec.origin = fmt::format("{}:{}:{}: floes[{}]", s.fileName, src.begin.line, src.begin.column, k);
+    t.finish();
+    s.floes.push_back(std::move(spec));
+  }
+}
+
+// Open-water speed for a bollard thrust when the scenario gives none: the thesis's pairs (issue 2;
+// thesis 6.2.1: 23 kN 1.4 m/s ... 740 kN 6.5 m/s), interpolated linearly in log T - log V, so
+// that --set vessel.bollard_thrust=92e3 alone gives the thesis's 2.6 m/s.
+Real openWaterSpeedFor(Real bollardThrust) {
+  static const Real table[][2] = {{23e3, 1.4}, {46e3, 1.9}, {92e3, 2.6}, {181.5e3, 3.6}, {370e3, 4.9}, {740e3, 6.5}};
+  constexpr int n = 6;
+  const Real t = std::max<Real>(bollardThrust, 1);
+  int k = 0;
+  while (k < n - 2 && t > table[k + 1][0]) ++k;
+  const Real f = std::log(t / table[k][0]) / std::log(table[k + 1][0] / table[k][0]);
+  return table[k][1] * std::exp(f * std::log(table[k + 1][1] / table[k][1]));
+}
+
+void readVessel(TableReader& t, Scenario& s) {
+  VesselSpec& v = s.vessel;
+  v.present = true;
+  v.length = t.getPositive("length", v.length);
+  v.beam = t.getPositive("beam", v.beam);
+  v.mass = t.getPositive("mass", v.mass);
+  v.draft = t.getPositive("draft", v.draft);
+  v.position = t.findVec2("position").value_or(v.position);
+  v.headingDeg = t.getReal("heading_deg", 0);
+  v.dof = static_cast<int>(t.getInt("dof", 1, 1, 3));
+  if (v.dof == 2) t.fail("dof", "must be 1 (surge) or 3 (surge, sway, yaw)");
+  v.bollardThrust = t.getNonNegative("bollard_thrust", v.bollardThrust);
+  v.openWaterSpeed = t.getPositive("open_water_speed", openWaterSpeedFor(v.bollardThrust));
+  v.speed = t.getNonNegative("speed", v.openWaterSpeed);  // MODEL.md 7: starts at V_ow
+  auto hull = t.findPoints("vertices");
+  auto frames = t.findReals("frame_angle_deg");
+  if (hull) {
+    if (!frames) t.fail("vertices", "a hull given by vertices also needs frame_angle_deg (one per edge)");
+    if (frames->size() != hull->size())
+      t.fail("frame_angle_deg", fmt::format("needs one angle per hull edge: {} vertices, {} angles", hull->size(), frames->size()));
+    for (Real b : *frames)
+      if (b < 0 || b >= 90) t.fail("frame_angle_deg", fmt::format("angles must be in [0, 90) degrees, got {}", b));
+    v.hull = *hull;
+    v.frameAnglesDeg = *frames;
+  } else if (frames) {
+    t.fail("frame_angle_deg", "only with vertices = [...] (the default hull has its own)");
+  }
+  t.finish();
+}
+
+void readOutput(TableReader& t, Scenario& s) {
+  OutputSpec& o = s.output;
+  const std::string dir = t.getString("dir", "");
+  if (!dir.empty()) o.dir = fs::path(dir).is_absolute() ? fs::path(dir) : s.file.parent_path() / dir;
+  o.frameEvery = static_cast<int>(t.getInt("frame_every", o.frameEvery, 0, 1000000000));
+  o.timeseriesEvery = static_cast<int>(t.getInt("timeseries_every", o.timeseriesEvery, 1, 1000000000));
+  if (const toml::array* formats = t.findArray("formats")) {
+    o.formats.clear();
+    for (const toml::node& f : *formats) {
+      auto name = f.value_exact<std::string>();
+      if (!name || (*name != "vtk" && *name != "ice")) t.failAt(f, "output.formats: valid formats are \"vtk\" and \"ice\"");
+      o.formats.push_back(*name);
+    }
+  }
+  t.finish();
+}
+
+// [[plugins]]: path (relative to the scenario's folder) and override. Each is required from the
+// registry's plugin loader now (its names are then valid below); the
+// loader's message (what differs, which symbol is missing, which names clash) gets this entry's
+// file:line:column. The path is written back absolute, so a copy of root (a sweep case's
+// scenario.toml) still finds it.
+void readPlugins(const toml::array& plugins, TableReader& top, Scenario& s) {
+  for (const toml::node& p : plugins) {
+    const toml::table* pt = p.as_table();
+    if (!pt) top.failAt(p, "plugins: expected [[plugins]] tables");
+    TableReader t(pt, "plugins", s.fileName);
+    PluginSpec spec;
+    if (!t.has("path")) t.failAt(p, "plugins: each [[plugins]] needs a path = \"...\" (to the plugin's .so)");
+    spec.path = t.getString("path", "");
+    spec.override = t.getBool("override", false);
+    t.finish();
+    if (spec.path.is_relative()) spec.path = s.file.parent_path() / spec.path;
+    spec.path = spec.path.lexically_normal();
+    try {
+      requirePluginLibrary(spec.path, spec.override);
+    } catch (const InputError& e) {
+      t.fail("path", e.what());
+    }
+    const_cast<toml::table*>(pt)->insert_or_assign("path", spec.path.string());
+    s.plugins.push_back(spec);
+  }
+}
+
+}  // namespace
+
+const toml::table* Scenario::eventTable(const std::string& name) const {
+  const toml::table* events = root["events"].as_table();
+  return events ? (*events)[name].as_table() : nullptr;
+}
+
+Scenario loadScenario(const fs::path& file, const std::vector<std::string>& overrides) {
+  Scenario s;
+  s.fileName = file.string();
+  if (!fs::exists(file)) throw InputError(fmt::format("{}: no such scenario file", s.fileName));
+  s.file = fs::absolute(file);
+  try {
+    s.root = toml::parse_file(s.file.string());
+  } catch (const toml::parse_error& e) {
+    throw InputError(s.fileName, static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
+                     std::string(e.description()));
+  }
+  for (const std::string& o : overrides) applyOverride(s.root, o);
+
+  TableReader top(&s.root, "", s.fileName);
+  // Plugins first: their events and broadphases are valid names in the sections below.
+  requireEnvironmentPluginLibraries();
+  if (const toml::array* plugins = top.findArray("plugins")) readPlugins(*plugins, top, s);
+  {
+    TableReader t(top.findTable("simulation"), "simulation", s.fileName);
+    s.dt = t.getPositive("dt", s.dt);
+    const bool hasSteps = t.has("steps");
+    s.duration = t.getPositive("duration", s.duration);
+    const std::int64_t steps = t.getInt("steps", 0, 1, 2000000000);
+    if (hasSteps && t.has("duration")) t.fail("steps", "give either duration or steps, not both");
+    s.steps = hasSteps ? static_cast<long>(steps) : static_cast<long>(std::llround(s.duration / s.dt));
+    if (hasSteps) s.duration = static_cast<Real>(s.steps) * s.dt;
+    s.backend = t.getChoice("backend", "auto", {"auto", "cpu", "cuda"});
+    s.broadphase = t.getString("broadphase", s.broadphase);
+    try {
+      Registry::global().broadphase(s.broadphase);  // unknown name: lists the valid ones
+    } catch (const InputError& e) {
+      t.fail("broadphase", e.what());
+    }
+    s.seed = static_cast<std::uint64_t>(t.getInt("seed", 1, 0, INT64_MAX));
+    s.broadphaseSettings.skin = t.getPositive("skin", s.broadphaseSettings.skin);
+    s.broadphaseSettings.fixedRadius = t.getNonNegative("fixed_radius", 0);
+    s.broadphaseSettings.cellSize = t.getNonNegative("cell_size", 0);
+    s.mortonSort = t.getBool("morton_sort", true);
+    s.copyBackEvery = static_cast<int>(t.getInt("copy_back_every", s.copyBackEvery, 1, 100000));
+    s.cudaBlockSize = static_cast<int>(t.getInt("cuda_block_size", s.cudaBlockSize, 32, 1024));
+    if (s.cudaBlockSize % 32 != 0) t.fail("cuda_block_size", "must be a multiple of 32 (a whole number of warps)");
+    t.finish();
+  }
+  if (const toml::table* d = top.findTable("domain")) {
+    TableReader t(d, "domain", s.fileName);
+    s.hasDomain = true;
+    s.domain = readDomain(t, s);
+    s.walls = t.getBool("walls", false);
+    s.wallThickness = t.getPositive("wall_thickness", s.wallThickness);
+    t.finish();
+  }
+  if (const toml::table* v = top.findTable("vessel")) {
+    TableReader t(v, "vessel", s.fileName);
+    readVessel(t, s);
+  }
+  if (const toml::table* f = top.findTable("field")) {
+    TableReader t(f, "field", s.fileName);
+    readField(t, s);
+  }
+  if (const toml::array* floes = top.findArray("floes")) readFloes(*floes, top, s);
+  if (const toml::table* events = top.findTable("events")) {
+    for (const auto& [key, node] : *events) {
+      const std::string name(key.str());
+      if (!Registry::global().findEvent(name))
+        top.failAt(node, fmt::format("events.{}: unknown event (valid: {})", name, fmt::join(Registry::global().eventNames(), ", ")));
+      const toml::table* table = node.as_table();
+      if (!table) top.failAt(node, fmt::format("events.{}: expected a table [events.{}]", name, name));
+      bool enabled = true;
+      if (const toml::node* e = table->get("enabled")) {
+        auto b = e->value_exact<bool>();
+        if (!b) top.failAt(*e, fmt::format("events.{}.enabled: expected true or false", name));
+        enabled = *b;
+      }
+      s.events[name] = Scenario::EventSetting{enabled};
+    }
+  }
+  {
+    s.output.dir = fs::current_path() / "runs" / s.file.stem();
+    TableReader t(top.findTable("output"), "output", s.fileName);
+    readOutput(t, s);
+  }
+  top.finish();
+
+  if (s.fieldKind != "none" && s.fieldKind != "file" && !s.hasDomain)
+    throw InputError(fmt::format("{}: a generated [field] needs a [domain] with x = [x0, x1] and y = [y0, y1]", s.fileName));
+  // The field was read before [domain] may have been: bind the generators to the final domain.
+  s.randomField.domain = s.domain;
+  s.hexagonField.domain = s.domain;
+  return s;
+}
+
+}  // namespace gem

@@ -1,0 +1,88 @@
+// A scenario: everything one run needs, read from a TOML file (SCENARIO.md) with --set overrides.
+// Loading validates every key, type and range; errors are InputError with file:line:column.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "framework/api/broadphase.hpp"
+#include "framework/field/field_generator.hpp"
+#include "framework/world/vessel.hpp"
+#include "framework/world/world.hpp"
+
+namespace gem {
+
+struct OutputSpec {
+  std::filesystem::path dir;  // absolute
+  int frameEvery = 10;        // steps between frames; 0 = no frames
+  int timeseriesEvery = 1;    // steps between time-series rows
+  std::vector<std::string> formats{"vtk", "ice"};
+};
+
+struct PluginSpec {
+  std::filesystem::path path;
+  bool override = false;
+};
+
+struct Scenario {
+  std::filesystem::path file;  // the scenario file (absolute)
+  std::string fileName;        // as given, for messages
+  toml::table root;            // the parsed document, overrides applied
+
+  // [simulation]
+  Real dt = Real(0.1);
+  Real duration = 600;
+  long steps = 0;  // total steps (from duration / dt, or simulation.steps)
+  std::string backend = "auto";
+  std::string broadphase = "variable_radius";
+  BroadphaseSettings broadphaseSettings;
+  std::uint64_t seed = 1;
+  bool mortonSort = true;  // re-sort bodies along a space-filling curve at each list rebuild
+  // CUDA backend only (thesis 5.7): steps run on the device between two copies of results to the
+  // host (frames, re-sorts, breaks and the run's end still come exactly on time), and the threads
+  // per block of the per-body and per-contact kernels.
+  int copyBackEvery = 16;
+  int cudaBlockSize = 128;
+
+  // [domain]
+  bool hasDomain = false;
+  Domain domain{0, 500, -100, 100};
+  bool walls = false;
+  Real wallThickness = 5;  // m: the wall polygons' width outside the domain
+
+  // [field] and [[floes]]
+  std::string fieldKind = "none";  // none | random_convex | hexagons | file
+  RandomFieldSpec randomField;
+  HexagonFieldSpec hexagonField;
+  std::filesystem::path fieldFile;
+  std::vector<BodySpec> floes;  // explicit [[floes]]
+
+  VesselSpec vessel;
+
+  // [events.NAME] given in the scenario: its enabled flag. Its table is looked up in root by
+  // eventTable(), never stored as a pointer, so a copied Scenario stays self-contained.
+  struct EventSetting {
+    bool enabled;
+  };
+  std::map<std::string, EventSetting> events;
+
+  std::vector<PluginSpec> plugins;
+  OutputSpec output;
+
+  // The [events.NAME] table of this scenario's root, or null when absent.
+  const toml::table* eventTable(const std::string& name) const;
+};
+
+// Reads and validates a scenario. overrides are "dotted.key=VALUE" (VALUE in TOML syntax; a bare
+// word is taken as a string). outDir, when not empty, replaces output.dir.
+Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
+
+// The thesis's open-water speed for a bollard thrust (interpolated in log-log), m/s.
+Real openWaterSpeedFor(Real bollardThrust);
+
+}  // namespace gem

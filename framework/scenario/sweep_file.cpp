@@ -1,0 +1,261 @@
+#include "framework/scenario/sweep_file.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "framework/api/errors.hpp"
+#include "framework/api/table_reader.hpp"
+
+namespace fs = std::filesystem;
+
+namespace gem {
+
+namespace {
+
+// A leaf of a set table or of [parameters]: the dotted key and its node in the sweep document.
+struct Leaf {
+  std::string key;
+  const toml::node* node;
+};
+
+void flatten(const toml::table& table, const std::string& prefix, std::vector<Leaf>& out) {
+  for (const auto& [k, v] : table) {
+    const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    if (const toml::table* sub = v.as_table()) flatten(*sub, key, out);
+    else out.push_back({key, &v});
+  }
+}
+
+// toml::table is ordered by key; the user's order (file order) is the source position.
+std::vector<Leaf> leaves(const toml::table& table, const TableReader& reader) {
+  std::vector<Leaf> out;
+  flatten(table, "", out);
+  std::stable_sort(out.begin(), out.end(), [](const Leaf& a, const Leaf& b) {
+    const auto &sa = a.node->source().begin, &sb = b.node->source().begin;
+    return sa.line != sb.line ? sa.line < sb.line : sa.column < sb.column;
+  });
+  for (size_t i = 0; i < out.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (out[i].key == out[j].key) reader.failAt(*out[i].node, fmt::format("{}: key \"{}\" given twice", reader.path(), out[i].key));
+  return out;
+}
+
+void makeInline(toml::node& node) {
+  if (toml::table* t = node.as_table()) {
+    t->is_inline(true);
+    for (auto&& [k, v] : *t) makeInline(v);
+  } else if (toml::array* a = node.as_array()) {
+    for (toml::node& e : *a) makeInline(e);
+  }
+}
+
+// The value in TOML syntax, one line, as loadScenario's overrides read it (floats round-trip exactly).
+std::string tomlText(const toml::node& value) {
+  toml::table wrapper;
+  wrapper.insert("value", value);
+  makeInline(*wrapper.get("value"));
+  std::ostringstream out;
+  out << toml::toml_formatter{wrapper};
+  const std::string text = out.str();
+  const std::string prefix = "value = ";
+  return text.rfind(prefix, 0) == 0 ? text.substr(prefix.size()) : text;
+}
+
+bool isScalar(const toml::node& v) { return !v.is_table() && !v.is_array(); }
+
+// For names and cells: shortest round-trip numbers, bare strings.
+std::string plainText(const toml::node& v) {
+  if (auto d = v.value_exact<double>()) return fmt::format("{}", *d);
+  if (auto i = v.value_exact<std::int64_t>()) return fmt::format("{}", *i);
+  if (auto b = v.value_exact<bool>()) return *b ? "true" : "false";
+  if (auto s = v.value_exact<std::string>()) return *s;
+  return tomlText(v);
+}
+
+std::string sanitize(const std::string& text) {
+  std::string out = text;
+  for (char& c : out)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-' && c != '+') c = '_';
+  return out;
+}
+
+bool validName(const std::string& name) {
+  if (name.empty() || name.size() > 200 || name[0] == '.' || name[0] == '-') return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || std::string_view("._-+=,@#").find(c) != std::string_view::npos;
+  });
+}
+
+SweepOverride makeOverride(const Leaf& leaf, bool varied) {
+  const auto& src = leaf.node->source().begin;
+  return SweepOverride{leaf.key, tomlText(*leaf.node), plainText(*leaf.node), varied, static_cast<int>(src.line),
+                       static_cast<int>(src.column)};
+}
+
+fs::path resolveBase(TableReader& reader, const std::string& key, const std::string& text, const fs::path& folder) {
+  if (text.empty()) reader.fail(key, "expected the path of a scenario file");
+  const fs::path path = fs::path(text).is_absolute() ? fs::path(text) : folder / text;
+  if (!fs::is_regular_file(path)) reader.fail(key, fmt::format("no such scenario file: {}", path.string()));
+  return fs::absolute(path).lexically_normal();
+}
+
+// One combination of [parameters]: its overrides and its name.
+struct Combination {
+  std::vector<SweepOverride> overrides;
+  std::string name;
+};
+
+std::vector<Combination> expandParameters(const std::vector<Leaf>& parameters, const TableReader& reader) {
+  std::vector<Combination> out;
+  if (parameters.empty()) return {Combination{}};
+  std::vector<const toml::array*> lists;
+  std::vector<std::string> shortKeys;
+  for (const Leaf& p : parameters) {
+    const toml::array* list = p.node->as_array();
+    if (!list) reader.failAt(*p.node, fmt::format("parameters.{}: expected a list of values, e.g. [1.0, 2.0]", p.key));
+    if (list->empty()) reader.failAt(*p.node, fmt::format("parameters.{}: the list of values is empty", p.key));
+    lists.push_back(list);
+    shortKeys.push_back(p.key.substr(p.key.rfind('.') == std::string::npos ? 0 : p.key.rfind('.') + 1));
+  }
+  std::vector<std::string> names = shortKeys;
+  for (size_t i = 0; i < shortKeys.size(); ++i)
+    if (std::count(shortKeys.begin(), shortKeys.end(), shortKeys[i]) > 1) names[i] = parameters[i].key;
+  shortKeys = names;
+  // An odometer: the last parameter turns fastest.
+  std::vector<size_t> index(parameters.size(), 0);
+  while (true) {
+    Combination c;
+    for (size_t i = 0; i < parameters.size(); ++i) {
+      const toml::node& value = *lists[i]->get(index[i]);
+      c.overrides.push_back(makeOverride({parameters[i].key, &value}, true));
+      const std::string part = isScalar(value) ? sanitize(shortKeys[i]) + "=" + sanitize(plainText(value))
+                                               : sanitize(shortKeys[i]) + "#" + std::to_string(index[i]);
+      c.name += (i ? "," : "") + part;
+    }
+    out.push_back(std::move(c));
+    size_t k = parameters.size();
+    while (k > 0 && ++index[k - 1] == lists[k - 1]->size()) index[--k] = 0;
+    if (k == 0) break;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string sweepCell(const SweepCase& c, const std::string& key) {
+  for (const SweepOverride& o : c.overrides)
+    if (o.varied && o.key == key) return o.text;
+  return "";
+}
+
+SweepDefinition readSweepFile(const fs::path& file) {
+  SweepDefinition def;
+  def.fileName = file.string();
+  if (!fs::is_regular_file(file)) throw InputError(fmt::format("{}: no such sweep file", def.fileName));
+  def.file = fs::absolute(file).lexically_normal();
+  const fs::path folder = def.file.parent_path();
+  toml::table root;
+  try {
+    root = toml::parse_file(def.file.string());
+  } catch (const toml::parse_error& e) {
+    throw InputError(def.fileName, static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
+                     std::string(e.description()));
+  }
+
+  TableReader top(&root, "", def.fileName);
+  TableReader sweep(top.findTable("sweep"), "sweep", def.fileName);
+  def.name = sweep.getString("name", def.file.stem().string());
+  if (!validName(def.name)) sweep.fail("name", "a sweep name may hold letters, digits and . _ - + = , @ # (it names a folder)");
+  fs::path base;
+  sweep.accept("base");
+  if (sweep.has("base")) base = resolveBase(sweep, "base", sweep.getString("base", ""), folder);
+  std::vector<SweepOverride> common;
+  if (const toml::table* set = sweep.findTable("set")) {
+    TableReader reader(set, "sweep.set", def.fileName);
+    for (const Leaf& leaf : leaves(*set, reader)) common.push_back(makeOverride(leaf, false));
+  }
+  sweep.finish();
+
+  std::vector<Leaf> parameters;
+  const toml::table* parameterTable = top.findTable("parameters");
+  TableReader parameterReader(parameterTable, "parameters", def.fileName);
+  if (parameterTable) parameters = leaves(*parameterTable, parameterReader);
+  if (parameterTable && parameters.empty())
+    throw InputError(def.fileName, static_cast<int>(parameterTable->source().begin.line),
+                     static_cast<int>(parameterTable->source().begin.column), "parameters: no parameter to vary");
+  const std::vector<Combination> combinations = expandParameters(parameters, parameterReader);
+  for (const Leaf& p : parameters) def.columns.push_back(p.key);
+
+  // The [[cases]] entries, or one anonymous entry standing for the plain product.
+  struct Entry {
+    std::string name;
+    fs::path base;
+    std::vector<SweepOverride> set;
+    int line = 0, column = 0;
+  };
+  std::vector<Entry> entries;
+  const toml::array* cases = top.findArray("cases");
+  top.finish();
+  if (cases) {
+    if (cases->empty()) top.fail("cases", "the list of cases is empty");
+    for (size_t k = 0; k < cases->size(); ++k) {
+      const toml::table* t = cases->get(k)->as_table();
+      if (!t) top.failAt(*cases->get(k), "cases: expected [[cases]] tables with name = \"...\" and set = { ... }");
+      TableReader reader(t, fmt::format("cases[{}]", k), def.fileName);
+      Entry e;
+      e.line = static_cast<int>(t->source().begin.line), e.column = static_cast<int>(t->source().begin.column);
+      if (!reader.has("name")) reader.fail("name", "each case needs a name = \"...\"");
+      e.name = reader.getString("name", "");
+      if (!validName(e.name)) reader.fail("name", "a case name may hold letters, digits and . _ - + = , @ # (it names a folder)");
+      reader.accept("base");
+      e.base = reader.has("base") ? resolveBase(reader, "base", reader.getString("base", ""), folder) : base;
+      if (e.base.empty()) reader.fail("name", "no base scenario: give base = \"...\" here or in [sweep]");
+      if (const toml::table* set = reader.findTable("set")) {
+        TableReader setReader(set, reader.keyPath("set"), def.fileName);
+        for (const Leaf& leaf : leaves(*set, setReader)) {
+          for (const Leaf& p : parameters)
+            if (p.key == leaf.key)
+              setReader.failAt(*leaf.node, fmt::format("{}: \"{}\" is also varied by [parameters]", setReader.path(), leaf.key));
+          e.set.push_back(makeOverride(leaf, true));
+          if (std::find(def.columns.begin(), def.columns.end(), leaf.key) == def.columns.end()) def.columns.push_back(leaf.key);
+        }
+      }
+      reader.finish();
+      entries.push_back(std::move(e));
+    }
+  } else {
+    if (!parameterTable) throw InputError(def.fileName, 0, 0, "a sweep needs [parameters] (lists to combine) or [[cases]], or both");
+    if (base.empty()) sweep.fail("base", "missing: the base scenario, relative to the sweep file");
+    Entry e;
+    e.base = base;
+    e.line = static_cast<int>(parameterTable->source().begin.line);
+    e.column = static_cast<int>(parameterTable->source().begin.column);
+    entries.push_back(std::move(e));
+  }
+
+  std::map<std::string, size_t> seen;
+  for (const Entry& e : entries) {
+    for (const Combination& c : combinations) {
+      SweepCase sc;
+      sc.name = e.name.empty() ? c.name : c.name.empty() ? e.name : e.name + "," + c.name;
+      sc.base = e.base;
+      sc.line = e.line, sc.column = e.column;
+      sc.overrides = common;
+      sc.overrides.insert(sc.overrides.end(), e.set.begin(), e.set.end());
+      sc.overrides.insert(sc.overrides.end(), c.overrides.begin(), c.overrides.end());
+      if (auto [it, inserted] = seen.emplace(sc.name, def.cases.size()); !inserted)
+        throw InputError(def.fileName, sc.line, sc.column,
+                         fmt::format("two cases are named \"{}\" (cases {} and {}): case names must differ", sc.name, it->second,
+                                     def.cases.size()));
+      def.cases.push_back(std::move(sc));
+    }
+  }
+  return def;
+}
+
+}  // namespace gem

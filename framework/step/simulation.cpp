@@ -1,0 +1,327 @@
+#include "framework/step/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
+#include "framework/field/ice_file.hpp"
+#include "framework/api/log_channel.hpp"
+#include "framework/api/table_reader.hpp"
+#include "framework/world/vessel.hpp"
+#include "geometry/contact.hpp"
+
+namespace gem {
+
+void validateBodySpec(BodySpec& spec, int maxVertices) {
+  const int n = static_cast<int>(spec.vertices.size());
+  if (n < 3 || n > maxVertices)
+    throw InputError(fmt::format("{}: a {} needs 3 to {} vertices, got {}", spec.origin, bodyKindName(spec.kind), maxVertices, n));
+  for (const Vec2& v : spec.vertices)
+    if (!std::isfinite(v.x) || !std::isfinite(v.y))
+      throw InputError(fmt::format("{}: vertex coordinates must be finite numbers", spec.origin));
+  if (!std::isfinite(spec.velocity.x) || !std::isfinite(spec.velocity.y) || !std::isfinite(spec.angularVelocity))
+    throw InputError(fmt::format("{}: velocity must be finite", spec.origin));
+  if (!(spec.thickness > 0) || !std::isfinite(spec.thickness))
+    throw InputError(fmt::format("{}: thickness must be a positive number, got {}", spec.origin, spec.thickness));
+  if (signedArea(spec.vertices.data(), n) < 0) reverseOrder(spec.vertices.data(), n);  // MODEL.md 1
+  if (!isStrictlyConvexCCW(spec.vertices.data(), n, Real(1e-9)))
+    throw InputError(fmt::format("{}: the polygon is not convex (or is self-intersecting or has repeated or collinear vertices)", spec.origin));
+}
+
+// Static walls along the long sides of the domain (SCENARIO.md [domain] walls): the channel. They
+// reach past both ends so that a vessel starting before the field is already between them.
+static void addWalls(const Scenario& s, std::vector<BodySpec>& bodies) {
+  const Real margin = std::max<Real>(2 * s.vessel.length, 50);
+  const Real x0 = s.domain.x0 - margin, x1 = s.domain.x1 + margin;
+  const Real t = s.wallThickness;
+  for (int side = 0; side < 2; ++side) {
+    const Real inner = side == 0 ? s.domain.y0 : s.domain.y1;
+    const Real outer = side == 0 ? inner - t : inner + t;
+    BodySpec wall;
+    wall.kind = BodyKind::Wall;
+    wall.thickness = 10;
+    wall.origin = side == 0 ? "domain wall (y0)" : "domain wall (y1)";
+    wall.vertices = {{x0, std::min(inner, outer)}, {x1, std::min(inner, outer)}, {x1, std::max(inner, outer)}, {x0, std::max(inner, outer)}};
+    bodies.push_back(wall);
+  }
+}
+
+// The generators report bad specs by key; this adds where the [field] table is.
+static std::vector<BodySpec> generateField(const Scenario& s) {
+  try {
+    if (s.fieldKind == "random_convex") return generateRandomConvexField(s.randomField);
+    return generateHexagonField(s.hexagonField);
+  } catch (const InputError& e) {
+    const toml::node* field = s.root.get("field");
+    const auto line = field ? field->source().begin.line : 0, column = field ? field->source().begin.column : 0;
+    throw InputError(s.fileName, static_cast<int>(line), static_cast<int>(column), e.what());
+  }
+}
+
+World buildWorld(const Scenario& s) {
+  std::vector<BodySpec> bodies;
+  if (s.walls) addWalls(s, bodies);
+  if (s.fieldKind == "random_convex" || s.fieldKind == "hexagons") {
+    auto field = generateField(s);
+    bodies.insert(bodies.end(), field.begin(), field.end());
+  } else if (s.fieldKind == "file") {
+    auto field = readIceInitialBodies(s.fieldFile);
+    bodies.insert(bodies.end(), field.begin(), field.end());
+  }
+  bodies.insert(bodies.end(), s.floes.begin(), s.floes.end());
+
+  World world;
+  std::vector<std::string> origins;
+  for (BodySpec& spec : bodies) {
+    if (spec.kind == BodyKind::Vessel) continue;  // a vessel comes from [vessel]
+    validateBodySpec(spec, spec.kind == BodyKind::Floe ? kMaxFloeVertices : kMaxVertices);
+    world.addBody(spec);
+    origins.push_back(spec.origin);
+  }
+  if (s.vessel.present) {
+    HullGeometry hull = hullGeometry(s.vessel);
+    BodySpec check;
+    check.kind = BodyKind::Vessel;
+    check.origin = "vessel hull";
+    check.vertices = hull.vertices;
+    check.thickness = s.vessel.draft;
+    validateBodySpec(check, kMaxVertices);
+    addVessel(world, s.vessel);
+    origins.push_back("vessel");
+  }
+
+  // Bodies never start in contact (MODEL.md 1): any conservative broadphase + the exact contact.
+  auto broadphase = Registry::global().broadphase("variable_radius").make(BroadphaseSettings{0, 0, 0});
+  std::vector<CandidatePair> pairs;
+  broadphase->findCandidates(world, pairs);
+  Vec2 p[kMaxVertices], q[kMaxVertices];
+  for (const CandidatePair& pair : pairs) {
+    if (world.invMass[pair.a] == 0 && world.invMass[pair.b] == 0) continue;
+    const int n = world.worldVertices(pair.a, p), m = world.worldVertices(pair.b, q);
+    const Contact c = computeContact(p, n, world.position(pair.a), q, m, world.position(pair.b));
+    if (c.touching)
+      throw InputError(fmt::format("{}: bodies overlap at the start: {} (id {}) and {} (id {}), overlap area {:.4g} m^2",
+                                   s.fileName, origins[pair.a], world.id[pair.a], origins[pair.b], world.id[pair.b], c.area));
+  }
+  return world;
+}
+
+Simulation::Simulation(const Scenario& scenario) : Simulation(scenario, buildWorld(scenario)) {}
+
+Simulation::Simulation(const Scenario& scenario, World world) : m_scenario(scenario), m_world(std::move(world)) {
+  setUp();
+}
+
+void Simulation::setUp() {
+  m_broadphase = Registry::global().broadphase(m_scenario.broadphase).make(m_scenario.broadphaseSettings);
+  for (const EventEntry* entry : Registry::global().events()) {
+    auto it = m_scenario.events.find(entry->name);
+    const toml::table* table = m_scenario.eventTable(entry->name);
+    const bool enabled = it == m_scenario.events.end() ? entry->enabledByDefault : it->second.enabled;
+    TableReader reader(table, "events." + entry->name, m_scenario.fileName);
+    reader.accept("enabled");
+    EventConfig config{reader, m_scenario};
+    auto instance = entry->makeCpu(config);  // parsed even when off, so its table is still checked
+    reader.finish();
+    if (enabled) m_events.push_back({entry->name, entry->phase, std::move(instance)});
+  }
+  for (int i = 0; i < m_world.size(); ++i)
+    if (m_world.kind[i] == BodyKind::Vessel) m_vesselId = m_world.id[i];
+  if (m_scenario.mortonSort) reorderAlongCurve();
+}
+
+int Simulation::vesselSlot() const {
+  if (m_vesselId < 0) return -1;
+  for (int i = 0; i < m_world.size(); ++i)
+    if (m_world.id[i] == m_vesselId) return i;
+  return -1;
+}
+
+VesselSample Simulation::vessel() {
+  const int v = vesselSlot();
+  if (v < 0) return VesselSample{false, {0, 0}, 0, {0, 0}};
+  return VesselSample{true, m_world.position(v), m_world.angle[v], m_world.velocity(v)};
+}
+
+static int dofOf(const World& w, int i, int vesselDof) {
+  switch (w.kind[i]) {
+    case BodyKind::Wall: return 0;
+    case BodyKind::Vessel: return vesselDof;
+    default: return 3;
+  }
+}
+
+// Re-sorts the bodies along a Morton curve (World::curveOrder). Every strategy sees the same order,
+// so results stay identical.
+void Simulation::reorderAlongCurve() {
+  if (m_world.size() < 2) return;
+  m_world.permute(m_world.curveOrder());
+  m_broadphase->invalidate();
+}
+
+void Simulation::narrowphase() {
+  const int n = m_world.size();
+  m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
+  m_boxes.resize(n);
+  m_vertexPose.resize(n, Pose{-1, 0, 0, 0});
+  m_moved.assign(n, 0);
+  for (int i = 0; i < n; ++i) {
+    // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
+    // vertices from an earlier step are still exact, so only bodies that moved are transformed.
+    const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
+    if (pose == m_vertexPose[i]) continue;
+    m_vertexPose[i] = pose;
+    m_moved[i] = 1;
+    Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
+    m_boxes[i] = boundingBox(v, m_world.worldVertices(i, v));
+  }
+
+  m_contactA.clear();
+  m_contactB.clear();
+  m_contacts.clear();
+  m_currentContacts.clear();
+  for (const CandidatePair& pair : m_pairs) {
+    const int a = pair.a, b = pair.b;
+    if (m_world.invMass[a] == 0 && m_world.invMass[b] == 0) continue;
+    // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
+    if (!boxesOverlap(m_boxes[a], m_boxes[b])) continue;
+    const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
+    // Two bodies that have not moved since the last step, and did not touch then, do not touch
+    // now: the same polygons give the same answer. Most of a pack rests ahead of the vessel.
+    // (A touching pair is always a candidate, whatever the broadphase, so "did not touch then"
+    // is exactly "not among the last step's contacts".)
+    const bool touchedBefore = std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
+    if (!m_moved[a] && !m_moved[b] && !touchedBefore) continue;
+    const Contact c = computeContact(&m_worldVertices[static_cast<size_t>(a) * kMaxVertices], m_world.vertexCount[a],
+                                     m_world.position(a), &m_worldVertices[static_cast<size_t>(b) * kMaxVertices],
+                                     m_world.vertexCount[b], m_world.position(b));
+    if (!c.touching) continue;
+    const bool onset = !touchedBefore;
+    m_contactA.push_back(a);
+    m_contactB.push_back(b);
+    m_contacts.push_back(PairContact{c, onset});
+    m_currentContacts.push_back(key);
+  }
+  std::sort(m_currentContacts.begin(), m_currentContacts.end());
+  m_previousContacts.swap(m_currentContacts);
+}
+
+void Simulation::step() {
+  const StepContext ctx{m_scenario.dt, m_time, m_step};
+  const int n = m_world.size();
+  const int vesselDof = m_scenario.vessel.dof;
+
+  // 1-2. Candidates, then contacts.
+  m_broadphase->findCandidates(m_world, m_pairs);
+  narrowphase();
+
+  // 3. Two-body events write into each contact's slot.
+  m_pairBodies.resize(n);
+  for (int i = 0; i < n; ++i)
+    m_pairBodies[i] = pairBodyOf(m_world, i, dofOf(m_world, i, vesselDof), &m_worldVertices[static_cast<size_t>(i) * kMaxVertices],
+                                 m_world.vertexCount[i]);
+  const int contacts = static_cast<int>(m_contacts.size());
+  m_slots.assign(contacts, PairSlot{{0, 0}});
+  // Each contact yields at most one impact and one break: the buffers can never overflow.
+  // Logs: an event may log more than one row per contact; the buffer grows and the phase runs
+  // again in the rare step that passes it (pair events only write their slots and records).
+  m_impacts.resize(contacts);
+  m_breaks.resize(contacts);
+  if (m_logs.size() < static_cast<size_t>(contacts)) m_logs.resize(static_cast<size_t>(contacts));
+  for (;;) {
+    int impactCount = 0, breakCount = 0, logCount = 0;
+    const RecordSink sink{m_impacts.data(), contacts, &impactCount, m_breaks.data(), contacts, &breakCount,
+                          m_logs.data(), static_cast<int>(m_logs.size()), &logCount};
+    const PairPhaseData pairData{m_pairBodies.data(), m_contactA.data(), m_contactB.data(), m_contacts.data(),
+                                 m_slots.data(), contacts, ctx, sink};
+    for (auto& e : m_events)
+      if (e.phase == EventPhase::Pair) e.instance->runPairs(pairData);
+    if (logCount > static_cast<int>(m_logs.size())) {
+      m_logs.resize(static_cast<size_t>(logCount));
+      m_slots.assign(contacts, PairSlot{{0, 0}});
+      continue;
+    }
+    m_impacts.resize(impactCount);
+    m_breaks.resize(breakCount);
+    deliverLogs(m_logs.data(), logCount);
+    break;
+  }
+
+  // 4. Solo events, from the state at the start of the step.
+  m_soloBodies.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const PairBody& p = m_pairBodies[i];
+    m_soloBodies[i] = SoloBody{p.kind, p.dof, p.position, p.angle, p.velocity, p.omega, p.mass, p.area, p.thickness};
+  }
+  m_changes.assign(n, VelocityChange{{0, 0}, 0});
+  const SoloPhaseData soloData{m_soloBodies.data(), m_changes.data(), n, ctx};
+  for (auto& e : m_events)
+    if (e.phase == EventPhase::Solo) e.instance->runSolo(soloData);
+
+  // 5. Velocities from 3 and 4, then positions.
+  gatherAndMove();
+
+  // 6. Topology: breaks, rubble, new floes.
+  TopologyData topology{&m_world, m_breaks.data(), static_cast<int>(m_breaks.size()), m_time};
+  for (auto& e : m_events)
+    if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
+  m_rubbleMass += topology.rubbleMass;
+  m_floesBroken += topology.floesBroken;
+  if (topology.changed) m_broadphase->invalidate();
+
+  ++m_step;
+  m_time = static_cast<Real>(m_step) * m_scenario.dt;
+  if (m_scenario.mortonSort && m_step % 200 == 0) reorderAlongCurve();
+}
+
+void Simulation::gatherAndMove() {
+  const int n = m_world.size();
+  // Impulses: every body sums its contacts in contact order (sorted by slot pair), so the sum
+  // is the same whatever broadphase found the pairs, and no atomics are needed.
+  std::vector<VelocityChange>& total = m_changes;  // already holds the solo events' part
+  const int vessel = m_vesselId >= 0 ? vesselSlot() : -1;
+  Vec2 vesselImpulse{0, 0};
+  for (size_t k = 0; k < m_contacts.size(); ++k) {
+    const Vec2 j = m_slots[k].impulse;
+    if (j.x == 0 && j.y == 0) continue;
+    const Vec2 c = m_contacts[k].geometry.point;
+    for (int side = 0; side < 2; ++side) {
+      const int i = side == 0 ? m_contactA[k] : m_contactB[k];
+      const Vec2 ji = side == 0 ? -j : j;
+      const PairBody& b = m_pairBodies[i];
+      if (i == vessel) vesselImpulse += ji;
+      if (b.dof == 0) continue;
+      if (b.dof == 1) {
+        const Vec2 heading{std::cos(b.angle), std::sin(b.angle)};
+        total[i].dv += (b.invMass * dot(ji, heading)) * heading;
+        continue;
+      }
+      total[i].dv += b.invMass * ji;
+      total[i].domega += b.invInertia * cross(c - b.position, ji);
+    }
+  }
+  m_vesselIceForce = (Real(1) / m_scenario.dt) * vesselImpulse;
+
+  m_motionBodies.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const PairBody& p = m_pairBodies[i];
+    m_motionBodies[i] = MotionBody{p.kind, p.dof, p.position, p.angle, p.velocity + total[i].dv, p.omega + total[i].domega};
+  }
+  const StepContext ctx{m_scenario.dt, m_time, m_step};
+  const MotionPhaseData motion{m_motionBodies.data(), n, ctx};
+  for (auto& e : m_events)
+    if (e.phase == EventPhase::Motion) e.instance->runMotion(motion);
+  for (int i = 0; i < n; ++i) {
+    const MotionBody& b = m_motionBodies[i];
+    m_world.x[i] = b.position.x;
+    m_world.y[i] = b.position.y;
+    m_world.angle[i] = b.angle;
+    m_world.vx[i] = b.velocity.x;
+    m_world.vy[i] = b.velocity.y;
+    m_world.omega[i] = b.omega;
+  }
+}
+
+}  // namespace gem

@@ -1,0 +1,103 @@
+// The GEM scheduler with the CPU driver: one step is the fixed phases of MODEL.md 8.
+//   1 broadphase  2 narrowphase  3 two-body events  4 solo events  5 motion  6 topology
+// (7, the observers, live in the runner). Events come from the registry by name.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/api/broadphase.hpp"
+#include "framework/api/registry.hpp"
+#include "framework/scenario/scenario.hpp"
+#include "framework/step/stepper.hpp"
+#include "framework/world/world.hpp"
+
+namespace gem {
+
+// Builds the initial bodies of a scenario (walls, field, [[floes]], vessel) after validating each
+// one (convex, finite, 3..19 vertices for floes, positive thickness) and checking that no two
+// overlap. Throws InputError naming the body (and the first overlapping pair).
+World buildWorld(const Scenario& scenario);
+
+// Throws InputError when a body spec is invalid; reverses clockwise vertices in place.
+void validateBodySpec(BodySpec& spec, int maxVertices);
+
+struct EnabledEvent {
+  std::string name;
+  EventPhase phase;
+  std::unique_ptr<EventInstance> instance;
+};
+
+class Simulation final : public Stepper {
+ public:
+  explicit Simulation(const Scenario& scenario);
+  // For tests: a world built by hand, with the scenario's events and broadphase.
+  Simulation(const Scenario& scenario, World world);
+
+  void step() override;
+
+  World& world() { return m_world; }
+  const World& world() const { return m_world; }
+  const Scenario& scenario() const { return m_scenario; }
+  long stepIndex() const override { return m_step; }
+  Real time() const override { return m_time; }
+  const World& hostWorld() override { return m_world; }
+  VesselSample vessel() override;
+  std::string device() const override { return "cpu"; }
+  std::string backend() const override { return "cpu"; }
+  const std::vector<EnabledEvent>& events() const { return m_events; }
+  Broadphase& broadphase() { return *m_broadphase; }
+
+  // What the last step produced.
+  const std::vector<ImpactRecord>& impacts() const override { return m_impacts; }
+  int contactCount() const override { return static_cast<int>(m_contacts.size()); }
+  int candidateCount() const { return static_cast<int>(m_pairs.size()); }
+  Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
+  int vesselSlot() const;                                   // -1 without a vessel
+
+  // Totals since the start.
+  double rubbleMass() const override { return m_rubbleMass; }
+  long floesBroken() const override { return m_floesBroken; }
+
+ private:
+  void setUp();
+  void narrowphase();
+  void gatherAndMove();
+  void reorderAlongCurve();
+
+  Scenario m_scenario;
+  World m_world;
+  std::unique_ptr<Broadphase> m_broadphase;
+  std::vector<EnabledEvent> m_events;
+  long m_step = 0;
+  Real m_time = 0;
+  std::int64_t m_vesselId = -1;
+
+  // Per-step buffers, kept to avoid allocation.
+  std::vector<Vec2> m_worldVertices;  // kMaxVertices per body
+  std::vector<Box> m_boxes;  // world-aligned bounding box of each body, this step
+  struct Pose {
+    std::int64_t id;
+    Real x, y, angle;
+    bool operator==(const Pose&) const = default;
+  };
+  std::vector<Pose> m_vertexPose;  // the pose m_worldVertices and m_boxes were computed for, by slot
+  std::vector<char> m_moved;       // this step: the body's pose differs from the last step's
+  std::vector<CandidatePair> m_pairs;
+  std::vector<int> m_contactA, m_contactB;
+  std::vector<PairContact> m_contacts;
+  std::vector<PairSlot> m_slots;
+  std::vector<PairBody> m_pairBodies;
+  std::vector<SoloBody> m_soloBodies;
+  std::vector<VelocityChange> m_changes;
+  std::vector<MotionBody> m_motionBodies;
+  std::vector<std::pair<std::int64_t, std::int64_t>> m_previousContacts, m_currentContacts;
+  std::vector<ImpactRecord> m_impacts;
+  std::vector<BreakRequest> m_breaks;
+  std::vector<LogRecord> m_logs;
+  Vec2 m_vesselIceForce{0, 0};
+  double m_rubbleMass = 0;
+  long m_floesBroken = 0;
+};
+
+}  // namespace gem

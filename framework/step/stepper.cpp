@@ -1,0 +1,62 @@
+#include "framework/step/stepper.hpp"
+
+#include <cstdio>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
+#include "framework/step/simulation.hpp"
+
+namespace gem {
+
+static std::map<std::string, BackendEntry>& backends() {
+  static std::map<std::string, BackendEntry> table = [] {
+    std::map<std::string, BackendEntry> t;
+    t["cpu"] = BackendEntry{"cpu", [] { return true; }, [] { return std::string("cpu"); },
+                            [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); },
+                            nullptr};  // the CPU backend's workers share the cores: no device to choose
+    return t;
+  }();
+  return table;
+}
+
+void registerBackend(BackendEntry entry) { backends()[entry.name] = std::move(entry); }
+
+const BackendEntry* findBackend(const std::string& name) {
+  auto it = backends().find(name);
+  return it == backends().end() ? nullptr : &it->second;
+}
+
+std::vector<std::string> backendNames() {
+  std::vector<std::string> names;
+  for (const auto& [name, entry] : backends()) names.push_back(name);
+  return names;
+}
+
+std::string resolveBackend(const std::string& requested) {
+  if (requested == "auto") {
+    const BackendEntry* cuda = findBackend("cuda");
+    return cuda && cuda->available() ? "cuda" : "cpu";
+  }
+  const BackendEntry* entry = findBackend(requested);
+  if (!entry)
+    throw InputError(fmt::format("simulation.backend = \"{}\": this build of GEM has no such backend (built: {})", requested,
+                                 fmt::join(backendNames(), ", ")));
+  if (!entry->available())
+    throw InputError(fmt::format("simulation.backend = \"{}\": no device for it was found on this machine", requested));
+  return requested;
+}
+
+std::unique_ptr<Stepper> makeStepper(const Scenario& scenario) {
+  const std::string backend = resolveBackend(scenario.backend);
+  try {
+    return findBackend(backend)->make(scenario);
+  } catch (const BackendUnsupported& e) {
+    if (scenario.backend != "auto" || backend == "cpu") throw;
+    std::fprintf(stderr, "gem: backend auto: %s; running on the cpu\n", e.what());
+    return findBackend("cpu")->make(scenario);
+  }
+}
+
+}  // namespace gem

@@ -1,0 +1,79 @@
+// A backend steps a scenario's world: the CPU one (Simulation) or a device one. The runner and the
+// benchmarks see only this interface, so a backend added later (CUDA) changes neither.
+#pragma once
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/api/errors.hpp"
+#include "framework/api/event_api.hpp"
+#include "framework/scenario/scenario.hpp"
+#include "framework/world/world.hpp"
+
+namespace gem {
+
+// The vessel's state after the last step, cheap to read every step.
+struct VesselSample {
+  bool present;
+  Vec2 position;
+  Real heading;
+  Vec2 velocity;
+};
+
+class Stepper {
+ public:
+  virtual ~Stepper() = default;
+  virtual void step() = 0;
+  virtual long stepIndex() const = 0;
+  virtual Real time() const = 0;
+  // The whole state on the host; a device backend copies it here when asked (outputs, frames).
+  virtual const World& hostWorld() = 0;
+  virtual VesselSample vessel() = 0;
+  // What the last step produced.
+  virtual const std::vector<ImpactRecord>& impacts() const = 0;
+  virtual int contactCount() const = 0;
+  virtual Vec2 vesselIceForce() const = 0;  // N, from the step's impulses on the vessel
+  // Totals since the start.
+  virtual double rubbleMass() const = 0;
+  virtual long floesBroken() const = 0;
+  virtual std::string device() const = 0;
+  virtual std::string backend() const = 0;  // "cpu", "cuda"
+};
+
+// A backend that cannot run this scenario (e.g. an event without a driver for it). Bad input when
+// the backend was asked for by name; with "auto", makeStepper falls back to the CPU instead.
+class BackendUnsupported : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+struct BackendEntry {
+  std::string name;
+  std::function<bool()> available;  // a device exists
+  std::function<std::string()> deviceName;
+  std::function<std::unique_ptr<Stepper>(const Scenario&)> make;
+  // Sweeps on a machine with several devices: the runs that this host thread makes next use device
+  // `worker` modulo the device count (a sweep's workers, over MPI ranks and threads, spread over the
+  // GPUs of their node). Empty for a backend without devices.
+  std::function<void(int worker)> useDeviceForWorker;
+  // Sweeps on a device: cases whose batchKey is the same and not "" may run together in one device
+  // state (makeTogether: a stepper each, stepped together by runScenariosTogether), each exactly as
+  // alone. deviceCount: the devices this process sees. All three empty for the CPU.
+  std::function<std::string(const Scenario&)> batchKey;
+  std::function<std::vector<std::unique_ptr<Stepper>>(const std::vector<const Scenario*>&)> makeTogether;
+  std::function<int()> deviceCount;
+};
+
+void registerBackend(BackendEntry entry);
+const BackendEntry* findBackend(const std::string& name);
+std::vector<std::string> backendNames();
+
+// "auto" is "cuda" when that backend is built and a device is present, else "cpu". Asking for a
+// backend that is not built, or has no device, is an InputError that says so.
+std::string resolveBackend(const std::string& requested);
+// The scenario's backend, made. With backend = "auto", a device backend that cannot run the
+// scenario (BackendUnsupported) gives way to the CPU, with a note on stderr.
+std::unique_ptr<Stepper> makeStepper(const Scenario& scenario);
+
+}  // namespace gem

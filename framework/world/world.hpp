@@ -1,0 +1,95 @@
+// The world state: every body as structure of arrays (DESIGN.md "Speed habits"), in Real.
+// Index i is a body's slot in the arrays; id[i] is its stable identity for outputs, which never
+// changes and is never reused, even when floes break or leave as rubble.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "framework/world/body_kind.hpp"
+#include "framework/world/constants.hpp"
+#include "geometry/polygon.hpp"
+
+namespace gem {
+
+
+
+const char* bodyKindName(BodyKind kind);
+
+
+// One body as given by a scenario, a field generator or a .ice file: world coordinates.
+struct BodySpec {
+  BodyKind kind = BodyKind::Floe;
+  std::vector<Vec2> vertices;  // world coordinates, convex (counter-clockwise after validation)
+  Real thickness = 1;          // m
+  Vec2 velocity{0, 0};         // m/s
+  Real angularVelocity = 0;    // rad/s
+  std::int64_t id = -1;        // -1: the world assigns the next free id
+  std::string origin;          // where it came from, for error messages ("field", "floes[3]", "pack.ice object 12")
+};
+
+struct World {
+  // Identity and shape.
+  std::vector<std::int64_t> id;
+  std::vector<BodyKind> kind;
+  std::vector<int> vertexCount;
+  std::vector<Vec2> localVertices;  // kMaxVertices per body, about the centroid, in the body frame
+  // Kinematics: centroid position, orientation and their rates.
+  std::vector<Real> x, y, angle, vx, vy, omega;
+  // Mass properties. invMass and invInertia are 0 for walls (immovable); the vessel's
+  // constrained degrees of freedom are handled by its dof (see Vessel).
+  std::vector<Real> area, thickness, mass, invMass, invInertia;
+  std::vector<Real> gyration2;       // r_z^2 = I_zz / A (floes), m^2: the 2D impulse's r^2
+  std::vector<Real> gyrationX2, gyrationY2;  // principal r_x^2, r_y^2 (the 2.5D impact, A.80 to A.82)
+  std::vector<Real> principalAngle;  // body-frame angle of the principal x axis, rad
+  std::vector<Real> radius;          // bounding radius about the centroid, m
+  std::int64_t nextId = 0;
+
+  int size() const { return static_cast<int>(id.size()); }
+  const Vec2* local(int i) const { return &localVertices[static_cast<size_t>(i) * kMaxVertices]; }
+  Vec2* local(int i) { return &localVertices[static_cast<size_t>(i) * kMaxVertices]; }
+  Vec2 position(int i) const { return {x[i], y[i]}; }
+  Vec2 velocity(int i) const { return {vx[i], vy[i]}; }
+  // World vertices of body i into out (kMaxVertices long); returns the count.
+  int worldVertices(int i, Vec2* out) const {
+    toWorld(local(i), vertexCount[i], position(i), angle[i], out);
+    return vertexCount[i];
+  }
+
+  // Adds a body from world-coordinate vertices (already validated: convex, CCW, finite).
+  // Floe mass is rho_ice * area * thickness (MODEL.md 1); walls get infinite mass.
+  int addBody(const BodySpec& spec);
+  // Removes the bodies whose flag is set, keeping the order of the others.
+  void removeBodies(const std::vector<char>& remove);
+  // Reorders all arrays by the permutation (new slot k holds old slot order[k]).
+  void permute(const std::vector<int>& order);
+  // The order of the bodies along a Morton (Z-order) curve through their centroids: neighbours in
+  // space become neighbours in memory (DESIGN.md "Speed habits"). Ties keep slot order.
+  std::vector<int> curveOrder() const;  // sorted by curveKey, ties by slot
+  // Total mass of the floes, kg.
+  double floeMass() const;
+  int count(BodyKind k) const;
+};
+
+// The Morton key of World::curveOrder, written once for the host and the device (the CUDA backend
+// re-sorts on the device and must get the very same order): the centroid's place in the box of all
+// centroids [x0, x1] x [y0, y1], on a 65536 x 65536 grid, x and y bits interleaved.
+GEM_HD inline Real curveScale(Real x0, Real y0, Real x1, Real y1) {
+  Real extent = x1 - x0 > y1 - y0 ? x1 - x0 : y1 - y0;
+  if (!(extent > Real(1e-9))) extent = Real(1e-9);
+  return 65535 / extent;
+}
+GEM_HD inline std::uint32_t curveKey(Real x, Real y, Real x0, Real y0, Real scale) {
+  auto spread = [](std::uint32_t v) {  // the 16 bits of v to the even bits of the result
+    v &= 0xffff;
+    v = (v | (v << 8)) & 0x00ff00ff;
+    v = (v | (v << 4)) & 0x0f0f0f0f;
+    v = (v | (v << 2)) & 0x33333333;
+    v = (v | (v << 1)) & 0x55555555;
+    return v;
+  };
+  const auto gx = static_cast<std::uint32_t>((x - x0) * scale), gy = static_cast<std::uint32_t>((y - y0) * scale);
+  return spread(gx) | (spread(gy) << 1);
+}
+
+}  // namespace gem
