@@ -19,6 +19,7 @@
 #include "framework/cuda/device_world.hpp"
 #include "framework/api/log_channel.hpp"
 #include "framework/api/registry.hpp"
+#include "framework/step/phases.hpp"
 #include "framework/step/simulation.hpp"
 #include "framework/step/stepper.hpp"
 
@@ -310,7 +311,7 @@ void CudaBatch::ensureStep(long step) {
 }
 
 // Up to copy_back_every steps, ending where the host needs the state: the next frame, the next
-// re-sort along the curve (every 200 steps), the scenario's last step.
+// re-sort along the curve (every kResortPeriod steps), the scenario's last step.
 void CudaBatch::runBatch(long step) {
   const Scenario& s = m_members.front()->scenario();
   // Alone on its device, a batch is copy_back_every steps in one launch. Sharing it (a sweep's
@@ -323,7 +324,7 @@ void CudaBatch::runBatch(long step) {
     if (every > 0) end = std::min(end, (step / every + 1) * every);
   };
   if (s.output.frameEvery > 0) stopAtMultipleOf(s.output.frameEvery);
-  if (s.mortonSort) stopAtMultipleOf(200);
+  if (s.mortonSort) stopAtMultipleOf(kResortPeriod);
   if (step < s.steps) end = std::min(end, s.steps);
   Stopwatch clock;
   m_device->run(step, s.dt, static_cast<int>(end - step), *m_result);
@@ -348,7 +349,7 @@ void CudaBatch::finishedStep(long step) {
   m_finished = 0;
   m_stepsDone = step + 1;
   applyEdits();
-  if (m_members.front()->scenario().mortonSort && (step + 1) % 200 == 0) {
+  if (m_members.front()->scenario().mortonSort && isResortStep(step + 1)) {
     Stopwatch clock;
     reSortAlongCurve();
     times.resort += clock.lap();
@@ -377,11 +378,11 @@ void CudaBatch::applyEdits() {
   times.bookkeeping += clock.lap();
 }
 
-// Every 200 steps (DESIGN.md "Speed habits": neighbours in space become neighbours in memory).
+// Every kResortPeriod steps (docs/architecture.md "Speed habits": neighbours in space become neighbours in memory).
 void CudaBatch::reSortAlongCurve() {
   // On the device, bit for bit as the host's World::curveOrder + World::permute, world by world;
   // the mirrors follow lazily (m_pendingOrder). At 10^6 floes a round trip through the host
-  // (download, sort, permute, upload, re-capture) cost more than the 200 steps it serves.
+  // (download, sort, permute, upload, re-capture) cost more than the kResortPeriod steps it serves.
   const std::vector<int> worldBefore = m_device->worldOfSlots();
   bool followed = true;
   const std::vector<int> order = m_device->reorderAlongCurve(&followed);
@@ -659,14 +660,14 @@ void CudaSimulation::step() {
     deliverLogs(m_logs.data(), static_cast<int>(m_logs.size()));
     batch.times.ordering += clock.lap();
   }
-  m_vesselIceForce = (Real(1) / scenario().dt) * mine.vesselImpulse;
+  m_vesselIceForce = forceOfImpulse(mine.vesselImpulse, scenario().dt);
   if (m_vesselSlot >= 0) m_vessel = VesselSample{true, mine.vesselPosition, mine.vesselAngle, mine.vesselVelocity};
 
   // 6. Topology, only in a step that asked for a break (the device stopped the batch there).
   if (!m_breaks.empty()) runTopology();
 
   const long done = m_step++;
-  m_time = static_cast<Real>(m_step) * scenario().dt;
+  m_time = stepTime(m_step, scenario().dt);
   batch.finishedStep(done);  // the last case of the step: edits on the device, the re-sort when due
 }
 

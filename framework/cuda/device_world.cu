@@ -1,6 +1,8 @@
-// The device phases of a step (see cuda_simulation.hpp for the list). Semantics copied from
-// framework/step/simulation.cpp, the reference: any difference in what is summed, or in which order,
-// is a bug (the CUDA-vs-CPU tests compare the two).
+// The device phases of a step (see cuda_simulation.hpp for the list). The rules every driver applies
+// (the prefilter, degrees of freedom, what an impulse does to a body, the time of a step) come from
+// framework/step/phases.hpp, the same functions the CPU stepper calls; what is written here is how
+// the device runs them in parallel while keeping the CPU's order of every sum (tests: golden hashes,
+// CUDA vs CPU).
 #include "framework/cuda/device_world.hpp"
 
 #include <cooperative_groups.h>
@@ -22,6 +24,7 @@
 #include <string>
 
 #include "framework/api/cuda_check.hpp"
+#include "framework/step/phases.hpp"
 #include "geometry/contact.hpp"
 
 namespace gem::cuda {
@@ -394,11 +397,9 @@ __global__ void cellRangeKernel(const unsigned* key, int n, unsigned largeKey, i
   if (k == n - 1 || key[k + 1] != key[k]) end[key[k]] = k + 1;
 }
 
-// The pair test of Simulation::narrowphase's prefilter: not two immovable bodies, boxes overlap.
+// The narrowphase's prefilter (phases.hpp), within one world: a hash cell may hold another world's bodies.
 __device__ inline bool accept(const GridView& g, int i, int j) {
-  if (g.world[i] != g.world[j]) return false;  // a hash cell may hold another world's bodies
-  if (g.invMass[i] == 0 && g.invMass[j] == 0) return false;
-  return boxesOverlap(g.boxes[i], g.boxes[j]);
+  return g.world[i] == g.world[j] && mayTouch(g.invMass[i], g.invMass[j], g.boxes[i], g.boxes[j]);
 }
 
 // A tile of Lanes threads per small body: its lanes test Lanes candidates at a time, so the
@@ -583,10 +584,10 @@ __global__ void narrowphaseKernel(int capacity, const int* needed, const int* ca
     return;
   }
   const int a = candA[p], b = candB[p];
-  // Simulation::narrowphase's prefilter: a device broadphase may propose more than the grid's
-  // accept() lets through; dropping the same pairs here keeps the contacts bit-identical.
-  // Bodies of two worlds never touch (a device strategy does not know the worlds).
-  if (world[a] != world[b] || (invMass[a] == 0 && invMass[b] == 0) || !boxesOverlap(boxes[a], boxes[b])) {
+  // The prefilter (phases.hpp): a device broadphase may propose more than the grid's accept() lets
+  // through; dropping the same pairs here keeps the contacts bit-identical. Bodies of two worlds
+  // never touch (a device strategy does not know the worlds).
+  if (world[a] != world[b] || !mayTouch(invMass[a], invMass[b], boxes[a], boxes[b])) {
     flag[p] = 0;
     return;
   }
@@ -685,18 +686,6 @@ __device__ inline int lowerBound(const int* v, int n, int x) {
   return lo;
 }
 
-// One contact's impulse on body b at point c, exactly as Simulation::gatherAndMove.
-__device__ inline void addImpulse(const PairBody& b, Vec2 ji, Vec2 c, VelocityChange& total) {
-  if (b.dof == 0) return;
-  if (b.dof == 1) {
-    const Vec2 heading{cos(b.angle), sin(b.angle)};
-    total.dv += (b.invMass * dot(ji, heading)) * heading;
-    return;
-  }
-  total.dv += b.invMass * ji;
-  total.domega += b.invInertia * cross(c - b.position, ji);
-}
-
 // Each body sums its contacts in contact order: the CPU loop visits contact k's a then b, and a
 // body's contacts as b (a < i) all come before its contacts as a (sorted by a). No atomics.
 // contactA and bKeySorted are sorted with the padding (slot n) last, so searching the whole
@@ -715,13 +704,13 @@ __global__ void gatherKernel(int n, const int* world, const int* vesselSlot, con
     const Vec2 j = slots[k].impulse;
     if (j.x == 0 && j.y == 0) continue;
     if (i == vessel) vesselImpulse += j;
-    addImpulse(b, j, contacts[k].geometry.point, total);
+    addContactImpulse(b, j, contacts[k].geometry.point, total);
   }
   for (int k = lowerBound(contactA, capacity, i); k < capacity && contactA[k] == i; ++k) {
     const Vec2 j = slots[k].impulse;
     if (j.x == 0 && j.y == 0) continue;
     if (i == vessel) vesselImpulse += -j;
-    addImpulse(b, -j, contacts[k].geometry.point, total);
+    addContactImpulse(b, -j, contacts[k].geometry.point, total);
   }
   if (i == vessel) worldStats[world[i]].vesselImpulse = vesselImpulse;
   motion[i] = MotionBody{b.kind, b.dof, b.position, b.angle, b.velocity + total.dv, b.omega + total.domega};
@@ -744,7 +733,7 @@ __global__ void beginStepKernel(const BatchControl* c, StepStats* s, StepContext
   for (int w = threadIdx.x; w < worlds; w += blockDim.x) worldStats[w] = WorldStepRecord{0, {0, 0}, {0, 0}, {0, 0}, 0};
   if (threadIdx.x != 0) return;
   const long step = c->firstStep + s->stepsDone;
-  *ctx = StepContext{c->dt, static_cast<Real>(step) * c->dt, step};
+  *ctx = StepContext{c->dt, stepTime(step, c->dt), step};
   s->impactBegin = s->impactCount, s->breakBegin = s->breakCount, s->logBegin = s->logCount;
   s->overflow = 0;
 }
@@ -817,13 +806,11 @@ void DeviceWorld::setBroadphase(std::unique_ptr<CudaBroadphase> broadphase) {
 const CudaBroadphase* DeviceWorld::broadphase() const { return m_state->broadphase.get(); }
 
 // What a captured graph baked in: when it is the same after an upload (a re-sort along the curve
-// every 200 steps changes only the arrays' contents) the graph is kept, not captured again.
+// every kResortPeriod steps changes only the arrays' contents) the graph is kept, not captured again.
 static auto bakedValues(const DeviceState& d) {
   return std::make_tuple(d.n, d.cell, d.tableSize, d.largeCount, d.idBits, d.capacity, d.worlds, g_reallocations.load());
 }
 
-// dof as Simulation's dofOf.
-static int dofOf(BodyKind kind, int vesselDof) { return kind == BodyKind::Wall ? 0 : (kind == BodyKind::Vessel ? vesselDof : 3); }
 
 // Everything that follows from n and the ids: the hash table, the key widths, the per-step buffers.
 static void sizeForBodies(DeviceState& d, std::int64_t nextId) {
@@ -902,7 +889,7 @@ void DeviceWorld::upload(const World& w, const std::vector<int>& worldOf, const 
   std::vector<int> dof(n);
   Real largestFloe = 0;
   for (int i = 0; i < n; ++i) {
-    dof[i] = dofOf(w.kind[i], vesselDofs[static_cast<size_t>(d.worldHost[static_cast<size_t>(i)])]);
+    dof[i] = degreesOfFreedom(w.kind[i], vesselDofs[static_cast<size_t>(d.worldHost[static_cast<size_t>(i)])]);
     if (w.kind[i] == BodyKind::Floe) largestFloe = std::max(largestFloe, w.radius[i]);
   }
   d.cell = largestFloe > 0 ? 2 * largestFloe : Real(1);
@@ -1136,7 +1123,7 @@ bool DeviceWorld::editBodies(const std::vector<int>& removedSlots, const World& 
   std::vector<unsigned char> isLarge(count);
   for (size_t k = 0; k < count; ++k) {
     if (!addedWorlds.empty()) worlds[k] = addedWorlds[k];
-    dof[k] = dofOf(from.kind[first + k], vesselDofs[static_cast<size_t>(worlds[k])]);
+    dof[k] = degreesOfFreedom(from.kind[first + k], vesselDofs[static_cast<size_t>(worlds[k])]);
     isLarge[k] = 2 * from.radius[first + k] > d.cell;  // the cell stays: a smaller largest floe only makes it coarse
   }
   d.dof.uploadAt(at, dof.data(), count);

@@ -10,6 +10,7 @@
 #include "framework/api/log_channel.hpp"
 #include "framework/api/table_reader.hpp"
 #include "framework/world/vessel.hpp"
+#include "framework/step/phases.hpp"
 #include "geometry/contact.hpp"
 
 namespace gem {
@@ -145,14 +146,6 @@ VesselSample Simulation::vessel() {
   return VesselSample{true, m_world.position(v), m_world.angle[v], m_world.velocity(v)};
 }
 
-static int dofOf(const World& w, int i, int vesselDof) {
-  switch (w.kind[i]) {
-    case BodyKind::Wall: return 0;
-    case BodyKind::Vessel: return vesselDof;
-    default: return 3;
-  }
-}
-
 // Re-sorts the bodies along a Morton curve (World::curveOrder). Every strategy sees the same order,
 // so results stay identical.
 void Simulation::reorderAlongCurve() {
@@ -184,9 +177,8 @@ void Simulation::narrowphase() {
   m_currentContacts.clear();
   for (const CandidatePair& pair : m_pairs) {
     const int a = pair.a, b = pair.b;
-    if (m_world.invMass[a] == 0 && m_world.invMass[b] == 0) continue;
     // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
-    if (!boxesOverlap(m_boxes[a], m_boxes[b])) continue;
+    if (!mayTouch(m_world.invMass[a], m_world.invMass[b], m_boxes[a], m_boxes[b])) continue;
     const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
     // Two bodies that have not moved since the last step, and did not touch then, do not touch
     // now: the same polygons give the same answer. Most of a pack rests ahead of the vessel.
@@ -220,7 +212,7 @@ void Simulation::step() {
   // 3. Two-body events write into each contact's slot.
   m_pairBodies.resize(n);
   for (int i = 0; i < n; ++i)
-    m_pairBodies[i] = pairBodyOf(m_world, i, dofOf(m_world, i, vesselDof), &m_worldVertices[static_cast<size_t>(i) * kMaxVertices],
+    m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof), &m_worldVertices[static_cast<size_t>(i) * kMaxVertices],
                                  m_world.vertexCount[i]);
   const int contacts = static_cast<int>(m_contacts.size());
   m_slots.assign(contacts, PairSlot{{0, 0}});
@@ -272,8 +264,8 @@ void Simulation::step() {
   if (topology.changed) m_broadphase->invalidate();
 
   ++m_step;
-  m_time = static_cast<Real>(m_step) * m_scenario.dt;
-  if (m_scenario.mortonSort && m_step % 200 == 0) reorderAlongCurve();
+  m_time = stepTime(m_step, m_scenario.dt);
+  if (m_scenario.mortonSort && isResortStep(m_step)) reorderAlongCurve();
 }
 
 void Simulation::gatherAndMove() {
@@ -290,19 +282,11 @@ void Simulation::gatherAndMove() {
     for (int side = 0; side < 2; ++side) {
       const int i = side == 0 ? m_contactA[k] : m_contactB[k];
       const Vec2 ji = side == 0 ? -j : j;
-      const PairBody& b = m_pairBodies[i];
       if (i == vessel) vesselImpulse += ji;
-      if (b.dof == 0) continue;
-      if (b.dof == 1) {
-        const Vec2 heading{std::cos(b.angle), std::sin(b.angle)};
-        total[i].dv += (b.invMass * dot(ji, heading)) * heading;
-        continue;
-      }
-      total[i].dv += b.invMass * ji;
-      total[i].domega += b.invInertia * cross(c - b.position, ji);
+      addContactImpulse(m_pairBodies[i], ji, c, total[i]);
     }
   }
-  m_vesselIceForce = (Real(1) / m_scenario.dt) * vesselImpulse;
+  m_vesselIceForce = forceOfImpulse(vesselImpulse, m_scenario.dt);
 
   m_motionBodies.resize(n);
   for (int i = 0; i < n; ++i) {
