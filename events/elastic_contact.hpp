@@ -14,6 +14,7 @@
 namespace gem {
 
 struct ElasticContact {
+  static constexpr int kOrder = event_order::kForces;  // docs/plugins.md "Order"
   struct Params {
     Real sigmaMax;   // Pa
     Real stiffness;  // K_ice, dimensionless
@@ -28,7 +29,7 @@ struct ElasticContact {
     const Real d = std::sqrt(a.area < b.area ? a.area : b.area);
     Real coverage = contact.geometry.area * p.stiffness / (w * d);
     coverage = coverage < 1 ? coverage : 1;
-    slot.impulse += (p.factor * coverage * p.sigmaMax * w * h * ctx.dt) * contact.geometry.normal;
+    slot.addNormal(p.factor * coverage * p.sigmaMax * w * h * ctx.dt, contact.geometry.normal);
   }
 };
 

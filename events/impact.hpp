@@ -15,6 +15,7 @@
 namespace gem {
 
 struct Impact {
+  static constexpr int kOrder = event_order::kImpulses;  // docs/plugins.md "Order"
   struct Params {
     Real friction;  // mu, dimensionless
   };
@@ -27,7 +28,7 @@ struct Impact {
     const Real inverseMass = inverseEffectiveMass(a, n, c) + inverseEffectiveMass(b, n, c);
     if (!(inverseMass > 0)) return;  // two immovable bodies
     const Real normalImpulse = closing / inverseMass;
-    slot.impulse += normalImpulse * n;
+    slot.addNormal(normalImpulse, n);
     if (p.friction > 0) {
       const Vec2 t = perpLeft(n);
       const Real sliding = dot(pointVelocity(a, c) - pointVelocity(b, c), t);
@@ -36,7 +37,7 @@ struct Impact {
         Real tangentImpulse = sliding / inverseTangentMass;
         const Real limit = p.friction * normalImpulse;
         tangentImpulse = tangentImpulse > limit ? limit : (tangentImpulse < -limit ? -limit : tangentImpulse);
-        slot.impulse += tangentImpulse * t;
+        slot.addTangent(tangentImpulse, t);
       }
     }
   }

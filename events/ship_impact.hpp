@@ -23,6 +23,7 @@
 namespace gem {
 
 struct ShipImpact {
+  static constexpr int kOrder = event_order::kObservers;  // reads the contact, applies no impulse
   struct Params {
     Real frameAngle[kMaxVertices];  // beta per vessel edge (edge i joins vertex i and i + 1), rad
     Real gyrationX2, gyrationY2, gyrationZ2;  // vessel r_xs^2, r_ys^2, r_zs^2 (A.67-A.69), m^2

@@ -4,7 +4,9 @@
 // plugins/ out of tree against it, run its scenario with the installed gem, see it in gem info.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <sstream>
 #include <string>
 
 #include "framework/app/plugin_loader.hpp"
@@ -161,6 +163,48 @@ TEST(PluginSdk, APluginOfTheOldLayoutStillBuildsAndRuns) {
   row = row.substr(row.find('\n') + 1);
   for (int k = 0; k < 6; ++k) row = row.substr(row.find(',') + 1);
   EXPECT_NEAR(std::stod(row.substr(0, row.find(','))), 2.0, 1e-9);
+}
+
+// Declared event order (docs/plugins.md "Order"): gem info lists the pair events in the order they
+// run, the friction plugin (kOrder = impulses + 50) between impact and ship_impact; and it reads the
+// impact's normal impulse from the contact's slot: a floe sliding along another drags it along.
+TEST(PluginOrder, AFrictionEventRunsAfterImpactAndReadsItsNormalImpulse) {
+  TempDir dir;
+  const fs::path log = dir.path() / "info.txt";
+  ASSERT_EQ(gem::test::runGem("info --plugin " + plugin("floe_friction"), log), 0) << readFile(log);
+  const std::string info = readFile(log);
+  const size_t elastic = info.find("  elastic_contact "), impact = info.find("  impact "), friction = info.find("  floe_friction "),
+               ship = info.find("  ship_impact ");
+  ASSERT_NE(friction, std::string::npos) << info;
+  EXPECT_LT(elastic, impact) << info;
+  EXPECT_LT(impact, friction) << info;
+  EXPECT_LT(friction, ship) << info;
+  EXPECT_TRUE(contains(info, "  floe_friction      two-body  250")) << info;
+
+  // Floe 0 slides up (+y) while it closes on floe 1 (+x): the impact stops the closing; friction
+  // then passes part of the sliding to floe 1.
+  const std::string scene = "[simulation]\ndt = 0.01\nsteps = 100\nbroadphase = \"all_pairs\"\n[events.drag]\nenabled = false\n"
+                            "[[floes]]\nvertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\nthickness = 0.5\nvelocity = [2.0, 1.0]\n"
+                            "[[floes]]\nvertices = [[10.2, -5.0], [20.2, -5.0], [20.2, 5.0], [10.2, 5.0]]\nthickness = 0.5\n"
+                            "[[plugins]]\npath = \"" + plugin("floe_friction") + "\"\n";
+  auto vyOfFloe1 = [&](const std::string& name, const std::string& extra) {
+    const fs::path scenario = dir.write(name + ".toml", scene + extra);
+    EXPECT_EQ(gem::test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / name).string(), dir.path() / "log"), 0)
+        << readFile(dir.path() / "log");
+    // state.csv: id,kind,x,y,angle,vx,vy,...: the row of id 1.
+    std::istringstream rows(readFile(dir.path() / name / "state.csv"));
+    std::string row;
+    while (std::getline(rows, row))
+      if (row.rfind("1,", 0) == 0) {
+        for (int k = 0; k < 6; ++k) row = row.substr(row.find(',') + 1);
+        return std::stod(row.substr(0, row.find(',')));
+      }
+    ADD_FAILURE() << "no floe 1 in " << name;
+    return 0.0;
+  };
+  const double without = vyOfFloe1("without", ""), with = vyOfFloe1("with", "[events.floe_friction]\nmu = 0.5\n");
+  EXPECT_LT(std::abs(without), 0.01);  // the impact alone pushes floe 1 (almost) along x only
+  EXPECT_GT(with, without + 0.05);
 }
 
 // The SDK from the build, as a user does it: install, build each example out of tree, run it.

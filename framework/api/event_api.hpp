@@ -99,10 +99,36 @@ struct PairContact {
 };
 
 // The impulse of all two-body events of one contact: +impulse acts on b at the contact point,
-// -impulse on a (equal and opposite, MODEL.md 4).
+// -impulse on a (equal and opposite, docs/model.md 4). Events add through addNormal and addTangent,
+// which also keep the normal and tangential parts apart: an event that runs later in the phase
+// (event_order below) reads what earlier ones applied, e.g. a Coulomb friction event bounds its
+// tangential impulse by mu x `normal` (docs/plugins.md "Order").
 struct PairSlot {
-  Vec2 impulse;  // N s
+  Vec2 impulse;      // N s, world frame: everything the events of this contact applied, on b
+  Real normal = 0;   // N s, the sum of the addNormal parts (along the contact normal, a into b)
+  Real tangent = 0;  // N s, the sum of the addTangent parts (along perpLeft(normal))
+
+  // j along the unit normal n (contact.geometry.normal): j > 0 pushes the bodies apart.
+  GEM_HD void addNormal(Real j, Vec2 n) {
+    impulse += j * n;
+    normal += j;
+  }
+  // j along the unit tangent t = perpLeft(n).
+  GEM_HD void addTangent(Real j, Vec2 t) {
+    impulse += j * t;
+    tangent += j;
+  }
 };
+
+// When an event runs within its phase: lower first, ties by name (docs/plugins.md "Order"). An
+// event declares it as `static constexpr int kOrder = event_order::kImpulses;`; one that does not
+// runs at kDefault. gem info prints each event's order.
+namespace event_order {
+constexpr int kForces = 100;     // steady contact forces (elastic_contact)
+constexpr int kImpulses = 200;   // collision impulses (impact)
+constexpr int kDefault = 300;    // after the built-in impulses: e.g. friction reading slot.normal
+constexpr int kObservers = 400;  // events that only read and record (ship_impact's log)
+}  // namespace event_order
 
 // A ship-ice impact at contact onset (MODEL.md 5), one row of impacts.csv.
 struct ImpactRecord {

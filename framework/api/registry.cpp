@@ -1,5 +1,7 @@
 #include "framework/api/registry.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "framework/api/errors.hpp"
@@ -99,9 +101,13 @@ const BroadphaseEntry& Registry::broadphase(const std::string& name) const {
 
 std::vector<const EventEntry*> Registry::events() const {
   std::vector<const EventEntry*> out;
-  for (EventPhase phase : {EventPhase::Pair, EventPhase::Solo, EventPhase::Motion, EventPhase::Topology})
-    for (const auto& [name, e] : m_events)
+  for (EventPhase phase : {EventPhase::Pair, EventPhase::Solo, EventPhase::Motion, EventPhase::Topology}) {
+    const size_t first = out.size();
+    for (const auto& [name, e] : m_events)  // by name: the stable sort keeps it among equal orders
       if (e.phase == phase) out.push_back(&e);
+    std::stable_sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(),
+                     [](const EventEntry* a, const EventEntry* b) { return a->order < b->order; });
+  }
   return out;
 }
 

@@ -87,7 +87,15 @@ struct EventEntry {
   EventPhase phase;
   bool enabledByDefault;
   std::function<std::unique_ptr<EventInstance>(EventConfig&)> makeCpu;
+  int order = event_order::kDefault;  // within the phase: lower first, ties by name
 };
+
+// The order an event declares (static constexpr int kOrder), else event_order::kDefault.
+template <class Event>
+constexpr int eventOrderOf() {
+  if constexpr (requires { Event::kOrder; }) return Event::kOrder;
+  else return event_order::kDefault;
+}
 
 struct BroadphaseEntry {
   std::string name, description, origin;
@@ -103,7 +111,8 @@ class Registry {
   const EventEntry& event(const std::string& name) const;
   const BroadphaseEntry& broadphase(const std::string& name) const;
   const EventEntry* findEvent(const std::string& name) const;
-  // In registration order of phase, then name.
+  // By phase (pair, solo, motion, topology), then each event's declared order, then name: the
+  // order in which every driver runs them.
   std::vector<const EventEntry*> events() const;
   std::vector<const BroadphaseEntry*> broadphases() const;
   std::vector<std::string> eventNames() const;
@@ -239,7 +248,8 @@ struct RegisterNow {
       NAME, DESCRIPTION, GEM_ORIGIN, PHASE, ENABLED,                                                        \
       [](::gem::EventConfig& config) -> std::unique_ptr<::gem::EventInstance> {                            \
         return std::make_unique<DRIVER<EVENT>>(PARSE(config));                                             \
-      }}))
+      },                                                                                                   \
+      ::gem::eventOrderOf<EVENT>()}))
 #define GEM_REGISTER_PAIR_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
   GEM_REGISTER_EVENT(::gem::CpuPairDriver, ::gem::EventPhase::Pair, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
 #define GEM_REGISTER_SOLO_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \

@@ -109,9 +109,10 @@ int commandInfo(const std::vector<std::string>& plugins) {
   std::printf("sweeps across MPI ranks: %s\n", mpiBuilt() ? "yes" : "no (built without MPI)");
   std::printf("devices: cpu");
   if (cuda) std::printf(", %s", cuda->available() ? cuda->deviceName().c_str() : "no CUDA device found");
-  std::printf("\n\nevents (phase, default, origin):\n");
+  // In the order the drivers run them: by phase, then each event's declared order (docs/plugins.md "Order").
+  std::printf("\n\nevents, in the order they run (phase, order, default, origin):\n");
   for (const EventEntry* e : Registry::global().events()) {
-    std::printf("  %-18s %-9s %-4s %-9s %s\n", e->name.c_str(), eventPhaseName(e->phase), e->enabledByDefault ? "on" : "off",
+    std::printf("  %-18s %-9s %-5d %-4s %-9s %s\n", e->name.c_str(), eventPhaseName(e->phase), e->order, e->enabledByDefault ? "on" : "off",
                 originColumn(e->origin).c_str(), e->description.c_str());
     printPluginOrigin(e->origin);
   }

@@ -2,7 +2,7 @@
 // random convex floes of a given size distribution and concentration, or a regular array of
 // slightly rotated equal hexagons. Both are deterministic for a given seed on every standard
 // library, and every floe starts inside the domain, at least minGap from every other (MODEL.md 1:
-// bodies never start in contact).
+// bodies never start in contact). Defined in random_convex_field.cpp and hexagon_field.cpp.
 #pragma once
 #include <cstdint>
 #include <vector>
