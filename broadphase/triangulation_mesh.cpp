@@ -1,4 +1,4 @@
-// triangulation_mesh: thesis 5.5.2 and MODEL.md 9. Each polygon is ear-clipped once, in its body
+// triangulation_mesh: thesis 5.5.2 and docs/model.md 9. Each polygon is ear-clipped once, in its body
 // frame, into triangles; two bodies are candidates when any triangle of one overlaps any triangle
 // of the other. The pairs worth testing come from a variable_radius list (same skin, same rebuild
 // rule); each step, a listed pair whose bounding circles overlap has its triangles placed in the

@@ -1,4 +1,4 @@
-// uniform_grid: the sort-based loose grid of thesis 5.5.1 and MODEL.md 9 (after the CUDA "particles"
+// uniform_grid: the sort-based loose grid of thesis 5.5.1 and docs/model.md 9 (after the CUDA "particles"
 // sample): each body sits in the one cell of its centroid, bodies are sorted by cell key, and each
 // body searches the 3 x 3 cells around its own. The pairs it finds are filtered by
 // |c_a - c_b| <= R_a + R_b + skin and kept under the rule of neighbour_list.hpp: the list is the

@@ -1,4 +1,4 @@
-// autopilot: the CUDA driver, the same evaluator as the CPU (DESIGN.md "Writing an event").
+// autopilot: the CUDA driver, the same evaluator as the CPU (docs/architecture.md "Writing an event").
 #include "events/autopilot.hpp"
 #include "framework/api/cuda_events.hpp"
 #include "framework/api/registry.hpp"

@@ -1,4 +1,4 @@
-// Autopilot of a 3-DOF vessel (MODEL.md 7, thesis eq. 3.3, 3.4): uncoupled PD controls
+// Autopilot of a 3-DOF vessel (docs/model.md 7, thesis eq. 3.3, 3.4): uncoupled PD controls
 //
 //   M_yaw   = -(G_1 d(theta) + G_2 d(theta)/dt)     yaw moment, N m
 //   F_sway  = -(G_3 d(y) + G_4 dy/dt)               sway force across the track, N

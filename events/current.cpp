@@ -1,4 +1,4 @@
-// Current: [events.current], off unless the scenario gives the table (SCENARIO.md).
+// Current: [events.current], off unless the scenario gives the table (docs/scenario.md).
 #include "events/environmental_force_params.hpp"
 
 namespace gem {

@@ -1,4 +1,4 @@
-// drag: the CUDA driver, the same evaluator as the CPU (DESIGN.md "Writing an event").
+// drag: the CUDA driver, the same evaluator as the CPU (docs/architecture.md "Writing an event").
 #include "events/drag.hpp"
 #include "framework/api/cuda_events.hpp"
 #include "framework/api/registry.hpp"

@@ -1,4 +1,4 @@
-// Water drag on floes (MODEL.md 7, thesis A.105 to A.107). The tutorial's first page.
+// Water drag on floes (docs/model.md 7, thesis A.105 to A.107). The tutorial's first page.
 //
 //   dv_x  = -1/2 rho_w C_d v_x |v_x| dt / (rho_ice h)         (likewise v_y)         [m/s]
 //   domega = -1/2 rho_w C_d omega |omega| L_rot dt / (rho_ice h)                     [rad/s]

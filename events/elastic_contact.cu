@@ -1,4 +1,4 @@
-// elastic_contact: the CUDA driver, the same evaluator as the CPU (DESIGN.md "Writing an event").
+// elastic_contact: the CUDA driver, the same evaluator as the CPU (docs/architecture.md "Writing an event").
 #include "events/elastic_contact.hpp"
 #include "framework/api/cuda_events.hpp"
 #include "framework/api/registry.hpp"

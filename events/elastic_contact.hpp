@@ -1,4 +1,4 @@
-// Elastic contact (MODEL.md 4): a steady elastic stress resisting static pressure, every step that
+// Elastic contact (docs/model.md 4): a steady elastic stress resisting static pressure, every step that
 // two bodies overlap:
 //
 //   I_el = 0.05 C sigma_max w h dt,   C = min(A_0 K_ice / (w D), 1)                       [N s]

@@ -1,4 +1,4 @@
-// Wind and current on floes (MODEL.md 7, thesis A.108 to A.113). Two forms, summed:
+// Wind and current on floes (docs/model.md 7, thesis A.108 to A.113). Two forms, summed:
 //
 //   given stress:  dv = F dt / (rho_ice h) (cos theta, sin theta)           F in N/m^2 (A.108-A.113)
 //   bulk formula:  tau = rho C |U - s v| (U - s v),  dv = tau dt / (rho_ice h)

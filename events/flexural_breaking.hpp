@@ -1,4 +1,4 @@
-// Flexural breaking (MODEL.md 6, thesis A.100 to A.104). When ship_impact finds that a floe edge
+// Flexural breaking (docs/model.md 6, thesis A.100 to A.104). When ship_impact finds that a floe edge
 // fails in bending (F_n > F_lim), the floe is cut (choice) by the straight line perpendicular to
 // the contact normal n at the cusp length into the floe:
 //

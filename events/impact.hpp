@@ -1,4 +1,4 @@
-// Inelastic impact between two bodies (MODEL.md 4, thesis A.31 to A.49): the ice-crushing event.
+// Inelastic impact between two bodies (docs/model.md 4, thesis A.31 to A.49): the ice-crushing event.
 // All normal kinetic energy at the contact point is absorbed:
 //
 //   M_ec = 1 / (1/M_e1 + 1/M_e2),  M_ek = M_k / (l_k^2 + m_k^2 + eta_k^2 / r_k^2)      [kg]

@@ -1,4 +1,4 @@
-// Motion (MODEL.md 2, thesis A.21 to A.23): semi-implicit Euler. The velocities already hold every
+// Motion (docs/model.md 2, thesis A.21 to A.23): semi-implicit Euler. The velocities already hold every
 // impulse and force of the step; positions then move with them:
 //
 //   x += v_x dt,  y += v_y dt,  angle += omega dt

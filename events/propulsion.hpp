@@ -1,4 +1,4 @@
-// Vessel propulsion with the net-thrust model (MODEL.md 7, thesis eq. 3.2):
+// Vessel propulsion with the net-thrust model (docs/model.md 7, thesis eq. 3.2):
 //
 //   T_net = T_bollard - C_res V^3,   C_res = T_bollard / V_ow^3   (T_net = 0 at the open-water speed)
 //   dv    = T_net dt / M  along the heading                                              [m/s]

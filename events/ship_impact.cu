@@ -1,4 +1,4 @@
-// ship_impact: the CUDA driver, the same evaluator as the CPU (DESIGN.md "Writing an event").
+// ship_impact: the CUDA driver, the same evaluator as the CPU (docs/architecture.md "Writing an event").
 #include "events/ship_impact.hpp"
 #include "framework/api/cuda_events.hpp"
 #include "framework/api/registry.hpp"

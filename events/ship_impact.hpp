@@ -1,4 +1,4 @@
-// Ship-ice impact force, 2.5D (MODEL.md 5, thesis A.50 to A.99). The kinematics stay 2D (impact
+// Ship-ice impact force, 2.5D (docs/model.md 5, thesis A.50 to A.99). The kinematics stay 2D (impact
 // and elastic_contact move the bodies); at the onset of each vessel-floe contact this event
 // evaluates the 3D impact force, logs it, and asks for a flexural break when the edge fails.
 //
@@ -60,7 +60,7 @@ struct ShipImpact {
     return massReduction(vessel, nr.x * std::cos(beta), nr.y * std::cos(beta), std::sin(beta), r.x, r.y, rx2, ry2, rz2);
   }
 
-  // The force of MODEL.md 5 for vessel s and floe f meeting at c with normal n (vessel into floe),
+  // The force of docs/model.md 5 for vessel s and floe f meeting at c with normal n (vessel into floe),
   // closing speed vn (m/s), frame angle beta and apex angle phi (rad).
   GEM_HD static Result evaluate(const Params& p, const PairBody& s, const PairBody& f, Vec2 c, Vec2 n, Real vn,
                                 Real beta, Real phi) {

@@ -1,4 +1,4 @@
-// Wind: [events.wind], off unless the scenario gives the table (SCENARIO.md).
+// Wind: [events.wind], off unless the scenario gives the table (docs/scenario.md).
 #include "events/environmental_force_params.hpp"
 
 namespace gem {

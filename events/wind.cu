@@ -1,4 +1,4 @@
-// wind: the CUDA driver, the same evaluator as the CPU (DESIGN.md "Writing an event").
+// wind: the CUDA driver, the same evaluator as the CPU (docs/architecture.md "Writing an event").
 #include "events/environmental_force.hpp"
 #include "framework/api/cuda_events.hpp"
 #include "framework/api/registry.hpp"

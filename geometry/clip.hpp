@@ -1,4 +1,4 @@
-// Overlap polygon P ∩ Q of two convex polygons (MODEL.md 3), with the provenance of every vertex
+// Overlap polygon P ∩ Q of two convex polygons (docs/model.md 3), with the provenance of every vertex
 // so that the points where the two boundaries cross (the ends of the line of contact) can be read
 // off the result.
 //

@@ -1,5 +1,5 @@
 // Project-wide compile-time settings shared by host and device code.
-// This is the one place GEM_HD and gem::Real are defined (DESIGN.md "Writing an event").
+// This is the one place GEM_HD and gem::Real are defined (docs/architecture.md "Writing an event").
 #pragma once
 
 #if defined(__CUDACC__)
@@ -20,7 +20,7 @@ using Real = double;
 #define GEM_REAL_NAME "double"
 #endif
 
-// Floes have 3 to 19 vertices (MODEL.md 1: "fewer than twenty sides"); the vessel and walls
+// Floes have 3 to 19 vertices (docs/model.md 1: "fewer than twenty sides"); the vessel and walls
 // may use up to kMaxVertices. Every polygon is stored with this fixed stride.
 constexpr int kMaxFloeVertices = 19;
 constexpr int kMaxVertices = 24;

@@ -1,4 +1,4 @@
-// The contact of two convex polygons (MODEL.md 3, thesis 3.2.1 and Figure 3.3): overlap area A_0,
+// The contact of two convex polygons (docs/model.md 3, thesis 3.2.1 and Figure 3.3): overlap area A_0,
 // line of contact between the two boundary crossing points, its midpoint c, length w and the
 // normal n from P into Q, with the degenerate cases made definite.
 #pragma once
@@ -52,9 +52,9 @@ GEM_HD inline int apexVertex(const ClipVertex* v, int k, signed char tag, Vec2 c
 // Contact of convex counter-clockwise polygons p and q (world coordinates) with area centroids
 // centroidP and centroidQ. Not touching (all fields zero, apex indices -1) when the separating-axis
 // test finds a gap or the overlap is a sliver thinner than kGeomRelTol times its length scale:
-// touching without area is no contact (MODEL.md 3).
+// touching without area is no contact (docs/model.md 3).
 //
-// Line of contact (MODEL.md 3):
+// Line of contact (docs/model.md 3):
 // - 2 crossing points: they are its ends.
 // - more than 2 (e.g. two triangles crossing as a star): (choice) the two farthest apart.
 // - fewer than 2 (one polygon inside the other, or a lone numerical crossing): n along the

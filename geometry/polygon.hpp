@@ -1,4 +1,4 @@
-// Convex polygon basics: signed area, centroid, second moments and principal axes (MODEL.md 1,
+// Convex polygon basics: signed area, centroid, second moments and principal axes (docs/model.md 1,
 // thesis A.1 to A.16), convexity, orientation and the body-to-world transform.
 // Polygons are plain arrays (pointer + count): no containers, so the same code runs on the GPU.
 #pragma once
@@ -37,7 +37,7 @@ struct MassProperties {
   Real area;            // m^2 (positive)
   Vec2 centroid;        // area centroid, input coordinates
   Real jxx, jyy, jxy;   // area moments about the centroid, axes of the input (A.6 to A.8), m^4
-  Real principalAngle;  // theta_p, rad (MODEL.md 1: 1/2 atan2(-2 J_xy, J_xx - J_yy))
+  Real principalAngle;  // theta_p, rad (docs/model.md 1: 1/2 atan2(-2 J_xy, J_xx - J_yy))
   Real ixx, iyy;        // principal area moments (A.11, A.12), m^4
   Real izz;             // polar moment about the centroid, I_xx + I_yy, m^4
 };
@@ -67,7 +67,7 @@ GEM_HD inline MassProperties massProperties(const Vec2* v, int n) {
   return p;
 }
 
-// Reverses the vertex order in place (clockwise input is reversed, not rejected: MODEL.md 1).
+// Reverses the vertex order in place (clockwise input is reversed, not rejected: docs/model.md 1).
 GEM_HD inline void reverseOrder(Vec2* v, int n) {
   for (int i = 0, j = n - 1; i < j; ++i, --j) {
     Vec2 t = v[i];
@@ -124,7 +124,7 @@ GEM_HD inline bool boxesOverlap(const Box& a, const Box& b) {
   return !(a.x0 > b.x1 || b.x0 > a.x1 || a.y0 > b.y1 || b.y0 > a.y1);
 }
 
-// Farthest vertex distance from the body origin: the bounding radius of MODEL.md 9.
+// Farthest vertex distance from the body origin: the bounding radius of docs/model.md 9.
 GEM_HD inline Real boundingRadius(const Vec2* local, int n) {
   Real r2 = 0;
   for (int i = 0; i < n; ++i) r2 = norm2(local[i]) > r2 ? norm2(local[i]) : r2;

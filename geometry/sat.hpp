@@ -1,4 +1,4 @@
-// Separating-axis overlap test of two convex polygons (MODEL.md 3: "in contact when they overlap
+// Separating-axis overlap test of two convex polygons (docs/model.md 3: "in contact when they overlap
 // (separating axis test over the edge normals of both)"), and the geometry tolerance shared by the
 // clipping, contact and split headers.
 #pragma once

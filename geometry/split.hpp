@@ -1,4 +1,4 @@
-// Cutting a convex polygon in two along a straight line: the flexural break of MODEL.md 6 cuts
+// Cutting a convex polygon in two along a straight line: the flexural break of docs/model.md 6 cuts
 // the floe perpendicular to n at distance L_cusp from the contact point.
 #pragma once
 #include <cmath>

@@ -1,5 +1,5 @@
 // Ear clipping of a polygon into triangles and the triangle-triangle overlap test of the
-// triangulation-mesh broadphase (MODEL.md 9, thesis 5.3.1).
+// triangulation-mesh broadphase (docs/model.md 9, thesis 5.3.1).
 #pragma once
 #include <cmath>
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Stages a build for the GPU machine (shared/GPU.md): builds here for compute capability 9.0, then
+# Stages a build for the GPU machine (docs/performance.md 1.3): builds here for compute capability 9.0, then
 # copies into .gpu-stage/ (git-ignored) the gem binary, the test binaries, the project's shared
 # libraries and every non-system, non-CUDA shared library they need, the scenarios, and a driver
 # script. On the GPU machine:  bash .gpu-stage/run.sh [OUT]   (OUT defaults to $OUT, else ./gpu-out)

@@ -40,7 +40,7 @@ cut_columns() { cut -d, -f"$2" "$1"; }
   echo "## 1. Calibration impacts (thesis 6.2.2.1, Figures 6.28, 6.29)"
   echo
   echo "32 cases: a 10 m x 10 m floe corner- or face-first against four bow edges, 2 and 5 m/s, 0.7 and 1.2 m."
-  echo "The force GEM logs at contact onset against a direct evaluation of MODEL.md 5 from the case's inputs."
+  echo "The force GEM logs at contact onset against a direct evaluation of docs/model.md 5 from the case's inputs."
   echo "The thesis reports \"some small differences\" between GEM and its spreadsheet."
   echo
   echo '```'

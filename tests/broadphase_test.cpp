@@ -1,4 +1,4 @@
-// Broadphase strategies (MODEL.md 9): every strategy, reached through the registry by name, must
+// Broadphase strategies (docs/model.md 9): every strategy, reached through the registry by name, must
 // propose a superset of the truly overlapping pairs (exact separating axes, written here), sorted,
 // unique, a < b, never two walls; keep doing so while bodies move (the rebuild rule), rebuild only
 // when the rule asks, and after invalidate(). Filtered by exact overlap, all agree with all_pairs.

@@ -1,5 +1,5 @@
 // The calibration impacts (thesis 6.2.2.1, issue 5 item 2): for each of the 32 cases the force GEM
-// logs at contact onset agrees with the direct evaluation of MODEL.md 5 within 2 %.
+// logs at contact onset agrees with the direct evaluation of docs/model.md 5 within 2 %.
 #include <gtest/gtest.h>
 
 #include "framework/app/calibration.hpp"

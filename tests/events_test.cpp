@@ -1,4 +1,4 @@
-// The analytic validation cases of MODEL.md 10 for each event, run through the real scheduler.
+// The analytic validation cases of docs/model.md 10 for each event, run through the real scheduler.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Small exact cases of the geometry headers (DESIGN.md "Tests": a square hitting a square first).
+// Small exact cases of the geometry headers (docs/architecture.md "Tests": a square hitting a square first).
 // The random cross-checks against CGAL's exact kernel are in tests/cgal/geometry_cgal_test.cpp.
 #include <gtest/gtest.h>
 
@@ -46,7 +46,7 @@ Poly regular(int n, Real r, Real phase = 0, Vec2 c = {0, 0}) {
 
 }  // namespace
 
-// ---- mass properties (MODEL.md 1) ----
+// ---- mass properties (docs/model.md 1) ----
 
 TEST(Geometry, UnitSquareMassProperties) {
   Poly s = rect(0, 0, 1, 1);
@@ -174,7 +174,7 @@ TEST(Geometry, ClipSquaresTagsCrossings) {
   EXPECT_EQ(clipConvex(a.data(), 4, edge.data(), 4, v), 0);
 }
 
-// ---- contact (MODEL.md 3) ----
+// ---- contact (docs/model.md 3) ----
 
 TEST(Geometry, SquareHitsSquare) {
   Poly a = rect(0, 0, 1, 1), b = rect(0.5, 0.5, 1.5, 1.5);
@@ -326,7 +326,7 @@ TEST(Geometry, NormalPointsFromPIntoQ) {
   expectVec(r.normal, {-1, 0});
 }
 
-// ---- ear clipping and triangle overlap (MODEL.md 9) ----
+// ---- ear clipping and triangle overlap (docs/model.md 9) ----
 
 namespace {
 
@@ -399,7 +399,7 @@ TEST(Geometry, TrianglesOverlap) {
   EXPECT_TRUE(trianglesOverlap(tiny, a, 0));
 }
 
-// ---- splitting (MODEL.md 6) ----
+// ---- splitting (docs/model.md 6) ----
 
 TEST(Geometry, SplitSquare) {
   Poly s = rect(0, 0, 1, 1);

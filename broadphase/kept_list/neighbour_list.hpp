@@ -1,4 +1,4 @@
-// The machinery every kept-list broadphase shares (MODEL.md 9, thesis 5.1 and 5.4): a flat list of
+// The machinery every kept-list broadphase shares (docs/model.md 9, thesis 5.1 and 5.4): a flat list of
 // pairs built with a skin, the never-miss rebuild rule, and the per-step filter that turns the kept
 // list into this step's candidates.
 //
@@ -6,7 +6,7 @@
 // R_a + R_b + skin at the build. Two bodies can only touch while their bounding circles overlap,
 // |c_a - c_b| <= R_a + R_b, and since the build the centroid distance has changed by at most
 // d_a + d_b, d the bound on how far any point of a body has moved. So while d_a + d_b <= skin for
-// every pair, every touching pair is still listed. MODEL.md's rule ("rebuild before any body can
+// every pair, every touching pair is still listed. docs/model.md's rule ("rebuild before any body can
 // have moved more than half the skin") keeps every d <= skin / 2, which guarantees that.
 //
 // Here a body that passes half the skin does not force a rebuild at once: it becomes *direct*,

@@ -1,5 +1,5 @@
 // Every CUDA call is checked: a failure throws std::runtime_error naming the file, line and the
-// runtime's message (GPU.md: "check every CUDA call's status and the last error after each launch").
+// runtime's message (docs/performance.md 1.3: check every CUDA call's status and the last error after each launch).
 #pragma once
 #include <cuda_runtime.h>
 

@@ -2,7 +2,7 @@
 // A solo event sees one body (SoloBody) and adds to its velocity change (VelocityChange).
 // A two-body event sees both bodies and their contact (PairBody, PairContact) and adds to the
 // contact's own impulse slot (PairSlot); each body later sums its slots in a fixed order, so no
-// floating-point atomics are ever needed (DESIGN.md "Writing an event").
+// floating-point atomics are ever needed (docs/architecture.md "Writing an event").
 #pragma once
 #include <cstdint>
 
@@ -32,13 +32,13 @@ struct SoloBody {
   Real mass, area, thickness;
 };
 
-// What solo events add up for one body during a step (MODEL.md 2: velocities change first).
+// What solo events add up for one body during a step (docs/model.md 2: velocities change first).
 struct VelocityChange {
   Vec2 dv;
   Real domega;
 };
 
-// One body as the motion event sees it: it owns the position update (MODEL.md 2).
+// One body as the motion event sees it: it owns the position update (docs/model.md 2).
 struct MotionBody {
   BodyKind kind;
   int dof;
@@ -59,7 +59,7 @@ struct PairBody {
   Real omega;
   Real mass, invMass, invInertia;
   Real gyration2;                // r_z^2, m^2
-  Real gyrationX2, gyrationY2;   // principal r_x^2, r_y^2, m^2 (MODEL.md 5)
+  Real gyrationX2, gyrationY2;   // principal r_x^2, r_y^2, m^2 (docs/model.md 5)
   Real principalAngle;           // world angle of the principal x axis, rad
   Real area, thickness;
   const Vec2* vertices;
@@ -130,7 +130,7 @@ constexpr int kDefault = 300;    // after the built-in impulses: e.g. friction r
 constexpr int kObservers = 400;  // events that only read and record (ship_impact's log)
 }  // namespace event_order
 
-// A ship-ice impact at contact onset (MODEL.md 5), one row of impacts.csv.
+// A ship-ice impact at contact onset (docs/model.md 5), one row of impacts.csv.
 struct ImpactRecord {
   Real time;
   std::int64_t floeId;
@@ -143,7 +143,7 @@ struct ImpactRecord {
   bool broke;
 };
 
-// A floe to be cut by the flexural_breaking event in the topology phase (MODEL.md 6).
+// A floe to be cut by the flexural_breaking event in the topology phase (docs/model.md 6).
 struct BreakRequest {
   std::int64_t floeId;
   Vec2 point;      // contact point c
@@ -199,7 +199,7 @@ struct RecordSink {
   }
 };
 
-// 1 / effective mass of a body for an impulse along unit n at point c (MODEL.md 4:
+// 1 / effective mass of a body for an impulse along unit n at point c (docs/model.md 4:
 // Co = l^2 + m^2 + eta^2 / r^2, M_e = M / Co). A 1-DOF vessel moves only along its heading, so
 // only the surge component of n counts and it cannot turn (choice: the constraint carries the
 // rest); walls are immovable.
@@ -219,7 +219,7 @@ GEM_HD inline Vec2 pointVelocity(const PairBody& b, Vec2 c) {
   return b.velocity + crossZ(b.omega, c - b.position);
 }
 
-// Closing speed along n at c, positive when the contact points approach (MODEL.md 4).
+// Closing speed along n at c, positive when the contact points approach (docs/model.md 4).
 GEM_HD inline Real closingSpeed(const PairBody& a, const PairBody& b, const PairContact& contact) {
   Vec2 c = contact.geometry.point;
   return dot(pointVelocity(a, c) - pointVelocity(b, c), contact.geometry.normal);

@@ -1,5 +1,5 @@
 // One registry of events and broadphases by name: built-ins register themselves at load time
-// with the macros below; plugins use the very same macros (DESIGN.md "Plugins", plugin_api.hpp).
+// with the macros below; plugins use the very same macros (docs/architecture.md "Plugins", plugin_api.hpp).
 #pragma once
 #include <filesystem>
 #include <functional>
@@ -49,7 +49,7 @@ struct MotionPhaseData {
   StepContext ctx;
 };
 
-// Topology events run on the host after motion (MODEL.md 8, phase 6). The contract, which lets the
+// Topology events run on the host after motion (docs/model.md 8, phase 6). The contract, which lets the
 // CUDA backend keep its world on the device: an event reads the state of the bodies its requests
 // name (breaks[k].floeId) and only theirs (the CUDA backend fetches just those rows), and changes
 // the bodies only through World::removeBodies and World::addBody (the device then replays the edit).
@@ -141,7 +141,7 @@ class Registry {
   std::unique_ptr<Staging> m_staging;  // non-null while a plugin registers
 };
 
-// The CPU drivers: the only loops over bodies and contacts (DESIGN.md "Folders").
+// The CPU drivers: the only loops over bodies and contacts (docs/architecture.md "Rooms").
 template <class Event>
 class CpuPairDriver final : public EventInstance {
  public:

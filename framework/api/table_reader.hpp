@@ -1,6 +1,6 @@
 // Strict reading of one TOML table (a scenario section or an event's parameters): every key read
 // is checked for type and range, and finish() rejects any key nobody asked for, listing the valid
-// ones, so a typo can never be silently ignored (SCENARIO.md). Errors name file:line:column.
+// ones, so a typo can never be silently ignored (docs/scenario.md). Errors name file:line:column.
 #pragma once
 #include <cstdint>
 #include <optional>

@@ -38,7 +38,7 @@ std::vector<int> bowEdges(const HullGeometry& hull) {
   return edges;
 }
 
-// MODEL.md 5 written out directly for a vessel with heading 0 and a square floe (isotropic in
+// docs/model.md 5 written out directly for a vessel with heading 0 and a square floe (isotropic in
 // plane, so its principal frame does not matter): the thesis's spreadsheet.
 void directEvaluation(const Scenario& base, const EdgeFrame& edge, const CalibrationCase& c, Real apexDeg,
                       CalibrationResult& out) {
@@ -109,7 +109,7 @@ CalibrationResult runCalibrationCase(const Scenario& base, const CalibrationCase
   if (signedArea(floe.vertices.data(), 4) < 0) reverseOrder(floe.vertices.data(), 4);
   s.floes = {floe};
   // The apex angle the direct evaluation uses: a corner is 90 deg; a face wider than the hull edge
-  // has no vertex inside the hull (180 deg, MODEL.md 5), a narrower one puts its corners inside.
+  // has no vertex inside the hull (180 deg, docs/model.md 5), a narrower one puts its corners inside.
   result.apexDeg = c.corner || kFloeSide < edge.length ? 90 : 180;
   result.frameAngleDeg = edge.frameAngleDeg;
   directEvaluation(s, edge, c, result.apexDeg, result);

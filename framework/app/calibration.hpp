@@ -1,7 +1,7 @@
 // gem calibrate: the impact algorithm check of thesis 6.2.2.1. A 10 m x 10 m floe is placed in
 // front of each of four starboard bow edges, corner-first or face-first, and struck at two speeds
 // and two thicknesses (32 cases). The force GEM logs at contact onset is compared with a direct
-// evaluation of MODEL.md 5 from the case's own inputs: the hull edge's normal, frame angle and
+// evaluation of docs/model.md 5 from the case's own inputs: the hull edge's normal, frame angle and
 // midpoint, the floe's apex angle and mass properties, and the ship's speed (the thesis's
 // spreadsheet). The direct evaluation is written out here on its own, not through ShipImpact.
 #pragma once

@@ -1,4 +1,4 @@
-// The gem command (SCENARIO.md "Command line"): run, check, info, bench.
+// The gem command (docs/scenario.md "Command line"): run, check, info, bench.
 // Exit status: 0 success; 2 bad input (with file, line and column or key); 1 any other failure.
 #include <unistd.h>
 

@@ -29,7 +29,7 @@ struct LoaderState {
   std::mutex mutex;
   std::vector<LoadedPlugin> plugins;
   // Never destroyed, so never unloaded: the registry's factories and every object they made run
-  // code of these libraries, up to and past the end of main (DESIGN.md "Plugins").
+  // code of these libraries, up to and past the end of main (docs/architecture.md "Plugins").
   std::vector<boost::dll::shared_library> libraries;
   bool environmentLoaded = false;
 };

@@ -1,4 +1,4 @@
-// Loads plugins (DESIGN.md "Plugins", docs/plugins.md): shared libraries that add events and
+// Loads plugins (docs/architecture.md "Plugins", docs/plugins.md): shared libraries that add events and
 // broadphases to the one Registry. The library's descriptor is checked before anything of it runs
 // but its static initializers; a mismatch, a missing symbol or a name clash is an InputError
 // (exit status 2) naming the file and the cause. Libraries are never unloaded.

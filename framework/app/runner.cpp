@@ -82,7 +82,7 @@ std::string summaryJson(const RunSummary& s) {
 
 namespace {
 
-// One run's outputs, step by step (the observers, MODEL.md 8 phase 7): opened when it starts,
+// One run's outputs, step by step (the observers, docs/model.md 8 phase 7): opened when it starts,
 // a row per step, the summary when it ends, and what it wrote kept if it fails.
 class ScenarioRun {
  public:

@@ -1,5 +1,5 @@
-// Runs a scenario to its end and writes every output of SCENARIO.md into the run folder (the
-// observers, MODEL.md 8 phase 7). Files are written under temporary names and renamed, so a
+// Runs a scenario to its end and writes every output of docs/scenario.md into the run folder (the
+// observers, docs/model.md 8 phase 7). Files are written under temporary names and renamed, so a
 // crash leaves only whole files; summary.json is written last, and only after a complete run.
 #pragma once
 #include <functional>

@@ -1,7 +1,7 @@
 // Generated pack-ice fields (thesis 6.2.1.1.1, Table 6.1, and the load study of 6.2.2.2):
 // random convex floes of a given size distribution and concentration, or a regular array of
 // slightly rotated equal hexagons. Both are deterministic for a given seed on every standard
-// library, and every floe starts inside the domain, at least minGap from every other (MODEL.md 1:
+// library, and every floe starts inside the domain, at least minGap from every other (docs/model.md 1:
 // bodies never start in contact). Defined in random_convex_field.cpp and hexagon_field.cpp.
 #pragma once
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Whole-file writes (DESIGN.md "Scenario and outputs"): every output file is written under a
+// Whole-file writes (docs/architecture.md "Scenario and outputs"): every output file is written under a
 // temporary name beside its final path and renamed onto it only once it is complete. rename(2)
 // within one directory is atomic, so a run that crashes (or is killed) leaves either the previous
 // whole file or the new whole file, never a torn one. No fsync: this guards against a crash of the

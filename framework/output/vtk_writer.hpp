@@ -1,4 +1,4 @@
-// ParaView output (SCENARIO.md "Outputs"): one VTK XML PolyData file per frame,
+// ParaView output (docs/scenario.md "Outputs"): one VTK XML PolyData file per frame,
 // runDir/frames/frame_NNNNNN.vtp, and the time series runDir/frames.pvd that lists them.
 // Each body is one polygon cell; points are its world vertices (z = 0). Cell data: id (Int64),
 // kind (Int32: 0 floe, 1 vessel, 2 wall), thickness (m), velocity (m/s, 3 components, z = 0),

@@ -153,7 +153,7 @@ void readVessel(TableReader& t, Scenario& s) {
   if (v.dof == 2) t.fail("dof", "must be 1 (surge) or 3 (surge, sway, yaw)");
   v.bollardThrust = t.getNonNegative("bollard_thrust", v.bollardThrust);
   v.openWaterSpeed = t.getPositive("open_water_speed", openWaterSpeedFor(v.bollardThrust));
-  v.speed = t.getNonNegative("speed", v.openWaterSpeed);  // MODEL.md 7: starts at V_ow
+  v.speed = t.getNonNegative("speed", v.openWaterSpeed);  // docs/model.md 7: starts at V_ow
   auto hull = t.findPoints("vertices");
   auto frames = t.findReals("frame_angle_deg");
   if (hull) {

@@ -1,4 +1,4 @@
-// A scenario: everything one run needs, read from a TOML file (SCENARIO.md) with --set overrides.
+// A scenario: everything one run needs, read from a TOML file (docs/scenario.md) with --set overrides.
 // Loading validates every key, type and range; errors are InputError with file:line:column.
 #pragma once
 #include <cstdint>

@@ -26,12 +26,12 @@ void validateBodySpec(BodySpec& spec, int maxVertices) {
     throw InputError(fmt::format("{}: velocity must be finite", spec.origin));
   if (!(spec.thickness > 0) || !std::isfinite(spec.thickness))
     throw InputError(fmt::format("{}: thickness must be a positive number, got {}", spec.origin, spec.thickness));
-  if (signedArea(spec.vertices.data(), n) < 0) reverseOrder(spec.vertices.data(), n);  // MODEL.md 1
+  if (signedArea(spec.vertices.data(), n) < 0) reverseOrder(spec.vertices.data(), n);  // docs/model.md 1
   if (!isStrictlyConvexCCW(spec.vertices.data(), n, Real(1e-9)))
     throw InputError(fmt::format("{}: the polygon is not convex (or is self-intersecting or has repeated or collinear vertices)", spec.origin));
 }
 
-// Static walls along the long sides of the domain (SCENARIO.md [domain] walls): the channel. They
+// Static walls along the long sides of the domain (docs/scenario.md [domain] walls): the channel. They
 // reach past both ends so that a vessel starting before the field is already between them.
 static void addWalls(const Scenario& s, std::vector<BodySpec>& bodies) {
   const Real margin = std::max<Real>(2 * s.vessel.length, 50);
@@ -93,7 +93,7 @@ World buildWorld(const Scenario& s) {
     origins.push_back("vessel");
   }
 
-  // Bodies never start in contact (MODEL.md 1): any conservative broadphase + the exact contact.
+  // Bodies never start in contact (docs/model.md 1): any conservative broadphase + the exact contact.
   auto broadphase = Registry::global().broadphase("variable_radius").make(BroadphaseSettings{0, 0, 0});
   std::vector<CandidatePair> pairs;
   broadphase->findCandidates(world, pairs);

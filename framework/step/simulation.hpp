@@ -1,4 +1,4 @@
-// The GEM scheduler with the CPU driver: one step is the fixed phases of MODEL.md 8.
+// The GEM scheduler with the CPU driver: one step is the fixed phases of docs/model.md 8.
 //   1 broadphase  2 narrowphase  3 two-body events  4 solo events  5 motion  6 topology
 // (7, the observers, live in the runner). Events come from the registry by name.
 #pragma once

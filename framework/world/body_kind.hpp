@@ -1,4 +1,4 @@
-// The kinds of body (MODEL.md 1). Host+device.
+// The kinds of body (docs/model.md 1). Host+device.
 #pragma once
 #include <cstdint>
 

@@ -1,4 +1,4 @@
-// Physical constants shared by host and device code (MODEL.md 1, 4, 7). Values that a researcher
+// Physical constants shared by host and device code (docs/model.md 1, 4, 7). Values that a researcher
 // may want to change are event parameters instead; these are the defaults they start from.
 #pragma once
 #include "geometry/config.hpp"

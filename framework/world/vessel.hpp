@@ -36,7 +36,7 @@ struct HullGeometry {
 
 HullGeometry hullGeometry(const VesselSpec& vessel);
 
-// r_z^2 of the vessel in 2D: r_y = r_z = 0.25 L (MODEL.md 1, A.17-A.20).
+// r_z^2 of the vessel in 2D: r_y = r_z = 0.25 L (docs/model.md 1, A.17-A.20).
 inline Real vesselYawGyration2(Real length) { return Real(0.0625) * length * length; }
 
 // Adds the vessel to the world at its position and heading, moving at its initial speed; sets its

@@ -37,7 +37,7 @@ int World::addBody(const BodySpec& spec) {
   omega.push_back(spec.angularVelocity);
   area.push_back(mp.area);
   thickness.push_back(spec.thickness);
-  const Real m = kRhoIce * mp.area * spec.thickness;  // MODEL.md 1; the vessel's mass is set by its owner
+  const Real m = kRhoIce * mp.area * spec.thickness;  // docs/model.md 1; the vessel's mass is set by its owner
   mass.push_back(m);
   const bool immovable = spec.kind == BodyKind::Wall;
   invMass.push_back(immovable ? Real(0) : Real(1) / m);

@@ -1,4 +1,4 @@
-// The world state: every body as structure of arrays (DESIGN.md "Speed habits"), in Real.
+// The world state: every body as structure of arrays (docs/architecture.md "Speed habits"), in Real.
 // Index i is a body's slot in the arrays; id[i] is its stable identity for outputs, which never
 // changes and is never reused, even when floes break or leave as rubble.
 #pragma once
@@ -57,14 +57,14 @@ struct World {
   }
 
   // Adds a body from world-coordinate vertices (already validated: convex, CCW, finite).
-  // Floe mass is rho_ice * area * thickness (MODEL.md 1); walls get infinite mass.
+  // Floe mass is rho_ice * area * thickness (docs/model.md 1); walls get infinite mass.
   int addBody(const BodySpec& spec);
   // Removes the bodies whose flag is set, keeping the order of the others.
   void removeBodies(const std::vector<char>& remove);
   // Reorders all arrays by the permutation (new slot k holds old slot order[k]).
   void permute(const std::vector<int>& order);
   // The order of the bodies along a Morton (Z-order) curve through their centroids: neighbours in
-  // space become neighbours in memory (DESIGN.md "Speed habits"). Ties keep slot order.
+  // space become neighbours in memory (docs/architecture.md "Speed habits"). Ties keep slot order.
   std::vector<int> curveOrder() const;  // sorted by curveKey, ties by slot
   // Total mass of the floes, kg.
   double floeMass() const;

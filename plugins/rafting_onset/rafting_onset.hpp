@@ -6,7 +6,7 @@
 //                       and  V_c >= min_closing_speed                 [m/s]
 //                       and  min(h_a, h_b) <= max_thickness           [m]
 //
-// V_c is the closing speed of the contact points along the normal (MODEL.md 4). Each onset is a
+// V_c is the closing speed of the contact points along the normal (docs/model.md 4). Each onset is a
 // LogRecord on the event's log channel (framework/api/log_channel.hpp): apply() is the same code on
 // the CPU and the GPU, and the host writes each record as a row of rafting.csv in the run folder,
 // in contact order, after the step.

@@ -5,7 +5,7 @@
 //   tau   = rho_w C_w |U - v| (U - v)                                     [N/m^2]
 //   dv    = tau dt / (rho_ice h)                                          [m/s]
 //
-// The stress is the bulk formula of the built-in current event (MODEL.md 7, A.108 to A.113) with
+// The stress is the bulk formula of the built-in current event (docs/model.md 7, A.108 to A.113) with
 // U taken at the floe's centroid instead of one U for the whole field. Floes only.
 #pragma once
 #include <cmath>

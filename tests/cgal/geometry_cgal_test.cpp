@@ -1,4 +1,4 @@
-// Property tests of the geometry headers against CGAL's exact kernel (DESIGN.md "Tests"): random
+// Property tests of the geometry headers against CGAL's exact kernel (docs/architecture.md "Tests"): random
 // convex polygons (random points -> convex hull, 3 to 19 vertices, 0.5 to 20 m), the second placed
 // near the first so that most pairs overlap. Every check runs in both argument orders. The inputs
 // are the same Real values on both sides, so every difference is our rounding or our bug.
@@ -132,7 +132,7 @@ Poly simplified(Poly p, double tol) {
   return p;
 }
 
-// Exact area, centroid and second moments about the exact centroid (MODEL.md 1, A.1 to A.8), in
+// Exact area, centroid and second moments about the exact centroid (docs/model.md 1, A.1 to A.8), in
 // plain GMP rationals (the lazy kernel number would build a long expression DAG here).
 struct ExactMass {
   CGAL::Gmpq area, cx, cy, jxx, jyy, jxy;

@@ -1,6 +1,6 @@
 // Device broadphases (framework/api/device_broadphase.hpp, broadphase/*.cu): every strategy gives
 // the very trajectories of the device grid, bit for bit, since the pairs are sorted by (a, b) and the
-// narrowphase drops what the CPU prefilter drops; kept lists rebuild on the device by MODEL.md 9's
+// narrowphase drops what the CPU prefilter drops; kept lists rebuild on the device by docs/model.md 9's
 // rule; a plugin's broadphase runs on the device with its own device part, and one without a device
 // part is refused by cuda and falls back to the CPU under auto. Device runs skip, visibly, where no
 // CUDA device exists.
