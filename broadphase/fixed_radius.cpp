@@ -15,6 +15,7 @@ namespace {
 
 class FixedRadius final : public KeptListBroadphase {
  public:
+  static constexpr const char* kSettings[] = {"skin", "fixed_radius"};  // docs/scenario.md [broadphase.NAME]
   explicit FixedRadius(const BroadphaseSettings& s)
       : KeptListBroadphase(checkedSettings(s).skin), m_fixedRadius(s.fixedRadius) {}
   std::string name() const override { return "fixed_radius"; }

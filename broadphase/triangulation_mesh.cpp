@@ -31,6 +31,7 @@ struct TriangleSet {
 
 class TriangulationMesh final : public KeptListBroadphase {
  public:
+  static constexpr const char* kSettings[] = {"skin"};  // docs/scenario.md [broadphase.NAME]
   explicit TriangulationMesh(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin) {}
   std::string name() const override { return "triangulation_mesh"; }
 

@@ -32,6 +32,7 @@ namespace {
 
 class UniformGrid final : public KeptListBroadphase {
  public:
+  static constexpr const char* kSettings[] = {"skin", "cell_size"};  // docs/scenario.md [broadphase.NAME]
   explicit UniformGrid(const BroadphaseSettings& s)
       : KeptListBroadphase(checkedSettings(s).skin), m_cellSize(s.cellSize) {}
   std::string name() const override { return "uniform_grid"; }

@@ -12,6 +12,7 @@ namespace {
 
 class VariableRadius final : public KeptListBroadphase {
  public:
+  static constexpr const char* kSettings[] = {"skin"};  // docs/scenario.md [broadphase.NAME]
   explicit VariableRadius(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin) {}
   std::string name() const override { return "variable_radius"; }
 

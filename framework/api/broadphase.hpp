@@ -4,6 +4,7 @@
 // Pairs come out as (a, b) slot indices with a < b, sorted by (a, b): so the contact set and the
 // order in which each body sums its contacts do not depend on the strategy (bit-identical runs).
 #pragma once
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,12 +17,31 @@ struct CandidatePair {
   int a, b;  // slot indices, a < b
 };
 
-// Settings every strategy understands; strategy-specific ones have defaults derived from the world.
+// The settings of the built-in strategies, as a scenario gives them ([broadphase.NAME], or the
+// older [simulation] keys; docs/scenario.md). Each strategy declares the keys it reads
+// (`static constexpr const char* kSettings[] = {"skin", "cell_size"};` in its class, the CPU and
+// the device part each for itself): a key given for a strategy that does not declare it is refused
+// when the scenario is read, and one that a backend's part of the strategy does not honour is
+// refused by that backend, never silently ignored.
 struct BroadphaseSettings {
   Real skin = 2;           // m: extra margin of a kept neighbour list (docs/model.md 9)
   Real fixedRadius = 0;    // m: fixed_radius's global radius; 0 = 2 x the largest bounding radius
   Real cellSize = 0;       // m: uniform_grid's cell size; 0 = the largest bounding diameter + skin
+  std::vector<std::string> given;  // the keys the scenario set ("skin", "cell_size", ...)
 };
+
+// Every setting key any built-in strategy reads.
+inline const std::vector<std::string>& broadphaseSettingKeys() {
+  static const std::vector<std::string> keys{"skin", "fixed_radius", "cell_size"};
+  return keys;
+}
+
+// The keys a strategy class declares (its kSettings), or none.
+template <class Strategy>
+std::vector<std::string> declaredBroadphaseSettings() {
+  if constexpr (requires { Strategy::kSettings; }) return {std::begin(Strategy::kSettings), std::end(Strategy::kSettings)};
+  else return {};
+}
 
 class Broadphase {
  public:

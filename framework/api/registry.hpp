@@ -100,6 +100,7 @@ constexpr int eventOrderOf() {
 struct BroadphaseEntry {
   std::string name, description, origin;
   std::function<std::unique_ptr<Broadphase>(const BroadphaseSettings&)> make;
+  std::vector<std::string> settings;  // the keys of BroadphaseSettings it reads (its kSettings)
 };
 
 class Registry {
@@ -259,12 +260,14 @@ struct RegisterNow {
 #define GEM_REGISTER_TOPOLOGY_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
   GEM_REGISTER_EVENT(::gem::TopologyDriver, ::gem::EventPhase::Topology, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
 
-// Registers a broadphase class constructible from BroadphaseSettings.
+// Registers a broadphase class constructible from BroadphaseSettings; its kSettings, if any, name
+// the settings it reads.
 #define GEM_REGISTER_BROADPHASE(CLASS, NAME, DESCRIPTION)                                                  \
   GEM_REGISTRATION(broadphase_, registry.addBroadphase(::gem::BroadphaseEntry{                             \
       NAME, DESCRIPTION, GEM_ORIGIN,                                                                       \
       [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::Broadphase> {                      \
         return std::make_unique<CLASS>(s);                                                                 \
-      }}))
+      },                                                                                                   \
+      ::gem::declaredBroadphaseSettings<CLASS>()}))
 
 }  // namespace gem

@@ -1,5 +1,6 @@
 #include "framework/scenario/scenario.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -214,7 +215,56 @@ void readPlugins(const toml::array& plugins, TableReader& top, Scenario& s) {
   }
 }
 
+// A strategy's settings from `t` into `settings` (docs/scenario.md [broadphase.NAME]): only the
+// keys the strategy declares; any other broadphase key is refused, naming the strategies that do
+// take it. A key set twice (in [simulation] and in [broadphase.NAME]) is refused too.
+void readBroadphaseSettings(TableReader& t, const BroadphaseEntry& strategy, BroadphaseSettings& settings) {
+  for (const std::string& key : broadphaseSettingKeys()) {
+    if (!t.has(key)) continue;
+    const auto& own = strategy.settings;
+    if (std::find(own.begin(), own.end(), key) == own.end()) {
+      std::vector<std::string> takers;
+      for (const BroadphaseEntry* b : Registry::global().broadphases())
+        if (std::find(b->settings.begin(), b->settings.end(), key) != b->settings.end()) takers.push_back(b->name);
+      t.fail(key, fmt::format("the broadphase \"{}\" has no setting {} ({}); {} take{} it", strategy.name, key,
+                              own.empty() ? "it has no settings" : "its settings: " + fmt::format("{}", fmt::join(own, ", ")),
+                              fmt::join(takers, ", "), takers.size() == 1 ? "s" : ""));
+    }
+    if (std::find(settings.given.begin(), settings.given.end(), key) != settings.given.end())
+      t.fail(key, "given twice: in [simulation] and in [broadphase." + strategy.name + "]; keep one");
+    settings.given.push_back(key);
+    if (key == "skin") settings.skin = t.getNonNegative(key, settings.skin);
+    if (key == "fixed_radius") settings.fixedRadius = t.getNonNegative(key, settings.fixedRadius);
+    if (key == "cell_size") settings.cellSize = t.getNonNegative(key, settings.cellSize);
+  }
+}
+
+// [broadphase.NAME] tables: each names a registered strategy and holds only its settings. The
+// chosen strategy's table applies; another's is still checked (a sweep may switch strategies).
+void readBroadphaseTables(const toml::table& tables, TableReader& top, Scenario& s) {
+  TableReader all(&tables, "broadphase", s.fileName);
+  for (const auto& [name, node] : tables) {
+    const std::string key(name.str());
+    const BroadphaseEntry* strategy = nullptr;
+    try {
+      strategy = &Registry::global().broadphase(key);
+    } catch (const InputError& e) {
+      all.fail(key, e.what());
+    }
+    if (!node.is_table()) all.fail(key, "expected a table [broadphase." + key + "] of the strategy's settings");
+    all.accept(key);
+    TableReader t(node.as_table(), "broadphase." + key, s.fileName);
+    BroadphaseSettings settings = key == s.broadphase ? s.broadphaseSettings : BroadphaseSettings{};
+    readBroadphaseSettings(t, *strategy, settings);
+    t.finish();
+    if (key == s.broadphase) s.broadphaseSettings = settings;
+  }
+  all.finish();
+  (void)top;
+}
+
 }  // namespace
+
 
 const toml::table* Scenario::eventTable(const std::string& name) const {
   const toml::table* events = root["events"].as_table();
@@ -255,15 +305,15 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
       t.fail("broadphase", e.what());
     }
     s.seed = static_cast<std::uint64_t>(t.getInt("seed", 1, 0, INT64_MAX));
-    s.broadphaseSettings.skin = t.getPositive("skin", s.broadphaseSettings.skin);
-    s.broadphaseSettings.fixedRadius = t.getNonNegative("fixed_radius", 0);
-    s.broadphaseSettings.cellSize = t.getNonNegative("cell_size", 0);
+    // The older home of the broadphase settings; [broadphase.NAME] is the strategy's own table.
+    readBroadphaseSettings(t, Registry::global().broadphase(s.broadphase), s.broadphaseSettings);
     s.mortonSort = t.getBool("morton_sort", true);
     s.copyBackEvery = static_cast<int>(t.getInt("copy_back_every", s.copyBackEvery, 1, 100000));
     s.cudaBlockSize = static_cast<int>(t.getInt("cuda_block_size", s.cudaBlockSize, 32, 1024));
     if (s.cudaBlockSize % 32 != 0) t.fail("cuda_block_size", "must be a multiple of 32 (a whole number of warps)");
     t.finish();
   }
+  if (const toml::table* b = top.findTable("broadphase")) readBroadphaseTables(*b, top, s);
   if (const toml::table* d = top.findTable("domain")) {
     TableReader t(d, "domain", s.fileName);
     s.hasDomain = true;
