@@ -29,9 +29,10 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 
 TEST(BroadphaseSettings, TheStrategysOwnTableSetsWhatItDeclares) {
   test::TempDir dir;
-  const Scenario s = test::scenarioFromToml(dir, kBase + "broadphase = \"uniform_grid\"\n[broadphase.uniform_grid]\ncell_size = 30.0\nskin = 1.5\n");
+  const Scenario s = test::scenarioFromToml(dir, kBase + "broadphase = \"uniform_grid\"\n[broadphase.uniform_grid]\ncell_size = 30.0\n");
   EXPECT_EQ(s.broadphaseSettings.cellSize, 30.0);
-  EXPECT_EQ(s.broadphaseSettings.skin, 1.5);
+  const Scenario v = test::scenarioFromToml(dir, kBase + "broadphase = \"variable_radius\"\n[broadphase.variable_radius]\nskin = 1.5\n");
+  EXPECT_EQ(v.broadphaseSettings.skin, 1.5);
   EXPECT_NE(std::find(s.broadphaseSettings.given.begin(), s.broadphaseSettings.given.end(), "cell_size"), s.broadphaseSettings.given.end());
   // The older keys in [simulation] still work for the strategy that declares them.
   const Scenario old = test::scenarioFromToml(dir, kBase + "broadphase = \"fixed_radius\"\nfixed_radius = 12.0\n");
@@ -43,6 +44,9 @@ TEST(BroadphaseSettings, AKeyTheChosenStrategyDoesNotTakeIsRefused) {
   EXPECT_TRUE(contains(e, "simulation.cell_size")) << e;
   EXPECT_TRUE(contains(e, "\"variable_radius\" has no setting cell_size")) << e;
   EXPECT_TRUE(contains(e, "uniform_grid takes it")) << e;
+  // uniform_grid is rebuilt every step, on both backends: it has no skin to set.
+  const std::string g = errorOf(kBase + "broadphase = \"uniform_grid\"\n[broadphase.uniform_grid]\nskin = 1.0\n");
+  EXPECT_TRUE(contains(g, "\"uniform_grid\" has no setting skin")) << g;
   const std::string f = errorOf(kBase + "broadphase = \"all_pairs\"\n[broadphase.all_pairs]\nskin = 1.0\n");
   EXPECT_TRUE(contains(f, "broadphase.all_pairs.skin")) << f;
   EXPECT_TRUE(contains(f, "it has no settings")) << f;
