@@ -1,11 +1,7 @@
 // The convex polygon operations of field_polygon.hpp: area, centroid, half-plane clip, inset, and
 // the corner cuts (cleanup, vertex count, aspect) that shape a power cell into a floe container.
-// No fused multiply-add and no vectorizing, as in every generator file (why: field_shared.hpp).
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
+// Compiled without fused multiply-add or vectorizing, as every generator file (CMakeLists.txt;
+// why: field_shared.hpp).
 
 #include "framework/field/field_polygon.hpp"
 

@@ -1,11 +1,7 @@
 // The helpers both field generators share (field_shared.hpp): the input checks of the domain and
 // the common keys, and the BodySpec output with its ordering along x.
-// No fused multiply-add and no vectorizing, as in every generator file (why: field_shared.hpp).
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
+// Compiled without fused multiply-add or vectorizing, as every generator file (CMakeLists.txt;
+// why: field_shared.hpp).
 
 #include "framework/field/field_shared.hpp"
 

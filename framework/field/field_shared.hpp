@@ -5,13 +5,8 @@
 // The generator computes in double whatever gem::Real is, and with no fused multiply-add, so
 // that the same seed gives the same field whatever the target flags (-march with FMA otherwise
 // changes the rounding; GCC 12 fuses a*b - c*d pairs through the vectorizer even with fp-contract
-// off, hence the second switch). Every .cpp that includes this header therefore starts, before
-// any #include, with:
-//   #if defined(__clang__)
-//   #pragma clang fp contract(off)
-//   #elif defined(__GNUC__)
-//   #pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-//   #endif
+// off, hence the second switch). CMakeLists.txt therefore compiles every .cpp of framework/field/
+// with -ffp-contract=off -fno-tree-vectorize.
 #pragma once
 #include <cmath>
 #include <cstdint>

@@ -1,11 +1,7 @@
 // The floe size distribution (floe_size_distribution.hpp): its moments and quantiles through the
 // standard normal, and the fit of the lognormal parameters to the requested mean and sd.
-// No fused multiply-add and no vectorizing, as in every generator file (why: field_shared.hpp).
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
+// Compiled without fused multiply-add or vectorizing, as every generator file (CMakeLists.txt;
+// why: field_shared.hpp).
 
 #include "framework/field/floe_size_distribution.hpp"
 

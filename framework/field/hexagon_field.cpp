@@ -1,11 +1,7 @@
 // The hexagon field (thesis 6.2.1.1.1): a regular array of equal, slightly rotated hexagons,
 // the layout chosen nearest a regular lattice within the concentration tolerance.
-// No fused multiply-add and no vectorizing, as in every generator file (why: field_shared.hpp).
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
+// Compiled without fused multiply-add or vectorizing, as every generator file (CMakeLists.txt;
+// why: field_shared.hpp).
 
 #include <algorithm>
 #include <cmath>

@@ -1,11 +1,7 @@
 // The power diagram of power_diagram.hpp, one cell at a time (the domain cut by the power
 // bisectors of the sites that can reach it), and the cell measures and Laplacian solve on it.
-// No fused multiply-add and no vectorizing, as in every generator file (why: field_shared.hpp).
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
+// Compiled without fused multiply-add or vectorizing, as every generator file (CMakeLists.txt;
+// why: field_shared.hpp).
 
 #include "framework/field/power_diagram.hpp"
 

@@ -17,12 +17,8 @@
 // whatever gem::Real is: given the same input values, a float build generates the same field,
 // rounded once at the end (and every floe is kept valid after rounding to float).
 // Shared helpers: field_shared.hpp; shapes: field_polygon.hpp; step 3: power_diagram.hpp.
-// No fused multiply-add and no vectorizing, as in every generator file (why: field_shared.hpp).
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
+// Compiled without fused multiply-add or vectorizing, as every generator file (CMakeLists.txt;
+// why: field_shared.hpp).
 
 #include <algorithm>
 #include <cmath>
