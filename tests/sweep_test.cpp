@@ -421,7 +421,13 @@ struct TogetherBackend {
   ~TogetherBackend() {
     // Put back what was there (the real CUDA backend in a CUDA build), or one that is never available.
     if (previous) registerBackend(saved);
-    else registerBackend(BackendEntry{"cuda", [] { return false; }, [] { return std::string("none"); }, nullptr, nullptr});
+    else {
+      BackendEntry none;
+      none.name = "cuda";
+      none.available = [] { return false; };
+      none.deviceName = [] { return std::string("none"); };
+      registerBackend(none);
+    }
   }
 };
 

@@ -13,9 +13,13 @@ namespace gem {
 static std::map<std::string, BackendEntry>& backends() {
   static std::map<std::string, BackendEntry> table = [] {
     std::map<std::string, BackendEntry> t;
-    t["cpu"] = BackendEntry{"cpu", [] { return true; }, [] { return std::string("cpu"); },
-                            [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); },
-                            nullptr};  // the CPU backend's workers share the cores: no device to choose
+    BackendEntry cpu;
+    cpu.name = "cpu";
+    cpu.available = [] { return true; };
+    cpu.deviceName = [] { return std::string("cpu"); };
+    cpu.make = [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); };
+    // No useDeviceForWorker (the CPU backend's workers share the cores) and no batching.
+    t["cpu"] = cpu;
     return t;
   }();
   return table;
