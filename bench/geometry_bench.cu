@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "framework/api/cuda_check.hpp"
+#include "framework/api/device_array.hpp"
 #include "bench/geometry_bench.hpp"
 #include "geometry/contact.hpp"
 #include "geometry/triangulate.hpp"
@@ -39,15 +40,8 @@ __global__ void earClipKernel(int polygons, const Vec2* v, const int* n, int* co
   count[i] = earClip(v + static_cast<size_t>(i) * kMaxVertices, n[i], reinterpret_cast<int(*)[3]>(tri + static_cast<size_t>(i) * kTri));
 }
 
-// A device allocation freed on scope exit, so that a failed check leaks nothing.
-template <class T>
-struct DeviceArray {
-  T* ptr = nullptr;
-  explicit DeviceArray(size_t n) { GEM_CUDA_CHECK(cudaMalloc(&ptr, std::max<size_t>(n, 1) * sizeof(T))); }
-  ~DeviceArray() { cudaFree(ptr); }
-  DeviceArray(const DeviceArray&) = delete;
-  DeviceArray& operator=(const DeviceArray&) = delete;
-};
+// Device allocations of a fixed size, freed on scope exit, so that a failed check leaks nothing.
+using cuda::DeviceArray;
 
 template <class T>
 struct PinnedArray {
@@ -130,14 +124,14 @@ DeviceTiming timeContacts(const ContactBenchInput& in, int reps, std::vector<Con
   DeviceArray<Vec2> sp(nv), sq(nv), scp(n), scq(n);
   DeviceArray<int> snp(n), snq(n);
   DeviceArray<Contact> sres(n);
-  GEM_CUDA_CHECK(cudaMemcpy(p.ptr, hp.ptr, total * kContactBenchStride * sizeof(Vec2), cudaMemcpyHostToDevice));
-  GEM_CUDA_CHECK(cudaMemcpy(q.ptr, hq.ptr, total * kContactBenchStride * sizeof(Vec2), cudaMemcpyHostToDevice));
-  GEM_CUDA_CHECK(cudaMemcpy(cp.ptr, hcp.ptr, total * sizeof(Vec2), cudaMemcpyHostToDevice));
-  GEM_CUDA_CHECK(cudaMemcpy(cq.ptr, hcq.ptr, total * sizeof(Vec2), cudaMemcpyHostToDevice));
-  GEM_CUDA_CHECK(cudaMemcpy(np.ptr, hnp.ptr, total * sizeof(int), cudaMemcpyHostToDevice));
-  GEM_CUDA_CHECK(cudaMemcpy(nq.ptr, hnq.ptr, total * sizeof(int), cudaMemcpyHostToDevice));
+  GEM_CUDA_CHECK(cudaMemcpy(p.get(), hp.ptr, total * kContactBenchStride * sizeof(Vec2), cudaMemcpyHostToDevice));
+  GEM_CUDA_CHECK(cudaMemcpy(q.get(), hq.ptr, total * kContactBenchStride * sizeof(Vec2), cudaMemcpyHostToDevice));
+  GEM_CUDA_CHECK(cudaMemcpy(cp.get(), hcp.ptr, total * sizeof(Vec2), cudaMemcpyHostToDevice));
+  GEM_CUDA_CHECK(cudaMemcpy(cq.get(), hcq.ptr, total * sizeof(Vec2), cudaMemcpyHostToDevice));
+  GEM_CUDA_CHECK(cudaMemcpy(np.get(), hnp.ptr, total * sizeof(int), cudaMemcpyHostToDevice));
+  GEM_CUDA_CHECK(cudaMemcpy(nq.get(), hnq.ptr, total * sizeof(int), cudaMemcpyHostToDevice));
   // Poisoned results: a pair the kernel skipped cannot pass the check.
-  GEM_CUDA_CHECK(cudaMemset(res.ptr, 0xff, total * sizeof(Contact)));
+  GEM_CUDA_CHECK(cudaMemset(res.get(), 0xff, total * sizeof(Contact)));
   const int blocks = static_cast<int>((n + kBlock - 1) / kBlock);
   bool staged = false;
   auto launchOn = [&](const Vec2* a, const int* na, const Vec2* ca, const Vec2* b, const int* nb, const Vec2* cb, Contact* o) {
@@ -145,29 +139,30 @@ DeviceTiming timeContacts(const ContactBenchInput& in, int reps, std::vector<Con
     GEM_CUDA_CHECK_LAUNCH();
   };
   auto launch = [&](int s) {
-    if (staged) return launchOn(sp.ptr, snp.ptr, scp.ptr, sq.ptr, snq.ptr, scq.ptr, sres.ptr);
+    if (staged) return launchOn(sp.get(), snp.get(), scp.get(), sq.get(), snq.get(), scq.get(), sres.get());
     const size_t o = s * n;
-    launchOn(p.ptr + o * kContactBenchStride, np.ptr + o, cp.ptr + o, q.ptr + o * kContactBenchStride, nq.ptr + o, cq.ptr + o, res.ptr + o);
+    launchOn(p.get() + o * kContactBenchStride, np.get() + o, cp.get() + o, q.get() + o * kContactBenchStride, nq.get() + o, cq.get() + o,
+             res.get() + o);
   };
   auto upload = [&](int s) {
     staged = true;
     const size_t o = s * n;
-    GEM_CUDA_CHECK(cudaMemcpyAsync(sp.ptr, hp.ptr + o * kContactBenchStride, nv * sizeof(Vec2), cudaMemcpyHostToDevice));
-    GEM_CUDA_CHECK(cudaMemcpyAsync(sq.ptr, hq.ptr + o * kContactBenchStride, nv * sizeof(Vec2), cudaMemcpyHostToDevice));
-    GEM_CUDA_CHECK(cudaMemcpyAsync(scp.ptr, hcp.ptr + o, n * sizeof(Vec2), cudaMemcpyHostToDevice));
-    GEM_CUDA_CHECK(cudaMemcpyAsync(scq.ptr, hcq.ptr + o, n * sizeof(Vec2), cudaMemcpyHostToDevice));
-    GEM_CUDA_CHECK(cudaMemcpyAsync(snp.ptr, hnp.ptr + o, n * sizeof(int), cudaMemcpyHostToDevice));
-    GEM_CUDA_CHECK(cudaMemcpyAsync(snq.ptr, hnq.ptr + o, n * sizeof(int), cudaMemcpyHostToDevice));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(sp.get(), hp.ptr + o * kContactBenchStride, nv * sizeof(Vec2), cudaMemcpyHostToDevice));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(sq.get(), hq.ptr + o * kContactBenchStride, nv * sizeof(Vec2), cudaMemcpyHostToDevice));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(scp.get(), hcp.ptr + o, n * sizeof(Vec2), cudaMemcpyHostToDevice));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(scq.get(), hcq.ptr + o, n * sizeof(Vec2), cudaMemcpyHostToDevice));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(snp.get(), hnp.ptr + o, n * sizeof(int), cudaMemcpyHostToDevice));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(snq.get(), hnq.ptr + o, n * sizeof(int), cudaMemcpyHostToDevice));
   };
   auto download = [&](int s) {
-    GEM_CUDA_CHECK(cudaMemcpyAsync(hout.ptr + s * n, sres.ptr, n * sizeof(Contact), cudaMemcpyDeviceToHost));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(hout.ptr + s * n, sres.get(), n * sizeof(Contact), cudaMemcpyDeviceToHost));
   };
   // The results checked are those of the kernel-only runs (every set written by then); the copied-
   // back results of the staged runs are checked too, for the sets they covered.
   DeviceTiming t = timeRotating(in.sets, reps, launch, upload, download);
   GEM_CUDA_CHECK(cudaDeviceSynchronize());
   out.resize(total);
-  GEM_CUDA_CHECK(cudaMemcpy(out.data(), res.ptr, total * sizeof(Contact), cudaMemcpyDeviceToHost));
+  GEM_CUDA_CHECK(cudaMemcpy(out.data(), res.get(), total * sizeof(Contact), cudaMemcpyDeviceToHost));
   const int covered = std::min(in.sets, kWarmups + reps);
   for (size_t i = 0; i < static_cast<size_t>(covered) * n; ++i)
     if (hout.ptr[i].touching != out[i].touching || hout.ptr[i].area != out[i].area || hout.ptr[i].width != out[i].width)
@@ -182,37 +177,37 @@ DeviceTiming timeTriangulation(const TriangulationBenchInput& in, int reps, Tria
   toPinned(hv, in.v), toPinned(hn, in.n);
   DeviceArray<Vec2> v(total * kMaxVertices), sv(n * kMaxVertices);
   DeviceArray<int> nv(total), count(total), tri(total * kTri), snv(n), scount(n), stri(n * kTri);
-  GEM_CUDA_CHECK(cudaMemcpy(v.ptr, hv.ptr, total * kMaxVertices * sizeof(Vec2), cudaMemcpyHostToDevice));
-  GEM_CUDA_CHECK(cudaMemcpy(nv.ptr, hn.ptr, total * sizeof(int), cudaMemcpyHostToDevice));
-  GEM_CUDA_CHECK(cudaMemset(count.ptr, 0xff, total * sizeof(int)));
-  GEM_CUDA_CHECK(cudaMemset(tri.ptr, 0xff, total * kTri * sizeof(int)));
+  GEM_CUDA_CHECK(cudaMemcpy(v.get(), hv.ptr, total * kMaxVertices * sizeof(Vec2), cudaMemcpyHostToDevice));
+  GEM_CUDA_CHECK(cudaMemcpy(nv.get(), hn.ptr, total * sizeof(int), cudaMemcpyHostToDevice));
+  GEM_CUDA_CHECK(cudaMemset(count.get(), 0xff, total * sizeof(int)));
+  GEM_CUDA_CHECK(cudaMemset(tri.get(), 0xff, total * kTri * sizeof(int)));
   const int blocks = static_cast<int>((n + kBlock - 1) / kBlock);
   bool staged = false;
   auto launch = [&](int s) {
     const size_t o = s * n;
     if (staged)
-      earClipKernel<<<blocks, kBlock>>>(in.polygons, sv.ptr, snv.ptr, scount.ptr, stri.ptr);
+      earClipKernel<<<blocks, kBlock>>>(in.polygons, sv.get(), snv.get(), scount.get(), stri.get());
     else
-      earClipKernel<<<blocks, kBlock>>>(in.polygons, v.ptr + o * kMaxVertices, nv.ptr + o, count.ptr + o, tri.ptr + o * kTri);
+      earClipKernel<<<blocks, kBlock>>>(in.polygons, v.get() + o * kMaxVertices, nv.get() + o, count.get() + o, tri.get() + o * kTri);
     GEM_CUDA_CHECK_LAUNCH();
   };
   auto upload = [&](int s) {
     staged = true;
     const size_t o = s * n;
-    GEM_CUDA_CHECK(cudaMemcpyAsync(sv.ptr, hv.ptr + o * kMaxVertices, n * kMaxVertices * sizeof(Vec2), cudaMemcpyHostToDevice));
-    GEM_CUDA_CHECK(cudaMemcpyAsync(snv.ptr, hn.ptr + o, n * sizeof(int), cudaMemcpyHostToDevice));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(sv.get(), hv.ptr + o * kMaxVertices, n * kMaxVertices * sizeof(Vec2), cudaMemcpyHostToDevice));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(snv.get(), hn.ptr + o, n * sizeof(int), cudaMemcpyHostToDevice));
   };
   auto download = [&](int s) {
     const size_t o = s * n;
-    GEM_CUDA_CHECK(cudaMemcpyAsync(hcount.ptr + o, scount.ptr, n * sizeof(int), cudaMemcpyDeviceToHost));
-    GEM_CUDA_CHECK(cudaMemcpyAsync(htri.ptr + o * kTri, stri.ptr, n * kTri * sizeof(int), cudaMemcpyDeviceToHost));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(hcount.ptr + o, scount.get(), n * sizeof(int), cudaMemcpyDeviceToHost));
+    GEM_CUDA_CHECK(cudaMemcpyAsync(htri.ptr + o * kTri, stri.get(), n * kTri * sizeof(int), cudaMemcpyDeviceToHost));
   };
   DeviceTiming t = timeRotating(in.sets, reps, launch, upload, download);
   GEM_CUDA_CHECK(cudaDeviceSynchronize());
   out.count.resize(total);
   out.tri.resize(total * kTri);
-  GEM_CUDA_CHECK(cudaMemcpy(out.count.data(), count.ptr, total * sizeof(int), cudaMemcpyDeviceToHost));
-  GEM_CUDA_CHECK(cudaMemcpy(out.tri.data(), tri.ptr, total * kTri * sizeof(int), cudaMemcpyDeviceToHost));
+  GEM_CUDA_CHECK(cudaMemcpy(out.count.data(), count.get(), total * sizeof(int), cudaMemcpyDeviceToHost));
+  GEM_CUDA_CHECK(cudaMemcpy(out.tri.data(), tri.get(), total * kTri * sizeof(int), cudaMemcpyDeviceToHost));
   // The staged runs' copied-back counts and used triangles must match the kernel-only runs' too.
   const int covered = std::min(in.sets, kWarmups + reps);
   for (size_t i = 0; i < static_cast<size_t>(covered) * n; ++i) {

@@ -1,4 +1,4 @@
-// uniform_grid on the device is the step's own hashed grid (framework/cuda/device_world.cu, phase
+// uniform_grid on the device is the step's own hashed grid (framework/cuda/broadphase_grid.cu, phase
 // 2): a loose grid rebuilt every step from the boxes, each body's partners written already sorted
 // by (a, b), so it needs no kept list and no sort of its pairs. Its entry here is a factory that
 // returns no strategy object, which DeviceWorld reads as "use the built-in grid".

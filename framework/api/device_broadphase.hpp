@@ -1,5 +1,6 @@
-// Device broadphases: the CUDA twin of framework/api/broadphase.hpp (DESIGN.md "The one idea": a
-// broadphase proposes candidate pairs and knows nothing about events). Modelled on cuda_events.hpp.
+// Device broadphases: the CUDA twin of framework/api/broadphase.hpp (docs/architecture.md "The one
+// idea": a broadphase proposes candidate pairs and knows nothing about events). Modelled on
+// cuda_events.hpp.
 //
 // The contract, for a strategy's .cu (broadphase/NAME.cu, or a plugin's):
 //   - enqueue() puts this step's work on the stream it is given. That work is captured once into
@@ -8,14 +9,14 @@
 //     arrays, or the strategy's own device state).
 //   - Every candidate goes to CandidateSink::add(i, j), in any order and from any thread: the
 //     framework then radix-sorts the pairs by (a, b), so the contacts, and so the trajectories, do
-//     not depend on the strategy (MODEL.md 9, broadphase.hpp).
+//     not depend on the strategy (docs/model.md 9, broadphase.hpp).
 //   - Conservative: emit every pair whose world boxes overlap (every pair whose bounding circles
 //     overlap is a superset of those). More is allowed: the narrowphase drops pairs whose boxes do
 //     not overlap and pairs of two immovable bodies, as the CPU's prefilter does. Each pair once.
-//   - Storage the strategy keeps is sized on the host in upload() and reserve(), outside the graph.
-//     When a kernel finds its own storage too small it calls sink.redo(): the step then leaves the
-//     state alone, the host calls reserve() (grow there) and re-captures, and the step runs again,
-//     exactly as when the candidate list itself overflows.
+//   - Storage the strategy keeps (DeviceArray, device_array.hpp) is sized on the host in upload()
+//     and reserve(), outside the graph. When a kernel finds its own storage too small it calls
+//     sink.redo(): the step then leaves the state alone, the host calls reserve() (grow there) and
+//     re-captures, and the step runs again, exactly as when the candidate list itself overflows.
 // Registration is one line in the .cu, for a class constructible from BroadphaseSettings:
 //   GEM_REGISTER_CUDA_BROADPHASE(DeviceSweepAndPrune, "sweep_and_prune");
 // keyed by (name, origin) as the event drivers are: CudaSimulation runs a broadphase on the device
@@ -30,6 +31,7 @@
 
 #include "framework/api/broadphase.hpp"
 #include "framework/api/cuda_check.hpp"
+#include "framework/api/device_array.hpp"  // DeviceArray, for a strategy's own storage
 #include "framework/world/world.hpp"
 #include "geometry/polygon.hpp"
 
@@ -102,45 +104,13 @@ class CudaBroadphase {
   virtual long rebuilds() const { return 0; }
 };
 
-// A factory returning nullptr means "the step's own hashed grid" (device_world.cu), the built-in
-// uniform_grid: its sorted-rows path writes the pairs already in order and needs no sort.
+// A factory returning nullptr means "the step's own hashed grid" (framework/cuda/broadphase_grid.cu),
+// the built-in uniform_grid: its sorted-rows path writes the pairs already in order and needs no sort.
 using CudaBroadphaseFactory = std::function<std::unique_ptr<CudaBroadphase>(const BroadphaseSettings&)>;
 // origin: "built-in", or the registering plugin's. A second factory of one (name, origin) replaces the first.
 void addCudaBroadphase(const std::string& name, CudaBroadphaseFactory factory, const std::string& origin = "built-in");
 // nullptr when no device part of that name comes from that origin.
 const CudaBroadphaseFactory* findCudaBroadphase(const std::string& name, const std::string& origin = "built-in");
-
-// A device array that only grows, for a strategy's own storage (sized on the host, outside the graph).
-template <class T>
-class DeviceArray {
- public:
-  DeviceArray() = default;
-  DeviceArray(const DeviceArray&) = delete;
-  DeviceArray& operator=(const DeviceArray&) = delete;
-  ~DeviceArray() {
-    if (m_data) cudaFree(m_data);  // no throw from a destructor
-  }
-  // True when it had to reallocate (the old contents are gone).
-  bool ensure(size_t n) {
-    if (n <= m_capacity) return false;
-    const size_t capacity = n + n / 2 + 64;
-    if (m_data) GEM_CUDA_CHECK(cudaFree(m_data));
-    m_data = nullptr;
-    GEM_CUDA_CHECK(cudaMalloc(&m_data, capacity * sizeof(T)));
-    m_capacity = capacity;
-    return true;
-  }
-  void upload(const T* h_data, size_t n) {
-    ensure(n);
-    if (n) GEM_CUDA_CHECK(cudaMemcpy(m_data, h_data, n * sizeof(T), cudaMemcpyHostToDevice));
-  }
-  T* get() const { return m_data; }
-  size_t capacity() const { return m_capacity; }
-
- private:
-  T* m_data = nullptr;
-  size_t m_capacity = 0;
-};
 
 struct RegisterCudaBroadphase {
   RegisterCudaBroadphase(const char* name, CudaBroadphaseFactory factory) { addCudaBroadphase(name, std::move(factory)); }

@@ -1,4 +1,4 @@
-// The CUDA backend: the scheduler of framework/step/simulation.cpp (MODEL.md 8) with the world on the
+// The CUDA backend: the scheduler of framework/step/simulation.cpp (docs/model.md 8) with the world on the
 // device for the whole run. Per step, on one stream:
 //   1 prepare: world vertices, boxes, the pair/solo views of every body
 //   2 broadphase: the scenario's, on the device (device_broadphase.hpp; broadphase/NAME.cu), its pairs

@@ -1,4 +1,4 @@
-// The world on the device and one step of the scheduler's device phases (1 to 5 of MODEL.md 8).
+// The world on the device and one step of the scheduler's device phases (1 to 5 of docs/model.md 8).
 // Kept apart from CudaSimulation so that nvcc never sees the scenario's TOML headers: this header
 // needs only the world, the event API and the CUDA runtime.
 #pragma once

@@ -1,0 +1,168 @@
+// Phase 3 of a step, the contacts: the narrowphase over the candidates, their compaction in
+// order, onset against the previous step's id pairs, and the commit of this step's pairs.
+#include <algorithm>
+
+#include "framework/api/cuda_check.hpp"
+#include "framework/cuda/device_state.cuh"
+#include "framework/cuda/step_phases.cuh"
+#include "framework/step/phases.hpp"
+#include "geometry/contact.hpp"
+
+namespace gem::cuda {
+namespace {
+
+// Over the capacity + 1 entries: candidates past this step's count get flag 0, so the scan of a
+// fixed length (captured in the graph) counts exactly this step's contacts.
+__global__ void narrowphaseKernel(int capacity, const int* needed, const int* candA, const int* candB, const Vec2* worldVertices,
+                                  const int* vertexCount, const Real* x, const Real* y, const Box* boxes, const Real* invMass,
+                                  const int* world, Contact* out, int* flag, StepStats* stats) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p > capacity) return;
+  const int total = *needed, count = total < capacity ? total : capacity;
+  if (p == 0) {
+    stats->candidatesNeeded = total;
+    stats->candidates = count;
+    stats->overflow = total > capacity ? 1 : 0;
+  }
+  // A step whose candidates passed the capacity is redone with more room, and its candidate list
+  // may hold entries no one wrote (a strategy that ran out of its own room, grid rows that did not
+  // fit): it tests nothing. (Reading them once read far out of bounds, when the memory had held
+  // another run's data.)
+  if (p >= count || total > capacity) {
+    flag[p] = 0;
+    return;
+  }
+  const int a = candA[p], b = candB[p];
+  // The prefilter (phases.hpp): a device broadphase may propose more than the grid's accept() lets
+  // through; dropping the same pairs here keeps the contacts bit-identical. Bodies of two worlds
+  // never touch (a device strategy does not know the worlds).
+  if (world[a] != world[b] || !mayTouch(invMass[a], invMass[b], boxes[a], boxes[b])) {
+    flag[p] = 0;
+    return;
+  }
+  const Contact c = computeContact(worldVertices + static_cast<size_t>(a) * kMaxVertices, vertexCount[a], Vec2{x[a], y[a]},
+                                   worldVertices + static_cast<size_t>(b) * kMaxVertices, vertexCount[b], Vec2{x[b], y[b]});
+  out[p] = c;
+  flag[p] = c.touching ? 1 : 0;
+}
+
+__device__ inline unsigned long long contactIdKey(std::int64_t ia, std::int64_t ib, int bits) {
+  const std::int64_t lo = ia < ib ? ia : ib, hi = ia < ib ? ib : ia;
+  return (static_cast<unsigned long long>(lo) << bits) | static_cast<unsigned long long>(hi);
+}
+
+__device__ inline bool sortedContains(const unsigned long long* keys, int n, unsigned long long key) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (keys[mid] < key) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo < n && keys[lo] == key;
+}
+
+struct CompactArgs {
+  int capacity, n, idBits;
+  unsigned long long padKey;  // larger than any real key: padding sorts to the end
+  const int *candA, *candB;
+  const Contact* cand;
+  const int *flag, *offset;
+  const std::int64_t* id;
+  const int* world;
+  WorldStepRecord* worldStats;
+  const unsigned long long* previous;
+  int *contactA, *contactB;
+  PairContact* contacts;
+  PairSlot* slots;
+  unsigned long long* keys;
+  int *bKey, *bIndex;
+  StepStats* stats;
+};
+
+// Compaction in order, onset against the previous step's sorted id pairs. The entries past this
+// step's contacts are padded (slot n, the largest key) so the fixed-length sorts keep them last.
+__global__ void compactContactsKernel(CompactArgs a) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p >= a.capacity) return;
+  const int contacts = a.offset[a.capacity];
+  if (p == 0) a.stats->contacts = contacts;
+  if (!a.flag[p]) {
+    const int k = contacts + (p - a.offset[p]);  // the non-contacts fill [contacts, capacity) once each
+    a.contactA[k] = a.n;
+    a.contactB[k] = a.n;
+    a.keys[k] = a.padKey;
+    a.bKey[k] = a.n;
+    a.bIndex[k] = k;
+    return;
+  }
+  const int k = a.offset[p], ia = a.candA[p], ib = a.candB[p];
+  const unsigned long long key = contactIdKey(a.id[ia], a.id[ib], a.idBits);
+  atomicAdd(&a.worldStats[a.world[ia]].contacts, 1);  // an integer count: the order does not matter
+  a.contactA[k] = ia;
+  a.contactB[k] = ib;
+  a.contacts[k] = PairContact{a.cand[p], !sortedContains(a.previous, a.stats->previousContacts, key)};
+  a.slots[k] = PairSlot{{0, 0}};
+  a.keys[k] = key;
+  a.bKey[k] = ib;
+  a.bIndex[k] = k;
+}
+
+// This step's sorted id pairs become the next step's "previous" (not when the step overflowed).
+// Run at the end of the step, once nothing can overflow any more.
+__global__ void commitContactsKernel(int capacity, const unsigned long long* sorted, unsigned long long* previous, StepStats* stats) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= capacity || stats->overflow) return;
+  const int contacts = stats->contacts;
+  if (k < contacts) previous[k] = sorted[k];
+  if (k == 0) stats->previousContacts = contacts;
+}
+
+// After ids outgrew the key's field width: re-key the kept pairs (the order is unchanged).
+__global__ void rekeyKernel(unsigned long long* keys, const StepStats* stats, int oldBits, int newBits) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= stats->previousContacts) return;
+  const unsigned long long key = keys[k], hi = key & ((1ull << oldBits) - 1), lo = key >> oldBits;
+  keys[k] = (lo << newBits) | hi;
+}
+
+}  // namespace
+
+void enqueueContacts(DeviceState& d, CubCalls& cubCalls, const int* candidatesNeeded) {
+  cudaStream_t s = d.stream;
+  const int n = d.n, capacity = d.capacity, block = d.block;
+  StepStats* stats = d.stats.get();
+  // 3. Narrowphase, compaction in order (with padding), onset, the two sorts.
+  // computeContact is a long serial chain per pair with a 2.3 KB local-memory frame: while the
+  // pairs are few, blocks of one warp spread them over every multiprocessor's L1.
+  const int narrowBlock = capacity + 1 < 64 * 1024 ? 32 : block;
+  narrowphaseKernel<<<(capacity + narrowBlock) / narrowBlock, narrowBlock, 0, s>>>(capacity, candidatesNeeded, d.candA.get(), d.candB.get(),
+                                                                d.worldVertices.get(), d.vertexCount.get(), d.x.get(), d.y.get(),
+                                                                d.boxes.get(), d.invMass.get(), d.world.get(), d.candContact.get(), d.flag.get(), stats);
+  GEM_CUDA_CHECK_LAUNCH();
+  cubCalls.scanFlags(capacity);
+  const unsigned long long padKey = d.idBits >= 32 ? ~0ull : (1ull << (2 * d.idBits)) - 1;
+  const CompactArgs c{capacity, n, d.idBits, padKey, d.candA.get(), d.candB.get(), d.candContact.get(), d.flag.get(),
+                      d.flagOffset.get(), d.id.get(), d.world.get(), d.worldStats.get(), d.previousKeys.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(),
+                      d.slots.get(), d.contactKey.get(), d.bKey.get(), d.bIndex.get(), stats};
+  compactContactsKernel<<<blocksFor(capacity, block), block, 0, s>>>(c);
+  GEM_CUDA_CHECK_LAUNCH();
+  cubCalls.sortKeys(capacity, std::min(64, 2 * d.idBits));
+  // The b side of every body, in contact order: a stable radix sort of (b, k) by b.
+  cubCalls.sortB(capacity, bitsFor(static_cast<unsigned long long>(n)));
+}
+
+void enqueueCommitContacts(DeviceState& d) {
+  cudaStream_t s = d.stream;
+  const int capacity = d.capacity, block = d.block;
+  StepStats* stats = d.stats.get();
+  commitContactsKernel<<<blocksFor(capacity, block), block, 0, s>>>(capacity, d.sortedKeys.get(), d.previousKeys.get(), stats);
+  GEM_CUDA_CHECK_LAUNCH();
+}
+
+void rekeyContacts(DeviceState& d, int newBits) {
+  rekeyKernel<<<blocksFor(d.capacity), kBlock, 0, d.stream>>>(d.previousKeys.get(), d.stats.get(), d.idBits, newBits);
+  GEM_CUDA_CHECK_LAUNCH();
+  GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
+}
+
+}  // namespace gem::cuda

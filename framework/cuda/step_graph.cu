@@ -1,0 +1,342 @@
+// The step graph: the CUB calls of a step, one whole step enqueued phase by phase, the batch of
+// steps captured as one CUDA graph with a device-side loop, and the host's batch loop around it.
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_scan.cuh>
+
+#include <algorithm>
+#include <chrono>
+#include <cstddef>
+#include <cstdlib>
+#include <stdexcept>
+#include <vector>
+
+#include "framework/api/cuda_check.hpp"
+#include "framework/cuda/device_state.cuh"
+#include "framework/cuda/device_world.hpp"
+#include "framework/cuda/step_phases.cuh"
+#include "framework/step/phases.hpp"
+
+// The device phases of a step (see cuda_simulation.hpp for the list), one file each (step_phases.cuh).
+// The rules every driver applies (the prefilter, degrees of freedom, what an impulse does to a body,
+// the time of a step) come from framework/step/phases.hpp, the same functions the CPU stepper calls;
+// what the phases' files write is how the device runs them in parallel while keeping the CPU's
+// order of every sum (tests: golden hashes, CUDA vs CPU).
+
+namespace gem::cuda {
+
+// ---- CubCalls ----------------------------------------------------------------------------------
+
+void CubCalls::check(cudaError_t status, const size_t& need, const char* what) {
+  ::gem::cuda::check(status, what, __FILE__, __LINE__);
+  if (sizing) bytes = std::max(bytes, need);
+}
+void CubCalls::cellSort(int n, int bits) {
+  size_t need = sizing ? 0 : bytes;
+  check(cub::DeviceRadixSort::SortPairs(temp, need, d.cellKey.get(), d.cellKeySorted.get(), d.slot.get(), d.slotSorted.get(), n, 0,
+                                        bits, d.stream),
+        need, "cub SortPairs (cells)");
+}
+void CubCalls::scanPartners(int n) {
+  size_t need = sizing ? 0 : bytes;
+  check(cub::DeviceScan::ExclusiveSum(temp, need, d.partnerCount.get(), d.partnerOffset.get(), n + 1, d.stream), need, "cub ExclusiveSum (partners)");
+}
+void CubCalls::sortCandidates(int capacity, int bits) {
+  size_t need = sizing ? 0 : bytes;
+  check(cub::DeviceRadixSort::SortKeys(temp, need, d.candKey.get(), d.candKeySorted.get(), capacity, 0, bits, d.stream), need,
+        "cub SortKeys (device broadphase pairs)");
+}
+void CubCalls::scanFlags(int capacity) {
+  size_t need = sizing ? 0 : bytes;
+  check(cub::DeviceScan::ExclusiveSum(temp, need, d.flag.get(), d.flagOffset.get(), capacity + 1, d.stream), need, "cub ExclusiveSum (flags)");
+}
+void CubCalls::sortKeys(int capacity, int bits) {
+  size_t need = sizing ? 0 : bytes;
+  check(cub::DeviceRadixSort::SortKeys(temp, need, d.contactKey.get(), d.sortedKeys.get(), capacity, 0, bits, d.stream), need, "cub SortKeys (contact ids)");
+}
+void CubCalls::sortB(int capacity, int bits) {
+  size_t need = sizing ? 0 : bytes;
+  check(cub::DeviceRadixSort::SortPairs(temp, need, d.bKey.get(), d.bKeySorted.get(), d.bIndex.get(), d.bIndexSorted.get(), capacity, 0,
+                                        bits, d.stream),
+        need, "cub SortPairs (b side)");
+}
+
+namespace {
+
+// ---- the step's edges ----------------------------------------------------------------------------
+
+// The batch's start: its record counters and step count (previousContacts carries over).
+__global__ void beginBatchKernel(StepStats* s) {
+  s->impactCount = s->breakCount = s->logCount = 0;
+  s->stepsDone = 0;
+  s->halt = kRunning;
+}
+
+// One block for the start and the end of a step: its threads share the worlds' records (a lone
+// run has one; a sweep's batch one per case), and no launch is added per step for them.
+static unsigned stepEdgeThreads(int worlds) { return static_cast<unsigned>(std::min(std::max(worlds, 32), 1024)); }
+
+// A step's start: its context (the host's formula, time = index x dt), the counters it may rewind
+// to, and each world's record emptied.
+__global__ void beginStepKernel(const BatchControl* c, StepStats* s, StepContext* ctx, int worlds, WorldStepRecord* worldStats) {
+  for (int w = threadIdx.x; w < worlds; w += blockDim.x) worldStats[w] = WorldStepRecord{0, {0, 0}, {0, 0}, {0, 0}, 0};
+  if (threadIdx.x != 0) return;
+  const long step = c->firstStep + s->stepsDone;
+  *ctx = StepContext{c->dt, stepTime(step, c->dt), step};
+  s->impactBegin = s->impactCount, s->breakBegin = s->breakCount, s->logBegin = s->logCount;
+  s->overflow = 0;
+}
+
+// After the pair events: records past a buffer's end fail the step like too many candidates do.
+__global__ void checkRecordsKernel(StepStats* s, int capacity) {
+  if (s->impactCount > capacity || s->breakCount > capacity || s->logCount > capacity) s->overflow = 1;
+}
+
+// A step's end: its record into the ring, and whether the loop goes on. It stops when the batch is
+// done, after a step that asked for a break (the host's topology phase comes next), or at a step
+// that overflowed (rewound: the host grows the buffers and runs it again).
+__global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, const BatchControl* c, StepStats* s, StepRecord* ring,
+                              int worlds, const WorldStepRecord* worldStats, WorldStepRecord* worldRing) {
+  // The worlds' records beside the step's, at its place in the ring (read before thread 0 moves on).
+  const int done = s->stepsDone;
+  if (!s->overflow)
+    for (int w = threadIdx.x; w < worlds; w += blockDim.x) worldRing[static_cast<size_t>(done) * worlds + w] = worldStats[w];
+  __syncthreads();
+  if (threadIdx.x != 0) return;
+  if (s->overflow) {
+    s->impactCount = s->impactBegin, s->breakCount = s->breakBegin, s->logCount = s->logBegin;
+    s->halt = kHaltOverflow;
+  } else {
+    ring[s->stepsDone] = StepRecord{s->candidates, s->contacts, s->impactCount, s->breakCount, s->logCount};
+    ++s->stepsDone;
+    if (s->breakCount > s->breakBegin) s->halt = kHaltBreak;
+    else if (s->stepsDone >= c->steps) s->halt = kHaltDone;
+  }
+  if (inGraph) cudaGraphSetConditional(loop, s->halt == kRunning ? 1u : 0u);
+}
+
+// ---- a step, a batch -----------------------------------------------------------------------------
+
+// Enqueues one whole step on d.stream: captured as the body of the batch graph's loop (inGraph),
+// or launched directly when graphs are off (GEM_CUDA_GRAPH=0, for debugging).
+void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) {
+  cudaStream_t s = d.stream;
+  const int n = d.n, capacity = d.capacity, block = d.block;
+  const unsigned largeKey = d.tableSize;  // past every cell: large bodies sort to the end
+  size_t bytes = d.tempBytes;
+  CubCalls cubCalls{d, d.temp.get(), bytes, false};
+  StepStats* stats = d.stats.get();
+
+  beginStepKernel<<<1, stepEdgeThreads(d.worlds), 0, s>>>(d.control.get(), stats, d.ctx.get(), d.worlds, d.worldStats.get());
+  GEM_CUDA_CHECK_LAUNCH();
+
+  // 1. World vertices, boxes, views, cell keys.
+  enqueuePrepare(d, largeKey);
+
+  // 2. Broadphase: the candidate pairs, sorted by (a, b).
+  const int* candidatesNeeded = enqueueBroadphase(d, cubCalls, largeKey);
+
+  // 3. Narrowphase, compaction in order (with padding), onset, the two sorts.
+  enqueueContacts(d, cubCalls, candidatesNeeded);
+
+  // 4. Two-body events write into each contact's slot; solo events from the start-of-step state.
+  const int records = d.recordCapacity;
+  const RecordSink sink{d.impacts.get(), records, &stats->impactCount, d.breaks.get(), records, &stats->breakCount,
+                        d.logs.get(), records, &stats->logCount};
+  const DevicePairData pairData{d.pairBodies.get(), d.world.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(), d.slots.get(),
+                                capacity, block, &stats->contacts, d.ctx.get(), sink};
+  for (auto& e : d.pairEvents) e->launchPairs(pairData, s);
+  checkRecordsKernel<<<1, 1, 0, s>>>(stats, records);
+  GEM_CUDA_CHECK_LAUNCH();
+  const DeviceSoloData soloData{d.soloBodies.get(), d.world.get(), d.changes.get(), n, block, d.ctx.get()};
+  for (auto& e : d.soloEvents) e->launchSolo(soloData, s);
+
+  // 5. Gather, motion, write back; then the counters to the host.
+  enqueueGather(d);
+  const DeviceMotionData motionData{d.motionBodies.get(), d.world.get(), n, block, d.ctx.get()};
+  for (auto& e : d.motionEvents) e->launchMotion(motionData, s);
+  enqueueWriteBack(d);
+  enqueueCommitContacts(d);
+  endStepKernel<<<1, stepEdgeThreads(d.worlds), 0, s>>>(loop, inGraph, d.control.get(), stats, d.ring.get(), d.worlds,
+                                                       d.worldStats.get(), d.worldRing.get());
+  GEM_CUDA_CHECK_LAUNCH();
+}
+
+// Sizes every buffer for n and the capacity.
+void prepareBuffers(DeviceState& d) {
+  const size_t cap = static_cast<size_t>(d.capacity);
+  d.candA.ensure(cap), d.candB.ensure(cap), d.candContact.ensure(cap), d.flag.ensure(cap + 1), d.flagOffset.ensure(cap + 1);
+  d.contactA.ensure(cap), d.contactB.ensure(cap), d.contacts.ensure(cap), d.slots.ensure(cap), d.contactKey.ensure(cap);
+  d.sortedKeys.ensure(cap), d.bKey.ensure(cap), d.bKeySorted.ensure(cap), d.bIndex.ensure(cap), d.bIndexSorted.ensure(cap);
+  // Records of a whole batch: a step needs one impact and one break per contact at most, and
+  // a batch that fills the buffers stops there (the next batch starts them empty).
+  d.recordCapacity = std::max(d.recordCapacity, d.capacity);
+  const size_t records = static_cast<size_t>(d.recordCapacity);
+  d.impacts.ensure(records), d.breaks.ensure(records), d.logs.ensure(records);
+  d.previousKeys.ensureKeeping(cap, static_cast<size_t>(d.h_stats->previousContacts));
+
+  size_t bytes = 1;
+  CubCalls sizing{d, nullptr, bytes, true};
+  sizing.cellSort(d.n, bitsFor(d.tableSize));
+  sizing.scanPartners(d.n);
+  sizing.scanFlags(d.capacity);
+  sizing.sortKeys(d.capacity, std::min(64, 2 * d.idBits));
+  sizing.sortB(d.capacity, bitsFor(static_cast<unsigned long long>(d.n)));
+  if (d.broadphase) {
+    d.candKey.ensure(cap), d.candKeySorted.ensure(cap), d.candCount.ensure(1);
+    d.broadphase->reserve(d.stream);
+    sizing.sortCandidates(d.capacity, 2 * d.slotBits);
+  }
+  d.temp.ensure(bytes);
+  d.tempBytes = bytes;
+}
+
+// Captures a batch as one graph, replayed every batch until n, a capacity or the ring changes:
+//   copy the control in -> reset the batch's counters -> WHILE (a step; its last kernel sets the
+//   condition) -> copy the ring and the counters out to pinned memory.
+// So a batch of up to copy_back_every steps is one launch and one host sync (thesis 5.7).
+void captureStep(DeviceState& d) {
+  prepareBuffers(d);
+  d.dropGraph();
+  // This stream's uploads and memsets finished before the capture: compute-sanitizer otherwise
+  // reports reads of "not yet allocated" memory inside a WHILE body (NVIDIA/warp#1406). Only this
+  // stream: a device-wide sync would also wait on (and so invalidate) another thread's capture
+  // (a sweep runs several simulations on one device).
+  GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
+  cudaGraph_t graph = nullptr;
+  GEM_CUDA_CHECK(cudaGraphCreate(&graph, 0));
+  struct Owned {
+    cudaGraph_t g;
+    ~Owned() { cudaGraphDestroy(g); }
+  } owned{graph};
+  cudaGraphNode_t controlIn, begin, loop, ringOut, worldRingOut, statsOut;
+  GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&controlIn, graph, nullptr, 0, d.control.get(), d.h_control, sizeof(BatchControl),
+                                          cudaMemcpyHostToDevice));
+  StepStats* stats = d.stats.get();
+  void* beginArgs[] = {&stats};
+  cudaKernelNodeParams beginParams{};
+  beginParams.func = reinterpret_cast<void*>(beginBatchKernel);
+  beginParams.gridDim = dim3(1);
+  beginParams.blockDim = dim3(1);
+  beginParams.kernelParams = beginArgs;
+  GEM_CUDA_CHECK(cudaGraphAddKernelNode(&begin, graph, &controlIn, 1, &beginParams));
+
+  cudaGraphConditionalHandle handle;
+  GEM_CUDA_CHECK(cudaGraphConditionalHandleCreate(&handle, graph, 1, cudaGraphCondAssignDefault));
+  cudaGraphNodeParams loopParams{};
+  loopParams.type = cudaGraphNodeTypeConditional;
+  loopParams.conditional.handle = handle;
+  loopParams.conditional.type = cudaGraphCondTypeWhile;
+  loopParams.conditional.size = 1;
+  GEM_CUDA_CHECK(cudaGraphAddNode(&loop, graph, &begin, nullptr, 1, &loopParams));
+  cudaGraph_t body = loopParams.conditional.phGraph_out[0];
+  GEM_CUDA_CHECK(cudaStreamBeginCaptureToGraph(d.stream, body, nullptr, nullptr, 0, cudaStreamCaptureModeThreadLocal));
+  try {
+    enqueueStep(d, handle, true);
+  } catch (...) {
+    cudaStreamEndCapture(d.stream, &body);
+    throw;
+  }
+  GEM_CUDA_CHECK(cudaStreamEndCapture(d.stream, &body));
+
+  GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&ringOut, graph, &loop, 1, d.h_ring, d.ring.get(),
+                                          sizeof(StepRecord) * static_cast<size_t>(d.ringSize), cudaMemcpyDeviceToHost));
+  GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&worldRingOut, graph, &loop, 1, d.h_worldRing, d.worldRing.get(),
+                                          sizeof(WorldStepRecord) * static_cast<size_t>(d.ringSize) * static_cast<size_t>(d.worlds),
+                                          cudaMemcpyDeviceToHost));
+  GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&statsOut, graph, &loop, 1, d.h_stats, stats, sizeof(StepStats), cudaMemcpyDeviceToHost));
+  GEM_CUDA_CHECK(cudaGraphInstantiate(&d.graph, graph, 0));
+}
+
+// The same batch with every kernel launched from the host, a sync per step (GEM_CUDA_GRAPH=0).
+void runBatchUncaptured(DeviceState& d) {
+  prepareBuffers(d);
+  GEM_CUDA_CHECK(cudaMemcpyAsync(d.control.get(), d.h_control, sizeof(BatchControl), cudaMemcpyHostToDevice, d.stream));
+  beginBatchKernel<<<1, 1, 0, d.stream>>>(d.stats.get());
+  GEM_CUDA_CHECK_LAUNCH();
+  do {
+    enqueueStep(d, cudaGraphConditionalHandle{}, false);
+    GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_stats, d.stats.get(), sizeof(StepStats), cudaMemcpyDeviceToHost, d.stream));
+    GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
+  } while (d.h_stats->halt == kRunning);
+  GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_ring, d.ring.get(), sizeof(StepRecord) * static_cast<size_t>(d.ringSize), cudaMemcpyDeviceToHost, d.stream));
+  GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_worldRing, d.worldRing.get(),
+                                 sizeof(WorldStepRecord) * static_cast<size_t>(d.ringSize) * static_cast<size_t>(d.worlds), cudaMemcpyDeviceToHost,
+                                 d.stream));
+}
+
+}  // namespace
+
+std::pair<long, double> DeviceWorld::captures() const { return {m_state->captures, m_state->captureSeconds}; }
+
+void DeviceWorld::configure(int copyBackEvery, int blockSize) {
+  DeviceState& d = *m_state;
+  if (copyBackEvery < 1 || blockSize < 32 || blockSize > 1024 || blockSize % 32)
+    throw std::invalid_argument("DeviceWorld::configure: copy_back_every >= 1, block size a multiple of 32 up to 1024");
+  if (copyBackEvery != d.ringSize) d.setRing(copyBackEvery, d.worlds);
+  if (blockSize != d.block) d.dropGraph();
+  d.block = blockSize;
+}
+
+void DeviceWorld::run(long firstStep, Real dt, int steps, DeviceBatchResult& result) {
+  DeviceState& d = *m_state;
+  result.steps.clear(), result.worldSteps.clear(), result.impacts.clear(), result.breaks.clear(), result.logs.clear();
+  result.worlds = d.worlds;
+  if (d.n == 0) {
+    result.steps.assign(static_cast<size_t>(steps), StepRecord{});
+    result.worldSteps.assign(static_cast<size_t>(steps) * static_cast<size_t>(d.worlds), WorldStepRecord{});
+    return;
+  }
+  static const bool useGraph = [] {
+    const char* v = std::getenv("GEM_CUDA_GRAPH");  // 0: launch the kernels one by one (debugging)
+    return !(v && v[0] == '0');
+  }();
+  long next = firstStep;
+  int remaining = steps;
+  while (remaining > 0) {
+    *d.h_control = BatchControl{next, dt, std::min(remaining, d.ringSize)};
+    if (!useGraph) {
+      runBatchUncaptured(d);
+    } else {
+      if (!d.graph) {
+        const auto start = std::chrono::steady_clock::now();
+        captureStep(d);
+        ++d.captures;
+        d.captureSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      }
+      GEM_CUDA_CHECK(cudaGraphLaunch(d.graph, d.stream));
+    }
+    GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
+    const StepStats stats = *d.h_stats;
+    const int done = stats.stepsDone;
+
+    // The completed steps' records, appended; their ends shifted past what earlier batches added.
+    const int impactBase = static_cast<int>(result.impacts.size()), breakBase = static_cast<int>(result.breaks.size()),
+              logBase = static_cast<int>(result.logs.size());
+    const StepRecord last = done > 0 ? d.h_ring[done - 1] : StepRecord{};
+    result.impacts.resize(static_cast<size_t>(impactBase + last.impactEnd));
+    result.breaks.resize(static_cast<size_t>(breakBase + last.breakEnd));
+    result.logs.resize(static_cast<size_t>(logBase + last.logEnd));
+    d.impacts.download(result.impacts.data() + impactBase, static_cast<size_t>(last.impactEnd));
+    d.breaks.download(result.breaks.data() + breakBase, static_cast<size_t>(last.breakEnd));
+    d.logs.download(result.logs.data() + logBase, static_cast<size_t>(last.logEnd));
+    for (int k = 0; k < done; ++k) {
+      StepRecord r = d.h_ring[k];
+      r.impactEnd += impactBase, r.breakEnd += breakBase, r.logEnd += logBase;
+      result.steps.push_back(r);
+    }
+    result.worldSteps.insert(result.worldSteps.end(), d.h_worldRing, d.h_worldRing + static_cast<size_t>(done) * static_cast<size_t>(d.worlds));
+    next += done;
+    remaining -= done;
+    if (stats.halt == kHaltBreak) break;
+    if (stats.halt != kHaltOverflow) continue;
+    // A step overflowed and left the state alone: grow what it passed, re-capture, run it again.
+    if (stats.candidatesNeeded > d.capacity) {
+      d.capacity = stats.candidatesNeeded + stats.candidatesNeeded / 2 + 256;
+    } else if (done == 0) {
+      d.recordCapacity *= 4;  // one step's records alone passed the buffers (a batch that filled them just stops)
+    }
+    d.dropGraph();
+  }
+}
+
+}  // namespace gem::cuda
