@@ -11,6 +11,7 @@ namespace {
 
 class DeviceFixedRadius final : public KeptListBroadphase {
  public:
+  static constexpr const char* kSettings[] = {"skin", "fixed_radius"};  // honoured on the device too
   explicit DeviceFixedRadius(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin), m_fixedRadius(s.fixedRadius) {}
   // An edit keeps the global radius: the R_a + R_b + skin reach covers the pieces (see the top).
   void upload(const World& world) override {

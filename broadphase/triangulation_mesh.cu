@@ -48,6 +48,7 @@ struct TrianglesOverlap {
 
 class DeviceTriangulationMesh final : public KeptListBroadphase {
  public:
+  static constexpr const char* kSettings[] = {"skin"};  // honoured on the device too
   explicit DeviceTriangulationMesh(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin) {}
   void upload(const World& world) override {
     const int n = world.size();

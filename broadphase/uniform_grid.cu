@@ -6,7 +6,8 @@
 
 namespace gem::cuda {
 
+// cell_size reaches the grid through DeviceWorld::setGridCell (framework/cuda/cuda_simulation.cpp).
 static const RegisterCudaBroadphase kUniformGrid{
-    "uniform_grid", [](const BroadphaseSettings&) -> std::unique_ptr<CudaBroadphase> { return nullptr; }};
+    "uniform_grid", [](const BroadphaseSettings&) -> std::unique_ptr<CudaBroadphase> { return nullptr; }, {"cell_size"}};
 
 }  // namespace gem::cuda

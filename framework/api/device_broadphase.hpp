@@ -28,6 +28,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "framework/api/broadphase.hpp"
 #include "framework/api/cuda_check.hpp"
@@ -108,12 +109,19 @@ class CudaBroadphase {
 // the built-in uniform_grid: its sorted-rows path writes the pairs already in order and needs no sort.
 using CudaBroadphaseFactory = std::function<std::unique_ptr<CudaBroadphase>(const BroadphaseSettings&)>;
 // origin: "built-in", or the registering plugin's. A second factory of one (name, origin) replaces the first.
-void addCudaBroadphase(const std::string& name, CudaBroadphaseFactory factory, const std::string& origin = "built-in");
+// settings: the keys of BroadphaseSettings the device part honours (its class's kSettings); a
+// scenario that sets another is refused on the device (docs/scenario.md [broadphase.NAME]).
+void addCudaBroadphase(const std::string& name, CudaBroadphaseFactory factory, const std::string& origin = "built-in",
+                       std::vector<std::string> settings = {});
 // nullptr when no device part of that name comes from that origin.
 const CudaBroadphaseFactory* findCudaBroadphase(const std::string& name, const std::string& origin = "built-in");
+// The settings that device part honours (empty when there is none).
+std::vector<std::string> cudaBroadphaseSettings(const std::string& name, const std::string& origin = "built-in");
 
 struct RegisterCudaBroadphase {
-  RegisterCudaBroadphase(const char* name, CudaBroadphaseFactory factory) { addCudaBroadphase(name, std::move(factory)); }
+  RegisterCudaBroadphase(const char* name, CudaBroadphaseFactory factory, std::vector<std::string> settings = {}) {
+    addCudaBroadphase(name, std::move(factory), "built-in", std::move(settings));
+  }
 };
 
 }  // namespace gem::cuda
@@ -127,11 +135,13 @@ struct RegisterCudaBroadphase {
       [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::cuda::CudaBroadphase> {                \
         return std::make_unique<CLASS>(s);                                                                      \
       },                                                                                                        \
-      registry.pluginOrigin()))
+      registry.pluginOrigin(), ::gem::declaredBroadphaseSettings<CLASS>()))
 #else
 #define GEM_REGISTER_CUDA_BROADPHASE(CLASS, NAME)                                                               \
   static const ::gem::cuda::RegisterCudaBroadphase GEM_CONCAT(gem_register_cuda_broadphase_, __LINE__){       \
-      NAME, [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::cuda::CudaBroadphase> {          \
+      NAME,                                                                                                     \
+      [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::cuda::CudaBroadphase> {                \
         return std::make_unique<CLASS>(s);                                                                      \
-      }}
+      },                                                                                                        \
+      ::gem::declaredBroadphaseSettings<CLASS>()}
 #endif

@@ -102,6 +102,12 @@ static std::unique_ptr<cuda::CudaBroadphase> deviceBroadphase(const Scenario& sc
                              ") that has no CUDA part for it (a .cu with GEM_REGISTER_CUDA_BROADPHASE, built by "
                              "gem_add_plugin's CUDA_SOURCES); run it with --backend cpu");
   if (!factory) throw BackendUnsupported("broadphase \"" + name + "\" has no CUDA part (broadphase/" + name + ".cu is missing)");
+  // Every setting the scenario gave must be honoured by the device part, or the run is refused.
+  const std::vector<std::string> honoured = cuda::cudaBroadphaseSettings(name, origin);
+  for (const std::string& key : scenario.broadphaseSettings.given)
+    if (std::find(honoured.begin(), honoured.end(), key) == honoured.end())
+      throw BackendUnsupported("broadphase \"" + name + "\": its CUDA part does not honour the setting " + key +
+                               " ([broadphase." + name + "] or [simulation]); leave it out, or run with --backend cpu");
   return (*factory)(scenario.broadphaseSettings);
 }
 
@@ -185,8 +191,8 @@ void appendRows(World& to, const World& from, int first, std::int64_t idOffset) 
 
 std::string CudaSimulation::batchKey(const Scenario& s) {
   if (s.broadphase != "uniform_grid") return "";
-  std::string key = fmt::format("dt={} steps={} copy_back_every={} block={} morton={} frames={} vessel_dof={}", s.dt, s.steps,
-                                s.copyBackEvery, s.cudaBlockSize, s.mortonSort, s.output.frameEvery, s.vessel.dof);
+  std::string key = fmt::format("dt={} steps={} copy_back_every={} block={} morton={} frames={} vessel_dof={} cell={}", s.dt, s.steps,
+                                s.copyBackEvery, s.cudaBlockSize, s.mortonSort, s.output.frameEvery, s.vessel.dof, s.broadphaseSettings.cellSize);
   for (const auto& [name, setting] : s.events) key += fmt::format(" {}={}", name, setting.enabled);
   for (const PluginSpec& p : s.plugins) key += fmt::format(" plugin={}{}", p.path.string(), p.override ? "!" : "");
   return key;
@@ -240,6 +246,7 @@ CudaBatch::CudaBatch(std::vector<CudaSimulation*> members, int deviceOrdinal)
       throw BackendUnsupported(fmt::format("{} cases of up to {} bodies are too many for one device state; run fewer together", worlds(), most));
   }
   m_device->setBroadphase(deviceBroadphase(s));
+  m_device->setGridCell(s.broadphase == "uniform_grid" ? s.broadphaseSettings.cellSize : 0);
   if (worlds() > 1 && m_device->broadphase())
     throw BackendUnsupported("cases run together on one device need the uniform_grid broadphase (it keeps their worlds apart)");
   for (CudaSimulation* m : m_members) m->locateVessel();

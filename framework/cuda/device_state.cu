@@ -24,6 +24,10 @@ void DeviceWorld::setBroadphase(std::unique_ptr<CudaBroadphase> broadphase) {
   m_state->broadphase = std::move(broadphase);
 }
 const CudaBroadphase* DeviceWorld::broadphase() const { return m_state->broadphase.get(); }
+void DeviceWorld::setGridCell(Real cellSize) {
+  m_state->dropGraph();
+  m_state->cellSetting = cellSize;
+}
 
 // What a captured graph baked in: when it is the same after an upload (a re-sort along the curve
 // every kResortPeriod steps changes only the arrays' contents) the graph is kept, not captured again.
@@ -99,15 +103,15 @@ void DeviceWorld::upload(const World& w, const std::vector<int>& worldOf, const 
   d.radius.upload(w.radius.data(), n);
   if (d.broadphase) d.broadphase->upload(w);
 
-  // The grid cell is the largest floe diameter, so a floe's box spans at most one cell; bodies
-  // larger than that (walls, the vessel) are "large" and tested against all.
+  // The grid cell is cell_size when set, else the largest floe diameter, so a floe's box spans at
+  // most one cell; bodies larger than a cell (walls, the vessel) are "large" and tested against all.
   std::vector<int> dof(n);
   Real largestFloe = 0;
   for (int i = 0; i < n; ++i) {
     dof[i] = degreesOfFreedom(w.kind[i], vesselDofs[static_cast<size_t>(d.worldHost[static_cast<size_t>(i)])]);
     if (w.kind[i] == BodyKind::Floe) largestFloe = std::max(largestFloe, w.radius[i]);
   }
-  d.cell = largestFloe > 0 ? 2 * largestFloe : Real(1);
+  d.cell = d.cellSetting > 0 ? d.cellSetting : (largestFloe > 0 ? 2 * largestFloe : Real(1));
   std::vector<unsigned char> isLarge(n);
   d.largeHost.clear();
   for (int i = 0; i < n; ++i) {

@@ -70,6 +70,7 @@ struct DeviceState {
   GraphArray<int> vessel;
   GraphArray<WorldStepRecord> worldStats;  // this step's, per world
   Real cell = 1;
+  Real cellSetting = 0;  // uniform_grid's cell_size (0: twice the largest floe radius)
   unsigned tableSize = 64;
   int tableBits = 6;
   // Per step, per body.

@@ -56,6 +56,8 @@ class DeviceWorld {
   void addMotionEvent(std::unique_ptr<CudaEventDriver> driver);
   // Phase 2's strategy (device_broadphase.hpp); nullptr (the default) is the step's own hashed grid.
   void setBroadphase(std::unique_ptr<CudaBroadphase> broadphase);
+  // The step's own grid (uniform_grid): its cell, m; 0 = twice the largest floe's bounding radius.
+  void setGridCell(Real cellSize);
   const CudaBroadphase* broadphase() const;
 
   // The whole host world to the device (set-up, after breaks and re-sorts). worldOf[i] is body i's

@@ -94,7 +94,9 @@ World buildWorld(const Scenario& s) {
   }
 
   // Bodies never start in contact (docs/model.md 1): any conservative broadphase + the exact contact.
-  auto broadphase = Registry::global().broadphase("variable_radius").make(BroadphaseSettings{0, 0, 0});
+  BroadphaseSettings noSkin;
+  noSkin.skin = 0;
+  auto broadphase = Registry::global().broadphase("variable_radius").make(noSkin);
   std::vector<CandidatePair> pairs;
   broadphase->findCandidates(world, pairs);
   Vec2 p[kMaxVertices], q[kMaxVertices];

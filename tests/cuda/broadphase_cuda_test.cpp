@@ -185,7 +185,8 @@ TEST(CudaBroadphase, PluginBroadphaseWithoutADevicePartIsRefusedByCudaAndRunsOnT
     Registry::global().addBroadphase(BroadphaseEntry{"cpu_only_plugin_broadphase", "test", "libpairs.so (pairs 1.0)",
                                                      [](const BroadphaseSettings& s) -> std::unique_ptr<Broadphase> {
                                                        return std::make_unique<PairsFromPlugin>(s);
-                                                     }});
+                                                     },
+                                                     {}});
   TempDir dir;
   const std::string scene =
       "[simulation]\nsteps = 5\nbroadphase = \"cpu_only_plugin_broadphase\"\n"
@@ -202,4 +203,71 @@ TEST(CudaBroadphase, PluginBroadphaseWithoutADevicePartIsRefusedByCudaAndRunsOnT
   auto stepper = makeStepper(automatic);
   EXPECT_EQ(stepper->backend(), "cpu");
   for (int k = 0; k < 5; ++k) stepper->step();
+}
+
+// [broadphase.uniform_grid] cell_size reaches the device's grid (it was dropped there): a cell far
+// smaller than the largest floe makes most floes "large" (tested against all), a far larger one
+// puts many in a cell; both step bit for bit as the default grid.
+TEST(CudaBroadphase, UniformGridHonoursCellSizeOnTheDevice) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  const int steps = 150;
+  const Trajectory grid = runOnDevice(test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"uniform_grid\""}), steps);
+  for (const char* cell : {"1.5", "40.0"}) {
+    const Scenario s = test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"uniform_grid\"", std::string("simulation.cell_size=") + cell});
+    EXPECT_EQ(s.broadphaseSettings.cellSize, std::stod(cell));
+    expectIdentical(grid, runOnDevice(s, steps), std::string("cell_size ") + cell);
+  }
+}
+
+// A setting the strategy's device part does not honour is refused by cuda, naming the strategy and
+// the setting, and run on the CPU under auto. (A strategy whose CPU part reads skin and whose device
+// part declares nothing, as a plugin's could.)
+namespace {
+class SkinOnlyOnTheCpu final : public Broadphase {
+ public:
+  static constexpr const char* kSettings[] = {"skin"};
+  explicit SkinOnlyOnTheCpu(const BroadphaseSettings&) {}
+  std::string name() const override { return "skin_only_on_the_cpu"; }
+  void invalidate() override {}
+  void findCandidates(const World& world, std::vector<CandidatePair>& pairs) override {
+    pairs.clear();
+    for (int a = 0; a < world.size(); ++a)
+      for (int b = a + 1; b < world.size(); ++b) pairs.push_back({a, b});
+  }
+};
+class NoSettingsOnTheDevice final : public cuda::CudaBroadphase {
+ public:
+  explicit NoSettingsOnTheDevice(const BroadphaseSettings&) {}
+  void enqueue(const cuda::BroadphaseBodies&, const cuda::CandidateSink&, cudaStream_t) override {}
+};
+}  // namespace
+
+TEST(CudaBroadphase, ASettingTheDevicePartDoesNotHonourIsRefused) {
+  GEM_SKIP_WITHOUT_CUDA();
+  bool known = false;
+  for (const BroadphaseEntry* e : Registry::global().broadphases()) known = known || e->name == "skin_only_on_the_cpu";
+  if (!known) {
+    Registry::global().addBroadphase(BroadphaseEntry{"skin_only_on_the_cpu", "test", "built-in",
+                                                     [](const BroadphaseSettings& s) -> std::unique_ptr<Broadphase> {
+                                                       return std::make_unique<SkinOnlyOnTheCpu>(s);
+                                                     },
+                                                     declaredBroadphaseSettings<SkinOnlyOnTheCpu>()});
+    cuda::addCudaBroadphase("skin_only_on_the_cpu", [](const BroadphaseSettings& s) -> std::unique_ptr<cuda::CudaBroadphase> {
+      return std::make_unique<NoSettingsOnTheDevice>(s);
+    });
+  }
+  TempDir dir;
+  const std::string scene = "[simulation]\nsteps = 5\nbroadphase = \"skin_only_on_the_cpu\"\n[broadphase.skin_only_on_the_cpu]\nskin = 1.0\n"
+                            "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
+  try {
+    makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"cuda\""}));
+    ADD_FAILURE() << "a setting the device part does not honour was accepted on cuda";
+  } catch (const BackendUnsupported& e) {
+    EXPECT_NE(std::string(e.what()).find("does not honour the setting skin"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"auto\""}))->backend(), "cpu");
+  // Without the setting it runs on the device.
+  const std::string plain = "[simulation]\nsteps = 5\nbroadphase = \"skin_only_on_the_cpu\"\n[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
+  EXPECT_EQ(makeStepper(test::scenarioFromToml(dir, plain, {"simulation.backend=\"cuda\""}))->backend(), "cuda");
 }
