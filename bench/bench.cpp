@@ -16,7 +16,7 @@
 #include "framework/field/field_generator.hpp"
 #include "bench/geometry_bench.hpp"
 #include "framework/api/registry.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "framework/step/stepper.hpp"
 
 namespace fs = std::filesystem;

@@ -16,7 +16,7 @@
 
 namespace gem {
 
-// framework/cuda/cuda_simulation.cpp (its header brings toml++, which nvcc does not compile).
+// framework/cuda/cuda_stepper.cpp (its header brings toml++, which nvcc does not compile).
 bool cudaAvailable();
 std::string cudaDeviceName();
 

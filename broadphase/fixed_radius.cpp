@@ -34,7 +34,7 @@ class FixedRadius final : public KeptListBroadphase {
  private:
   Real m_fixedRadius;
   std::vector<Real> m_half;
-  SweepAndPrune m_sweep;
+  AxisSweep m_sweep;
 };
 
 }  // namespace

@@ -132,7 +132,7 @@ class TriangulationMesh final : public KeptListBroadphase {
 
   std::vector<Real> m_half;
   std::vector<CandidatePair> m_circles;
-  SweepAndPrune m_sweep;
+  AxisSweep m_sweep;
   std::unordered_map<std::int64_t, TriangleSet> m_cache;
   std::vector<int> m_triStart, m_vertStart, m_tri;  // m_tri: 3 vertex indices per triangle
   std::vector<Vec2> m_world;

@@ -46,10 +46,10 @@ struct TrianglesOverlap {
 #endif
 };
 
-class DeviceTriangulationMesh final : public KeptListBroadphase {
+class DeviceTriangulationMesh final : public DeviceKeptListBroadphase {
  public:
   static constexpr const char* kSettings[] = {"skin"};  // honoured on the device too
-  explicit DeviceTriangulationMesh(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin) {}
+  explicit DeviceTriangulationMesh(const BroadphaseSettings& s) : DeviceKeptListBroadphase(checkedSettings(s).skin) {}
   void upload(const World& world) override {
     const int n = world.size();
     m_rows = n;
@@ -62,7 +62,7 @@ class DeviceTriangulationMesh final : public KeptListBroadphase {
     m_triangles.upload(triangles.data(), triangles.size());
   }
   bool reorder(const int* order, int n, cudaStream_t stream) override {
-    KeptListBroadphase::reorder(order, n, stream);
+    DeviceKeptListBroadphase::reorder(order, n, stream);
     if (n == 0) return true;
     // Each body's triangles (indices into its own vertices) follow it.
     const long long rows = n, width = kMaxTriangles * 3;
@@ -78,7 +78,7 @@ class DeviceTriangulationMesh final : public KeptListBroadphase {
     return true;
   }
   bool edited(const int* keptOrder, int kept, const World& after, int firstAdded, cudaStream_t stream) override {
-    KeptListBroadphase::edited(keptOrder, kept, after, firstAdded, stream);
+    DeviceKeptListBroadphase::edited(keptOrder, kept, after, firstAdded, stream);
     // The survivors' triangles follow them; only the new bodies are ear-clipped (on the host).
     const long long width = kMaxTriangles * 3, added = after.size() - firstAdded, n = kept + added;
     const long long before = static_cast<long long>(m_rows);

@@ -28,7 +28,7 @@ class VariableRadius final : public KeptListBroadphase {
 
  private:
   std::vector<Real> m_half;
-  SweepAndPrune m_sweep;
+  AxisSweep m_sweep;
 };
 
 }  // namespace

@@ -7,10 +7,10 @@
 namespace gem::cuda {
 namespace {
 
-class DeviceVariableRadius final : public KeptListBroadphase {
+class DeviceVariableRadius final : public DeviceKeptListBroadphase {
  public:
   static constexpr const char* kSettings[] = {"skin"};  // honoured on the device too
-  explicit DeviceVariableRadius(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin) {}
+  explicit DeviceVariableRadius(const BroadphaseSettings& s) : DeviceKeptListBroadphase(checkedSettings(s).skin) {}
   void upload(const World& world) override { uploadList(world, 0); }  // |c_a - c_b| <= (R_a + skin / 2) + (R_b + skin / 2)
   void enqueue(const BroadphaseBodies& bodies, const CandidateSink& sink, cudaStream_t stream) override {
     m_list.enqueue(bodies, sink, stream, AcceptAll{});

@@ -5,7 +5,7 @@
 
 #include "framework/field/ice_file.hpp"
 #include "framework/api/registry.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "test_support.hpp"
 
 using namespace gem;
@@ -23,7 +23,7 @@ struct Trajectory {
 
 Trajectory runWith(const std::string& broadphase, const TempDir& dir) {
   Scenario s = test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"" + broadphase + "\""});
-  Simulation sim(s);
+  CpuStepper sim(s);
   Trajectory t;
   for (long k = 0; k < s.steps; ++k) {
     sim.step();
@@ -60,13 +60,13 @@ TEST(Scenario, EveryEventCanBeTurnedOff) {
     SCOPED_TRACE(e->name);
     Scenario on = test::scenarioFromToml(dir, kBusyScene, {"events." + e->name + ".enabled=true"});
     Scenario off = test::scenarioFromToml(dir, kBusyScene, {"events." + e->name + ".enabled=false"});
-    auto has = [&](const Simulation& sim) {
+    auto has = [&](const CpuStepper& sim) {
       for (const auto& x : sim.events())
         if (x.name == e->name) return true;
       return false;
     };
-    EXPECT_TRUE(has(Simulation(on)));
-    EXPECT_FALSE(has(Simulation(off)));
+    EXPECT_TRUE(has(CpuStepper(on)));
+    EXPECT_FALSE(has(CpuStepper(off)));
   }
 }
 
@@ -79,7 +79,7 @@ TEST(Scenario, RelativeFieldFileResolvesAgainstTheScenarioFolder) {
          "<object index=\"9\"><coordinates>10 0 14 0 12 3</coordinates><velocity x=\"0\" y=\"0\" a=\"0.1\"/><thickness>1.5</thickness></object>"
          "</frame></iceFloeSim>";
   const auto file = dir.write("sub/s.toml", "[simulation]\nsteps = 3\n[field]\nkind = \"file\"\nfile = \"fields/two.ice\"\n");
-  Simulation sim(loadScenario(file));
+  CpuStepper sim(loadScenario(file));
   ASSERT_EQ(sim.world().size(), 2);
   EXPECT_EQ(sim.world().count(BodyKind::Floe), 2);
   EXPECT_NEAR(sim.world().floeMass(), 900 * (16 * 0.5 + 6 * 1.5), 1e-6);

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "events/ship_impact.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "framework/world/vessel.hpp"
 #include "test_support.hpp"
 
@@ -63,7 +63,7 @@ TEST(Impact, HeadOnCentredImpactOfEqualFloesLeavesBothAtTheCommonVelocity) {
   World w;
   w.addBody(square({0, 0}, 10, 1, {1, 0}));
   w.addBody(square({10.05, 0}, 10, 1, {0, 0}));
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   sim.step();  // closes the 5 cm gap
   EXPECT_EQ(sim.contactCount(), 0);
   sim.step();  // overlapping: one inelastic impulse
@@ -90,7 +90,7 @@ TEST(Impact, EveryContactConservesLinearAndAngularMomentum) {
     const Vec2 offset{4.0 + 0.8 * u(rng), 2.5 * u(rng)};
     for (Vec2& v : b.vertices) v = rotate(v, angle) + offset;
     w.addBody(b);
-    Simulation sim(s, std::move(w));
+    CpuStepper sim(s, std::move(w));
     const Momentum before = momentum(sim.world());
     sim.step();
     if (sim.contactCount() == 0) continue;
@@ -110,7 +110,7 @@ TEST(Impact, ClosingBodiesNeverGainNormalSpeedAndSeparatingOnesAreLeftAlone) {
   World w;
   w.addBody(square({0, 0}, 10, 1, {-1, 0}));  // already separating, though overlapping
   w.addBody(square({9.9, 0}, 10, 1, {1, 0}));
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   sim.step();
   ASSERT_EQ(sim.contactCount(), 1);
   EXPECT_EQ(sim.world().vx[0], -1);
@@ -123,7 +123,7 @@ TEST(ElasticContact, ImpulseMatchesTheFormulaForTwoOverlappingSquaresAtRest) {
   World w;
   w.addBody(square({0, 0}, 10, 1.0));
   w.addBody(square({7.8, 0}, 6, 0.5));  // overlap 0.2 m x 6 m
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   const Real m1 = sim.world().mass[0], m2 = sim.world().mass[1];
   sim.step();
   ASSERT_EQ(sim.contactCount(), 1);
@@ -135,7 +135,7 @@ TEST(ElasticContact, ImpulseMatchesTheFormulaForTwoOverlappingSquaresAtRest) {
   World thin;
   thin.addBody(square({0, 0}, 10, 1.0));
   thin.addBody(square({7.99, 0}, 6, 0.5));  // A_0 = 0.06, C = 0.06 * 100 / 36
-  Simulation sim2(s, std::move(thin));
+  CpuStepper sim2(s, std::move(thin));
   sim2.step();
   EXPECT_NEAR(sim2.world().vx[1], 0.05 * (0.06 * 100 / 36) * 1e6 * 6 * 0.5 * 0.1 / m2, 1e-9);
 }
@@ -145,7 +145,7 @@ TEST(Drag, OneStepIsTheFormulaAndAFloeSlowsAsTheClosedForm) {
   Scenario s = test::scenarioFromToml(dir, "[simulation]\ndt = 0.01\nsteps = 10\nmorton_sort = false\n" + eventsOnly({"drag"}));
   World w;
   w.addBody(square({0, 0}, 5, 1.0, {1.0, -0.5}, 0.2));
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   const Real k = 0.5 * 1025 * 0.05 / (900 * 1.0);  // 1/m
   sim.step();
   EXPECT_NEAR(sim.world().vx[0], 1.0 - k * 1.0 * 1.0 * 0.01, 1e-15);
@@ -164,7 +164,7 @@ TEST(Propulsion, VesselAloneSettlesAtTheOpenWaterSpeed) {
                                                "[vessel]\nposition = [0.0, 0.0]\nspeed = 0.0\nbollard_thrust = 370e3\nopen_water_speed = 4.9\n");
   World w;
   addVessel(w, s.vessel);
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   for (int i = 0; i < 6000; ++i) sim.step();
   EXPECT_NEAR(sim.world().vx[0], 4.9, 4.9e-3);
   EXPECT_EQ(sim.world().vy[0], 0);
@@ -172,7 +172,7 @@ TEST(Propulsion, VesselAloneSettlesAtTheOpenWaterSpeed) {
   s.vessel.speed = 4.9;
   World w2;
   addVessel(w2, s.vessel);
-  Simulation sim2(s, std::move(w2));
+  CpuStepper sim2(s, std::move(w2));
   for (int i = 0; i < 100; ++i) sim2.step();
   EXPECT_NEAR(sim2.world().vx[0], 4.9, 1e-9);
 }
@@ -185,7 +185,7 @@ TEST(Autopilot, ThreeDofVesselReturnsToItsTrackAndHeading) {
   const int v = addVessel(w, s.vessel);
   w.y[v] = 5;                 // 5 m off the track
   w.angle[v] = 5 * kPi / 180;  // 5 degrees off the heading
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   Real largestOffset = 0;
   for (int i = 0; i < 3000; ++i) {
     sim.step();
@@ -205,7 +205,7 @@ TEST(Motion, OneDofVesselNeitherSwaysNorTurnsWhenHitObliquely) {
   BodySpec floe = square({0, 0}, 8, 1.0, {0, 0});
   for (Vec2& p : floe.vertices) p = rotate(p, 0.4) + Vec2{stemX(s) + 4, 6};
   w.addBody(floe);
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   int contacts = 0;
   for (int i = 0; i < 40; ++i) {
     sim.step();
@@ -226,7 +226,7 @@ TEST(Wind, GivenStressAcceleratesAFloeAsFdtOverRhoH) {
                                                "[events.wind]\nforce = 2.0\ndirection_deg = 90.0\n[events.current]\nforce = 1.0\n");
   World w;
   w.addBody(square({0, 0}, 5, 0.5));
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   sim.step();
   EXPECT_NEAR(sim.world().vy[0], 2.0 * 0.1 / (900 * 0.5), 1e-15);
   EXPECT_NEAR(sim.world().vx[0], 1.0 * 0.1 / (900 * 0.5), 1e-15);
@@ -238,7 +238,7 @@ TEST(Current, BulkStressDrivesAFloeTowardsTheCurrentSpeed) {
                                                "[events.current]\nspeed = 0.3\ndirection_deg = 0.0\n");
   World w;
   w.addBody(square({0, 0}, 5, 0.5));
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   for (int i = 0; i < 20000; ++i) sim.step();
   // d(U - v)/dt = -k (U - v)^2 with k = rho_w C_w / (rho_ice h): U - v = U / (1 + k U t).
   const Real k = 1025 * 5.5e-3 / (900 * 0.5), lag = 0.3 / (1 + k * 0.3 * 10000);
@@ -304,7 +304,7 @@ TEST(ShipImpact, IsLoggedOnceAtContactOnsetWithTheHullAngleOfTheStem) {
   World w;
   addVessel(w, s.vessel);
   w.addBody(square({stemX(s) + 5.1, 0}, 10, 2.0));  // thick: it will not break
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   int logged = 0, stepsInContact = 0;
   for (int i = 0; i < 30; ++i) {
     sim.step();
@@ -328,7 +328,7 @@ TEST(FlexuralBreaking, ThinFloeStruckHardSplitsAndMassIsAccountedFor) {
   World w;
   addVessel(w, s.vessel);
   w.addBody(square({stemX(s) + 6.1, 0.5}, 12, 0.3, {0, 0}, 0.01));
-  Simulation sim(s, std::move(w));
+  CpuStepper sim(s, std::move(w));
   const double massBefore = sim.world().floeMass();
   bool broke = false;
   for (int i = 0; i < 10 && !broke; ++i) {

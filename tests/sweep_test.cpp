@@ -9,7 +9,7 @@
 
 #include "framework/api/errors.hpp"
 #include "framework/app/runner.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/app/sweep.hpp"
 #include "framework/scenario/sweep_file.hpp"
@@ -361,7 +361,7 @@ INSTANTIATE_TEST_SUITE_P(
 namespace {
 
 // A stand-in for a device backend that runs cases together in one state (CUDA's
-// CudaSimulation::together needs a GPU; its own tests run there): CPU simulations registered under
+// CudaStepper::together needs a GPU; its own tests run there): CPU simulations registered under
 // "cuda" while the test runs, each checking that the cases of its batch are stepped in lockstep.
 struct Batch {
   std::vector<Stepper*> members;
@@ -390,7 +390,7 @@ class LockstepStepper final : public Stepper {
   std::string backend() const override { return m_sim.backend(); }
 
  private:
-  Simulation m_sim;
+  CpuStepper m_sim;
   std::shared_ptr<Batch> m_batch;
 };
 
@@ -403,7 +403,7 @@ struct TogetherBackend {
     if (previous) saved = *previous;
     registerBackend(BackendEntry{
         "cuda", [] { return true; }, [] { return std::string("stand-in"); },
-        [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); }, nullptr,
+        [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CpuStepper>(s); }, nullptr,
         [](const Scenario& s) { return "steps=" + std::to_string(s.steps); },
         [this](const std::vector<const Scenario*>& scenarios) {
           if (refuse) throw BackendUnsupported("these cases cannot share a state");

@@ -7,7 +7,7 @@
 //             list is stale, a flag in device memory says "rebuild".
 //   2 order   the bodies sorted by the low end of their x span (CUB, every step: a graph cannot skip
 //             a CUB call, and it is cheap next to the rest).
-//   3 build   reference state and sweep and prune along x (SweepAndPrune::build's rule); both
+//   3 build   reference state and sweep and prune along x (AxisSweep::build's rule); both
 //             kernels return at once when the flag is clear, which is almost every step.
 //   4 filter  one thread per listed pair: bounding circles overlap now (R_a + R_b), neither direct.
 //   5 direct  one thread per (direct body, body): the vessel, the walls and the floes that moved
@@ -168,9 +168,9 @@ __global__ void gatherByOrderKernel(long long count, int width, const int* order
 // list follows re-sorts and topology edits on the device, so a strategy says only how it uploads
 // and which filter its enqueue() applies; one with per-body storage of its own extends reorder()
 // and edited().
-class KeptListBroadphase : public CudaBroadphase {
+class DeviceKeptListBroadphase : public CudaBroadphase {
  public:
-  explicit KeptListBroadphase(Real skin) : m_list(skin) {}
+  explicit DeviceKeptListBroadphase(Real skin) : m_list(skin) {}
   void reserve(cudaStream_t) override { m_list.reserve(); }
   bool reorder(const int* order, int n, cudaStream_t stream) override {
     m_list.reorder(order, n, stream);

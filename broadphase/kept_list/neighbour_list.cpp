@@ -147,7 +147,7 @@ void KeptListBroadphase::findCandidates(const World& world, std::vector<Candidat
   filter(world, pairs);
 }
 
-void SweepAndPrune::build(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list) {
+void AxisSweep::build(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list) {
   const int n = world.size();
   const Real* x = world.x.data();
   m_lo.resize(n);

@@ -113,7 +113,7 @@ Real largestFloeRadius(const World& world);
 // always has overlapping spans. The order of the last build is kept: bodies move little, so it is
 // nearly sorted and an insertion sort fixes it in about O(n). The sweep reads sorted copies of
 // x, y, h, so its inner loop walks memory in order.
-class SweepAndPrune {
+class AxisSweep {
  public:
   void build(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list);
 

@@ -10,7 +10,7 @@
 // own, the plugin's origin ("PATH (NAME VERSION)") for a plugin's. A plugin's .cu uses the same
 // macro; compiled with GEM_BUILDING_PLUGIN it defers, like the GEM_REGISTER_* macros, into the
 // plugin's own list, and gem_plugin_register adds it under the origin the loader is registering
-// (Registry::pluginOrigin). CudaSimulation pairs an event only with the driver of the same name
+// (Registry::pluginOrigin). CudaStepper pairs an event only with the driver of the same name
 // and the same origin as its registry entry: a plugin's event with its own plugin's driver.
 #pragma once
 #include <cuda_runtime.h>
@@ -33,7 +33,7 @@ namespace gem::cuda {
 // launch covers the buffers' capacity, `count`).
 //
 // `world` is each body's world: a sweep on a GPU runs several cases in one device state, each case
-// a world of its own (DeviceWorld::upload), and an event applies its own case's Params to a body.
+// a world of its own (DeviceStep::upload), and an event applies its own case's Params to a body.
 // Contacts never join two worlds.
 struct DevicePairData {
   const PairBody* bodies;

@@ -19,7 +19,7 @@
 //     re-captures, and the step runs again, exactly as when the candidate list itself overflows.
 // Registration is one line in the .cu, for a class constructible from BroadphaseSettings:
 //   GEM_REGISTER_CUDA_BROADPHASE(DeviceSweepAndPrune, "sweep_and_prune");
-// keyed by (name, origin) as the event drivers are: CudaSimulation runs a broadphase on the device
+// keyed by (name, origin) as the event drivers are: CudaStepper runs a broadphase on the device
 // only with the device part of the same origin as its registry entry (a plugin's with its own).
 #pragma once
 #include <cuda_runtime.h>

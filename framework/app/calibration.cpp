@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "framework/output/atomic_file.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "framework/world/vessel.hpp"
 
 namespace gem {
@@ -114,7 +114,7 @@ CalibrationResult runCalibrationCase(const Scenario& base, const CalibrationCase
   result.frameAngleDeg = edge.frameAngleDeg;
   directEvaluation(s, edge, c, result.apexDeg, result);
 
-  Simulation sim(s);
+  CpuStepper sim(s);
   for (long k = 0; k < s.steps && !result.logged; ++k) {
     sim.step();
     if (!sim.impacts().empty()) {

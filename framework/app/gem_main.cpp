@@ -19,7 +19,7 @@
 #include "framework/api/registry.hpp"
 #include "framework/app/runner.hpp"
 #include "framework/scenario/scenario.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "framework/app/mpi_work.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/app/sweep.hpp"
@@ -83,7 +83,7 @@ int commandRun(const RunArguments& a) {
 int commandCheck(const RunArguments& a) {
   const Scenario s = load(a);
   resolveBackend(s.backend);
-  Simulation sim(s);  // builds the field, checks every body and overlap, parses every event
+  CpuStepper sim(s);  // builds the field, checks every body and overlap, parses every event
   if (!a.quiet)
     std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(),
               sim.world().size(), sim.world().count(BodyKind::Floe), s.vessel.present ? ", a vessel" : "", s.steps,

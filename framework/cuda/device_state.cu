@@ -1,4 +1,4 @@
-// DeviceState's side of DeviceWorld: its construction, the world uploaded to the device and
+// DeviceState's side of DeviceStep: its construction, the world uploaded to the device and
 // downloaded back, and the sizing of every per-body buffer that follows from n and the ids.
 #include <algorithm>
 #include <cstdlib>
@@ -8,23 +8,23 @@
 
 #include "framework/api/cuda_check.hpp"
 #include "framework/cuda/device_state.cuh"
-#include "framework/cuda/device_world.hpp"
+#include "framework/cuda/device_step.hpp"
 #include "framework/cuda/step_phases.cuh"
 #include "framework/step/phases.hpp"
 
 namespace gem::cuda {
 
-DeviceWorld::DeviceWorld() : m_state(std::make_unique<DeviceState>()) {}
-DeviceWorld::~DeviceWorld() = default;
-void DeviceWorld::addPairEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->pairEvents.push_back(std::move(driver)); }
-void DeviceWorld::addSoloEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->soloEvents.push_back(std::move(driver)); }
-void DeviceWorld::addMotionEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->motionEvents.push_back(std::move(driver)); }
-void DeviceWorld::setBroadphase(std::unique_ptr<CudaBroadphase> broadphase) {
+DeviceStep::DeviceStep() : m_state(std::make_unique<DeviceState>()) {}
+DeviceStep::~DeviceStep() = default;
+void DeviceStep::addPairEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->pairEvents.push_back(std::move(driver)); }
+void DeviceStep::addSoloEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->soloEvents.push_back(std::move(driver)); }
+void DeviceStep::addMotionEvent(std::unique_ptr<CudaEventDriver> driver) { m_state->motionEvents.push_back(std::move(driver)); }
+void DeviceStep::setBroadphase(std::unique_ptr<CudaBroadphase> broadphase) {
   m_state->dropGraph();
   m_state->broadphase = std::move(broadphase);
 }
-const CudaBroadphase* DeviceWorld::broadphase() const { return m_state->broadphase.get(); }
-void DeviceWorld::setGridCell(Real cellSize) {
+const CudaBroadphase* DeviceStep::broadphase() const { return m_state->broadphase.get(); }
+void DeviceStep::setGridCell(Real cellSize) {
   m_state->dropGraph();
   m_state->cellSetting = cellSize;
 }
@@ -68,18 +68,18 @@ void sizeForBodies(DeviceState& d, std::int64_t nextId) {
   }
 }
 
-int DeviceWorld::worlds() const { return m_state->worlds; }
-const std::vector<int>& DeviceWorld::worldOfSlots() const { return m_state->worldHost; }
+int DeviceStep::worlds() const { return m_state->worlds; }
+const std::vector<int>& DeviceStep::worldOfSlots() const { return m_state->worldHost; }
 
 // Each world's vessel slot, to the device.
 void uploadVessels(DeviceState& d) { d.vessel.upload(d.vesselHost.data(), d.vesselHost.size()); }
 
-void DeviceWorld::upload(const World& w, const std::vector<int>& worldOf, const std::vector<int>& vesselSlots,
+void DeviceStep::upload(const World& w, const std::vector<int>& worldOf, const std::vector<int>& vesselSlots,
                          const std::vector<int>& vesselDofs) {
   DeviceState& d = *m_state;
   const int n = w.size(), worlds = static_cast<int>(vesselSlots.size());
   if (worlds < 1 || vesselDofs.size() != vesselSlots.size() || (!worldOf.empty() && worldOf.size() != static_cast<size_t>(n)))
-    throw std::invalid_argument("DeviceWorld::upload: one world at least, a vessel and its dof per world, a world per body");
+    throw std::invalid_argument("DeviceStep::upload: one world at least, a vessel and its dof per world, a world per body");
   if (worlds != d.worlds) {
     d.worlds = worlds;
     d.setRing(d.ringSize, worlds);
@@ -127,14 +127,14 @@ void DeviceWorld::upload(const World& w, const std::vector<int>& worldOf, const 
   if (bakedValues(d) != before || d.broadphase) d.dropGraph();
 }
 
-void DeviceWorld::uploadBroadphase(const World& w) {
+void DeviceStep::uploadBroadphase(const World& w) {
   DeviceState& d = *m_state;
   if (!d.broadphase) return;
   d.broadphase->upload(w);
   d.dropGraph();
 }
 
-void DeviceWorld::download(World& w) const {
+void DeviceStep::download(World& w) const {
   const DeviceState& d = *m_state;
   const int n = w.size();
   d.x.download(w.x.data(), n), d.y.download(w.y.data(), n), d.angle.download(w.angle.data(), n);

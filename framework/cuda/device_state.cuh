@@ -1,4 +1,4 @@
-// Internal to framework/cuda: DeviceState, everything the device keeps for one DeviceWorld (the
+// Internal to framework/cuda: DeviceState, everything the device keeps for one DeviceStep (the
 // world, the step's buffers, the records, the graph), and what the backend's files share about it.
 #pragma once
 #include <cuda_runtime.h>
@@ -10,7 +10,7 @@
 
 #include "framework/api/cuda_check.hpp"
 #include "framework/api/device_array.hpp"
-#include "framework/cuda/device_world.hpp"
+#include "framework/cuda/device_step.hpp"
 #include "geometry/contact.hpp"
 
 namespace gem::cuda {
@@ -61,7 +61,7 @@ struct DeviceState {
   std::vector<int> largeHost;  // the same slots, ascending: a topology edit shifts them on the host
   int largeCount = 0;
   int n = 0;
-  // Worlds (DeviceWorld::upload): each body's, and each world's vessel slot (-1: none), on the host
+  // Worlds (DeviceStep::upload): each body's, and each world's vessel slot (-1: none), on the host
   // and on the device (a re-sort moves them without a new graph).
   int worlds = 1;
   GraphArray<int> world;

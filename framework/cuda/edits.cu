@@ -10,7 +10,7 @@
 
 #include "framework/api/cuda_check.hpp"
 #include "framework/cuda/device_state.cuh"
-#include "framework/cuda/device_world.hpp"
+#include "framework/cuda/device_step.hpp"
 #include "framework/step/phases.hpp"
 
 namespace gem::cuda {
@@ -106,7 +106,7 @@ __global__ void gatherKinematicsKernel(int count, const int* slots, const Real* 
 
 }  // namespace
 
-std::vector<int> DeviceWorld::reorderAlongCurve(bool* broadphaseFollowed) {
+std::vector<int> DeviceStep::reorderAlongCurve(bool* broadphaseFollowed) {
   DeviceState& d = *m_state;
   const int n = d.n;
   *broadphaseFollowed = true;
@@ -168,7 +168,7 @@ std::vector<int> DeviceWorld::reorderAlongCurve(bool* broadphaseFollowed) {
   return order;
 }
 
-void DeviceWorld::downloadKinematics(const std::vector<int>& deviceSlots, const std::vector<int>& hostSlots, World& w) const {
+void DeviceStep::downloadKinematics(const std::vector<int>& deviceSlots, const std::vector<int>& hostSlots, World& w) const {
   DeviceState& d = *m_state;
   const int count = static_cast<int>(deviceSlots.size());
   if (count == 0) return;
@@ -189,14 +189,14 @@ void DeviceWorld::downloadKinematics(const std::vector<int>& deviceSlots, const 
   }
 }
 
-bool DeviceWorld::editBodies(const std::vector<int>& removedSlots, const World& from, int firstAdded, const std::vector<int>& addedWorlds,
+bool DeviceStep::editBodies(const std::vector<int>& removedSlots, const World& from, int firstAdded, const std::vector<int>& addedWorlds,
                              const std::vector<int>& vesselDofs) {
   DeviceState& d = *m_state;
   const int before = d.n, removedCount = static_cast<int>(removedSlots.size());
   const int kept = before - removedCount, added = from.size() - firstAdded, n = kept + added;
   if (kept < 0 || added < 0 || (!addedWorlds.empty() && addedWorlds.size() != static_cast<size_t>(added)) ||
       vesselDofs.size() != static_cast<size_t>(d.worlds))
-    throw std::logic_error("DeviceWorld::editBodies: the edit does not match the device's bodies");
+    throw std::logic_error("DeviceStep::editBodies: the edit does not match the device's bodies");
   cudaStream_t s = d.stream;
   ReorderScratch& scratch = d.permuteScratch;
 
@@ -254,7 +254,7 @@ bool DeviceWorld::editBodies(const std::vector<int>& removedSlots, const World& 
   for (int& v : d.vesselHost) {
     if (v < 0) continue;
     if (std::binary_search(removedSlots.begin(), removedSlots.end(), v))
-      throw std::logic_error("DeviceWorld::editBodies: a topology event removed the vessel");
+      throw std::logic_error("DeviceStep::editBodies: a topology event removed the vessel");
     v = newSlot(v);
   }
   uploadVessels(d);

@@ -32,7 +32,7 @@ struct PrepareArgs {
   int* slot;
 };
 
-// Phase 1 and the views: as Simulation::narrowphase's box loop and Simulation::step's view loops.
+// Phase 1 and the views: as CpuStepper::narrowphase's box loop and CpuStepper::step's view loops.
 // A body's rows (16 vertices, a PairBody, a SoloBody) are large, and a thread writing its own is a
 // strided pattern that wastes most of each memory transaction (0.92 ms of a 10^6-floe step): on
 // large fields the block stages them in shared memory and moves each block's rows as one

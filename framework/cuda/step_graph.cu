@@ -12,7 +12,7 @@
 
 #include "framework/api/cuda_check.hpp"
 #include "framework/cuda/device_state.cuh"
-#include "framework/cuda/device_world.hpp"
+#include "framework/cuda/device_step.hpp"
 #include "framework/cuda/step_phases.cuh"
 #include "framework/step/phases.hpp"
 
@@ -266,18 +266,18 @@ void runBatchUncaptured(DeviceState& d) {
 
 }  // namespace
 
-std::pair<long, double> DeviceWorld::captures() const { return {m_state->captures, m_state->captureSeconds}; }
+std::pair<long, double> DeviceStep::captures() const { return {m_state->captures, m_state->captureSeconds}; }
 
-void DeviceWorld::configure(int copyBackEvery, int blockSize) {
+void DeviceStep::configure(int copyBackEvery, int blockSize) {
   DeviceState& d = *m_state;
   if (copyBackEvery < 1 || blockSize < 32 || blockSize > 1024 || blockSize % 32)
-    throw std::invalid_argument("DeviceWorld::configure: copy_back_every >= 1, block size a multiple of 32 up to 1024");
+    throw std::invalid_argument("DeviceStep::configure: copy_back_every >= 1, block size a multiple of 32 up to 1024");
   if (copyBackEvery != d.ringSize) d.setRing(copyBackEvery, d.worlds);
   if (blockSize != d.block) d.dropGraph();
   d.block = blockSize;
 }
 
-void DeviceWorld::run(long firstStep, Real dt, int steps, DeviceBatchResult& result) {
+void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& result) {
   DeviceState& d = *m_state;
   result.steps.clear(), result.worldSteps.clear(), result.impacts.clear(), result.breaks.clear(), result.logs.clear();
   result.worlds = d.worlds;

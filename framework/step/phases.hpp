@@ -1,5 +1,5 @@
 // The step's rules, written once for every driver (docs/model.md 8, docs/architecture.md "The step"):
-// the CPU stepper (step/simulation.cpp) and the CUDA kernels (framework/cuda/) call these, so
+// the CPU stepper (step/cpu_stepper.cpp) and the CUDA kernels (framework/cuda/) call these, so
 // that a rule changed here changes on every backend at once. Host and device (GEM_HD); plain data in,
 // plain data out.
 #pragma once

@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "framework/api/errors.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 
 namespace gem {
 
@@ -17,7 +17,7 @@ static std::map<std::string, BackendEntry>& backends() {
     cpu.name = "cpu";
     cpu.available = [] { return true; };
     cpu.deviceName = [] { return std::string("cpu"); };
-    cpu.make = [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<Simulation>(s); };
+    cpu.make = [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CpuStepper>(s); };
     // No useDeviceForWorker (the CPU backend's workers share the cores) and no batching.
     t["cpu"] = cpu;
     return t;

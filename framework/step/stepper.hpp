@@ -1,4 +1,4 @@
-// A backend steps a scenario's world: the CPU one (Simulation) or a device one. The runner and the
+// A backend steps a scenario's world: the CPU one (CpuStepper) or a device one. The runner and the
 // benchmarks see only this interface, so a backend added later (CUDA) changes neither.
 #pragma once
 #include <functional>

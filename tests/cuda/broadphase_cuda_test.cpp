@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "framework/cuda/cuda_simulation.hpp"
+#include "framework/cuda/cuda_stepper.hpp"
 #include "framework/api/device_broadphase.hpp"
 #include "framework/app/plugin_loader.hpp"
 #include "framework/api/registry.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "../test_support.hpp"
 #include "cuda_test_support.hpp"
 
@@ -33,7 +33,7 @@ struct Trajectory {
 };
 
 Trajectory runOnDevice(const Scenario& s, int steps) {
-  CudaSimulation sim(s);
+  CudaStepper sim(s);
   Trajectory t;
   for (int k = 0; k < steps; ++k) {
     sim.step();

@@ -18,8 +18,8 @@
 #include <set>
 #include <thread>
 
-#include "framework/cuda/cuda_simulation.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/cuda/cuda_stepper.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "../test_support.hpp"
 #include "cuda_test_support.hpp"
 
@@ -107,8 +107,8 @@ TEST(CudaBackend, TwoFloesMatchTheCpu) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, kTwoFloes);
-  Simulation cpu(s);
-  CudaSimulation gpu(s);
+  CpuStepper cpu(s);
+  CudaStepper gpu(s);
   for (int k = 0; k < 40; ++k) {
     cpu.step();
     gpu.step();
@@ -124,8 +124,8 @@ TEST(CudaBackend, BusyChannelMatchesTheCpuAfter50Steps) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, kBusyScene);
-  Simulation cpu(s);
-  CudaSimulation gpu(s);
+  CpuStepper cpu(s);
+  CudaStepper gpu(s);
   long cpuImpacts = 0, gpuImpacts = 0;
   for (int k = 0; k < 50; ++k) {
     cpu.step();
@@ -152,8 +152,8 @@ TEST(CudaBackend, BusyChannelSummaryMatchesTheCpuOver300Steps) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, kBusyScene);
-  Simulation cpu(s);
-  CudaSimulation gpu(s);
+  CpuStepper cpu(s);
+  CudaStepper gpu(s);
   const State a = run(cpu, 300), b = run(gpu, 300);
   std::printf("busy channel, 300 steps: impacts cpu %ld cuda %ld, broken cpu %ld cuda %ld, mean floe speed cpu %.6g cuda %.6g\n",
               a.impacts, b.impacts, a.broken, b.broken, a.meanSpeed, b.meanSpeed);
@@ -167,7 +167,7 @@ TEST(CudaBackend, RepeatedRunIsBitIdentical) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, kBusyScene);
-  CudaSimulation first(s), second(s);
+  CudaStepper first(s), second(s);
   const State a = run(first, 300), b = run(second, 300);
   ASSERT_EQ(a.ids, b.ids);
   ASSERT_EQ(a.values.size(), b.values.size());
@@ -190,7 +190,7 @@ TEST(CudaBackend, BreaksOnTheDeviceMatchTheWholeWorldRoundTrip) {
     // 50 before the re-sort at step 200 and 40 after it, on the CPU), some pieces leaving as rubble.
     Scenario s = test::scenarioFromToml(dir, kBusyScene, {"domain.x=[0.0, 240.0]", "field.thickness=0.25", "simulation.steps=400"});
     s.broadphase = broadphase;
-    CudaSimulation onDevice(s), roundTrip(s);
+    CudaStepper onDevice(s), roundTrip(s);
     roundTrip.setTopologyThroughHost(true);
     long impactsA = 0, impactsB = 0;
     for (int k = 0; k < 200; ++k) {
@@ -355,7 +355,7 @@ TEST(CudaBackend, ConcurrentRunsOnOneDeviceAreIndependent) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, kBusyScene);
-  CudaSimulation alone(s);
+  CudaStepper alone(s);
   const State reference = run(alone, 120);
   constexpr int kThreads = 6;
   std::vector<State> results(kThreads);
@@ -364,7 +364,7 @@ TEST(CudaBackend, ConcurrentRunsOnOneDeviceAreIndependent) {
   for (int t = 0; t < kThreads; ++t)
     threads.emplace_back([&, t] {
       try {
-        CudaSimulation sim(s);
+        CudaStepper sim(s);
         results[t] = run(sim, 120);
       } catch (const std::exception& e) {
         errors[t] = e.what();
@@ -388,7 +388,7 @@ TEST(CudaBackend, StagedPrepareChangesNothing) {
   const char* modes[] = {"direct", "staged"};
   for (int m = 0; m < 2; ++m) {
     ::setenv("GEM_CUDA_PREPARE", modes[m], 1);
-    CudaSimulation sim(s);
+    CudaStepper sim(s);
     results[m] = run(sim, 150);
     ::unsetenv("GEM_CUDA_PREPARE");
   }
@@ -403,9 +403,9 @@ TEST(CudaBackend, CandidateOverflowIsRedoneBitIdentically) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, kBusyScene);
-  CudaSimulation roomy(s);
+  CudaStepper roomy(s);
   ::setenv("GEM_CUDA_CAPACITY", "8", 1);
-  CudaSimulation cramped(s);
+  CudaStepper cramped(s);
   ::unsetenv("GEM_CUDA_CAPACITY");
   const State a = run(roomy, 100), b = run(cramped, 100);
   ASSERT_EQ(a.ids, b.ids);
@@ -426,7 +426,7 @@ TEST(CudaBackend, OverflowedStepReadsNoUnwrittenCandidates) {
     SCOPED_TRACE(broadphase);
     Scenario s = test::scenarioFromToml(dir, kBusyScene);
     s.broadphase = broadphase;
-    CudaSimulation roomy(s);
+    CudaStepper roomy(s);
     const State a = run(roomy, 60);
     void* junk = nullptr;
     const size_t bytes = size_t(1) << 28;
@@ -434,7 +434,7 @@ TEST(CudaBackend, OverflowedStepReadsNoUnwrittenCandidates) {
     ASSERT_EQ(cudaSuccess, cudaMemset(junk, 0xff, bytes));
     ASSERT_EQ(cudaSuccess, cudaFree(junk));  // the allocations below reuse it
     ::setenv("GEM_CUDA_CAPACITY", "8", 1);
-    CudaSimulation cramped(s);
+    CudaStepper cramped(s);
     ::unsetenv("GEM_CUDA_CAPACITY");
     const State b = run(cramped, 60);
     ASSERT_EQ(a.ids, b.ids);
@@ -484,7 +484,7 @@ TEST(CudaBackend, CopyBackIntervalChangesNothing) {
   auto runWith = [&](int every, State& final) {
     Scenario s = test::scenarioFromToml(dir, kBusyScene);
     s.copyBackEvery = every;
-    CudaSimulation sim(s);
+    CudaStepper sim(s);
     PerStep seen;
     long impacts = 0;
     for (int k = 0; k < 300; ++k) {
@@ -517,11 +517,11 @@ TEST(CudaBackend, BlockSizeChangesNothing) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   Scenario s = test::scenarioFromToml(dir, kBusyScene);
-  CudaSimulation standard(s);
+  CudaStepper standard(s);
   s.cudaBlockSize = 256;
-  CudaSimulation wide(s);
+  CudaStepper wide(s);
   s.cudaBlockSize = 32;
-  CudaSimulation narrow(s);
+  CudaStepper narrow(s);
   const State a = run(standard, 120), b = run(wide, 120), c = run(narrow, 120);
   for (const State* other : {&b, &c}) {
     ASSERT_EQ(a.ids, other->ids);
@@ -537,7 +537,7 @@ TEST(CudaBackend, ReSortOnTheDeviceGivesTheHostsCurveOrder) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, kBusyScene);
-  CudaSimulation gpu(s);
+  CudaStepper gpu(s);
   const std::vector<std::int64_t> before = gpu.hostWorld().id;
   run(gpu, 200);
   const World& w = gpu.hostWorld();
@@ -565,18 +565,18 @@ TEST(CudaBackend, CasesRunTogetherStepExactlyAsAlone) {
   }
   std::vector<const Scenario*> pointers;
   for (const Scenario& s : scenarios) pointers.push_back(&s);
-  std::vector<std::unique_ptr<CudaSimulation>> together = CudaSimulation::together(pointers);
+  std::vector<std::unique_ptr<CudaStepper>> together = CudaStepper::together(pointers);
   ASSERT_EQ(together.size(), 3u);
   EXPECT_EQ(together[0]->casesOnDevice(), 3);
-  std::vector<std::unique_ptr<CudaSimulation>> alone;
-  for (const Scenario& s : scenarios) alone.push_back(std::make_unique<CudaSimulation>(s));
+  std::vector<std::unique_ptr<CudaStepper>> alone;
+  for (const Scenario& s : scenarios) alone.push_back(std::make_unique<CudaStepper>(s));
 
   std::vector<long> impacts(3, 0);
   for (long step = 0; step < 420; ++step) {
     for (auto& sim : together) sim->step();  // every case's step before any case's next
     for (size_t k = 0; k < 3; ++k) {
-      CudaSimulation& a = *alone[k];
-      CudaSimulation& b = *together[k];
+      CudaStepper& a = *alone[k];
+      CudaStepper& b = *together[k];
       a.step();
       SCOPED_TRACE(::testing::Message() << "case " << k << ", step " << step);
       ASSERT_EQ(a.contactCount(), b.contactCount());
@@ -592,8 +592,9 @@ TEST(CudaBackend, CasesRunTogetherStepExactlyAsAlone) {
       ASSERT_EQ(a.vesselIceForce().x, b.vesselIceForce().x);
       ASSERT_EQ(a.floesBroken(), b.floesBroken());
     }
-    if (step + 1 == 200)  // a batch ends at the re-sort: the worlds may be read there
+    if (step + 1 == 200) {  // a batch ends at the re-sort: the worlds may be read there
       for (size_t k = 0; k < 3; ++k) EXPECT_EQ(alone[k]->hostWorld().id, together[k]->hostWorld().id);
+    }
   }
   for (size_t k = 0; k < 3; ++k) {
     SCOPED_TRACE(::testing::Message() << "case " << k);
@@ -616,13 +617,13 @@ TEST(CudaBackend, CasesThatCannotShareADeviceStateAreRefused) {
   const Scenario a = test::scenarioFromToml(dir, kBusyScene, {grid});
   const Scenario longer = test::scenarioFromToml(dir, kBusyScene, {grid, "simulation.steps=301"});
   const Scenario kept = test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"variable_radius\""});
-  EXPECT_NE(CudaSimulation::batchKey(a), "");
-  EXPECT_EQ(CudaSimulation::batchKey(kept), "");
-  EXPECT_THROW(CudaSimulation::together({&a, &longer}), BackendUnsupported);
-  EXPECT_THROW(CudaSimulation::together({&a, &kept}), BackendUnsupported);
+  EXPECT_NE(CudaStepper::batchKey(a), "");
+  EXPECT_EQ(CudaStepper::batchKey(kept), "");
+  EXPECT_THROW(CudaStepper::together({&a, &longer}), BackendUnsupported);
+  EXPECT_THROW(CudaStepper::together({&a, &kept}), BackendUnsupported);
   // What a sweep varies (thrust, ice, the field) does not keep cases apart.
-  EXPECT_EQ(CudaSimulation::batchKey(a),
-            CudaSimulation::batchKey(test::scenarioFromToml(dir, kBusyScene, {grid, "vessel.bollard_thrust=1e5", "field.thickness=0.7"})));
+  EXPECT_EQ(CudaStepper::batchKey(a),
+            CudaStepper::batchKey(test::scenarioFromToml(dir, kBusyScene, {grid, "vessel.bollard_thrust=1e5", "field.thickness=0.7"})));
 }
 
 // `gem sweep` on a GPU runs its cases together in one device state: every case's outputs must be

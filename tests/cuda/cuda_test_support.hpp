@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "framework/cuda/cuda_simulation.hpp"
+#include "framework/cuda/cuda_stepper.hpp"
 
 #define GEM_SKIP_WITHOUT_CUDA() \
   if (!::gem::cudaAvailable()) GTEST_SKIP() << "no CUDA device"

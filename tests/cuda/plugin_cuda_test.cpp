@@ -1,6 +1,6 @@
 // A plugin's event on the CUDA backend (docs/plugins.md "On the GPU"): the shear_current example,
 // built by tests/CMakeLists.txt with its .cu (gem_add_plugin's CUDA_SOURCES), registers its device
-// driver under its own origin; CudaSimulation pairs the plugin's event with that driver only, and
+// driver under its own origin; CudaStepper pairs the plugin's event with that driver only, and
 // the run matches the CPU's. The device runs skip, visibly, where no CUDA device exists.
 #include <gtest/gtest.h>
 
@@ -10,10 +10,10 @@
 #include <sstream>
 
 #include "framework/api/cuda_events.hpp"
-#include "framework/cuda/cuda_simulation.hpp"
+#include "framework/cuda/cuda_stepper.hpp"
 #include "framework/app/plugin_loader.hpp"
 #include "framework/api/registry.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "../test_support.hpp"
 #include "cuda_test_support.hpp"
 
@@ -76,8 +76,8 @@ TEST(CudaPlugin, ShearCurrentOnCudaMatchesTheCpu) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, shearScene(shearPlugin(), 20));
-  Simulation cpu(s);
-  CudaSimulation gpu(s);
+  CpuStepper cpu(s);
+  CudaStepper gpu(s);
   int contacts = 0;
   for (int k = 0; k < 20; ++k) {
     cpu.step();

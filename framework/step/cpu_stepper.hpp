@@ -28,11 +28,11 @@ struct EnabledEvent {
   std::unique_ptr<EventInstance> instance;
 };
 
-class Simulation final : public Stepper {
+class CpuStepper final : public Stepper {
  public:
-  explicit Simulation(const Scenario& scenario);
+  explicit CpuStepper(const Scenario& scenario);
   // For tests: a world built by hand, with the scenario's events and broadphase.
-  Simulation(const Scenario& scenario, World world);
+  CpuStepper(const Scenario& scenario, World world);
 
   void step() override;
 

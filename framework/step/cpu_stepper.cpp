@@ -1,4 +1,4 @@
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -111,13 +111,13 @@ World buildWorld(const Scenario& s) {
   return world;
 }
 
-Simulation::Simulation(const Scenario& scenario) : Simulation(scenario, buildWorld(scenario)) {}
+CpuStepper::CpuStepper(const Scenario& scenario) : CpuStepper(scenario, buildWorld(scenario)) {}
 
-Simulation::Simulation(const Scenario& scenario, World world) : m_scenario(scenario), m_world(std::move(world)) {
+CpuStepper::CpuStepper(const Scenario& scenario, World world) : m_scenario(scenario), m_world(std::move(world)) {
   setUp();
 }
 
-void Simulation::setUp() {
+void CpuStepper::setUp() {
   m_broadphase = Registry::global().broadphase(m_scenario.broadphase).make(m_scenario.broadphaseSettings);
   for (const EventEntry* entry : Registry::global().events()) {
     auto it = m_scenario.events.find(entry->name);
@@ -135,14 +135,14 @@ void Simulation::setUp() {
   if (m_scenario.mortonSort) reorderAlongCurve();
 }
 
-int Simulation::vesselSlot() const {
+int CpuStepper::vesselSlot() const {
   if (m_vesselId < 0) return -1;
   for (int i = 0; i < m_world.size(); ++i)
     if (m_world.id[i] == m_vesselId) return i;
   return -1;
 }
 
-VesselSample Simulation::vessel() {
+VesselSample CpuStepper::vessel() {
   const int v = vesselSlot();
   if (v < 0) return VesselSample{false, {0, 0}, 0, {0, 0}};
   return VesselSample{true, m_world.position(v), m_world.angle[v], m_world.velocity(v)};
@@ -150,13 +150,13 @@ VesselSample Simulation::vessel() {
 
 // Re-sorts the bodies along a Morton curve (World::curveOrder). Every strategy sees the same order,
 // so results stay identical.
-void Simulation::reorderAlongCurve() {
+void CpuStepper::reorderAlongCurve() {
   if (m_world.size() < 2) return;
   m_world.permute(m_world.curveOrder());
   m_broadphase->invalidate();
 }
 
-void Simulation::narrowphase() {
+void CpuStepper::narrowphase() {
   const int n = m_world.size();
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
   m_boxes.resize(n);
@@ -202,7 +202,7 @@ void Simulation::narrowphase() {
   m_previousContacts.swap(m_currentContacts);
 }
 
-void Simulation::step() {
+void CpuStepper::step() {
   const StepContext ctx{m_scenario.dt, m_time, m_step};
   const int n = m_world.size();
   const int vesselDof = m_scenario.vessel.dof;
@@ -270,7 +270,7 @@ void Simulation::step() {
   if (m_scenario.mortonSort && isResortStep(m_step)) reorderAlongCurve();
 }
 
-void Simulation::gatherAndMove() {
+void CpuStepper::gatherAndMove() {
   const int n = m_world.size();
   // Impulses: every body sums its contacts in contact order (sorted by slot pair), so the sum
   // is the same whatever broadphase found the pairs, and no atomics are needed.

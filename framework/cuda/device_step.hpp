@@ -1,5 +1,5 @@
 // The world on the device and one step of the scheduler's device phases (1 to 5 of docs/model.md 8).
-// Kept apart from CudaSimulation so that nvcc never sees the scenario's TOML headers: this header
+// Kept apart from CudaStepper so that nvcc never sees the scenario's TOML headers: this header
 // needs only the world, the event API and the CUDA runtime.
 #pragma once
 #include <cstdint>
@@ -43,12 +43,12 @@ struct DeviceBatchResult {
   std::vector<LogRecord> logs;
 };
 
-class DeviceWorld {
+class DeviceStep {
  public:
-  DeviceWorld();
-  ~DeviceWorld();
-  DeviceWorld(const DeviceWorld&) = delete;
-  DeviceWorld& operator=(const DeviceWorld&) = delete;
+  DeviceStep();
+  ~DeviceStep();
+  DeviceStep(const DeviceStep&) = delete;
+  DeviceStep& operator=(const DeviceStep&) = delete;
 
   // Pair and solo drivers run in the order added (the registry's order, as on the CPU).
   void addPairEvent(std::unique_ptr<CudaEventDriver> driver);

@@ -1,6 +1,6 @@
-// The CUDA backend's host side: set-up from the scenario (through the CPU Simulation, which parses
+// The CUDA backend's host side: set-up from the scenario (through the CPU CpuStepper, which parses
 // and checks every event), record ordering, the topology phase and the periodic re-sort.
-#include "framework/cuda/cuda_simulation.hpp"
+#include "framework/cuda/cuda_stepper.hpp"
 
 #include <cuda_runtime.h>
 
@@ -16,11 +16,11 @@
 #include <fmt/format.h>
 
 #include "framework/api/cuda_check.hpp"
-#include "framework/cuda/device_world.hpp"
+#include "framework/cuda/device_step.hpp"
 #include "framework/api/log_channel.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/step/phases.hpp"
-#include "framework/step/simulation.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "framework/step/stepper.hpp"
 
 namespace gem {
@@ -80,15 +80,15 @@ void useCudaDeviceForWorker(int worker) {
 static std::atomic<int> g_liveOnDevice[64];
 static std::atomic<int>& liveOn(int device) { return g_liveOnDevice[static_cast<unsigned>(device) % 64]; }
 
-int CudaSimulation::bindThreadToDevice() {
+int CudaStepper::bindThreadToDevice() {
   int device = 0;
   if (t_workerDevice >= 0) GEM_CUDA_CHECK(cudaSetDevice(t_workerDevice));
   GEM_CUDA_CHECK(cudaGetDevice(&device));
   return device;
 }
 
-World& CudaSimulation::world() { return m_cpu->world(); }
-const Scenario& CudaSimulation::scenario() const { return m_cpu->scenario(); }
+World& CudaStepper::world() { return m_cpu->world(); }
+const Scenario& CudaStepper::scenario() const { return m_cpu->scenario(); }
 
 // The scenario's broadphase on the device, found by name and origin as the events' drivers are: a
 // plugin's broadphase runs on the device only with its own plugin's device part. nullptr is the
@@ -112,17 +112,17 @@ static std::unique_ptr<cuda::CudaBroadphase> deviceBroadphase(const Scenario& sc
 }
 
 // The device state of one run, or of several cases run together (a world each). It owns the
-// device and the step loop; each case (a CudaSimulation) keeps its own host mirror and hands out
+// device and the step loop; each case (a CudaStepper) keeps its own host mirror and hands out
 // its own world's records. With several worlds, body ids on the device are the case's own plus
 // world x idStride (unique over the state, so contacts' onset keys never mix worlds), and a
 // world's device slots are the state's slots of that world in ascending order.
 class CudaBatch {
  public:
-  CudaBatch(std::vector<CudaSimulation*> members, int deviceOrdinal);
+  CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal);
   ~CudaBatch();
 
   int worlds() const { return static_cast<int>(m_members.size()); }
-  cuda::DeviceWorld& device() { return *m_device; }
+  cuda::DeviceStep& device() { return *m_device; }
   const cuda::DeviceBatchResult& result() const { return *m_result; }
   long resultFirst() const { return m_resultFirst; }  // step index of result().steps[0]
   std::int64_t idOffset(int world) const { return static_cast<std::int64_t>(world) * m_idStride; }
@@ -154,9 +154,9 @@ class CudaBatch {
   void applyEdits();
   void reSortAlongCurve();
 
-  std::vector<CudaSimulation*> m_members;
+  std::vector<CudaStepper*> m_members;
   int m_deviceOrdinal;
-  std::unique_ptr<cuda::DeviceWorld> m_device;
+  std::unique_ptr<cuda::DeviceStep> m_device;
   std::unique_ptr<cuda::DeviceBatchResult> m_result;
   long m_resultFirst = 0;
   std::int64_t m_idStride = std::int64_t(1) << 62;  // one world: the ids as they are
@@ -189,7 +189,7 @@ void appendRows(World& to, const World& from, int first, std::int64_t idOffset) 
 
 }  // namespace
 
-std::string CudaSimulation::batchKey(const Scenario& s) {
+std::string CudaStepper::batchKey(const Scenario& s) {
   if (s.broadphase != "uniform_grid") return "";
   std::string key = fmt::format("dt={} steps={} copy_back_every={} block={} morton={} frames={} vessel_dof={} cell={}", s.dt, s.steps,
                                 s.copyBackEvery, s.cudaBlockSize, s.mortonSort, s.output.frameEvery, s.vessel.dof, s.broadphaseSettings.cellSize);
@@ -198,18 +198,18 @@ std::string CudaSimulation::batchKey(const Scenario& s) {
   return key;
 }
 
-CudaBatch::CudaBatch(std::vector<CudaSimulation*> members, int deviceOrdinal)
+CudaBatch::CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal)
     : m_members(std::move(members)),
       m_deviceOrdinal(deviceOrdinal),
-      m_device(std::make_unique<cuda::DeviceWorld>()),
+      m_device(std::make_unique<cuda::DeviceStep>()),
       m_result(std::make_unique<cuda::DeviceBatchResult>()) {
-  const CudaSimulation& first = *m_members.front();
+  const CudaStepper& first = *m_members.front();
   const Scenario& s = first.scenario();
   m_device->configure(s.copyBackEvery, s.cudaBlockSize);
   // The CPU simulations parsed every event (strictly) and sorted their worlds along the curve; their
   // instances give the Params the device drivers are made from, in the same order, a set per world.
   const std::vector<EnabledEvent>& events = first.m_cpu->events();
-  for (const CudaSimulation* m : m_members) {
+  for (const CudaStepper* m : m_members) {
     const std::vector<EnabledEvent>& own = m->m_cpu->events();
     bool same = own.size() == events.size();
     for (size_t e = 0; same && e < own.size(); ++e) same = own[e].name == events[e].name && own[e].phase == events[e].phase;
@@ -230,7 +230,7 @@ CudaBatch::CudaBatch(std::vector<CudaSimulation*> members, int deviceOrdinal)
                                "gem_add_plugin's CUDA_SOURCES); run it with --backend cpu");
     if (!factory) throw BackendUnsupported("event \"" + event.name + "\" has no CUDA driver (events/" + event.name + ".cu is missing)");
     std::vector<const void*> params;
-    for (const CudaSimulation* m : m_members) params.push_back(m->m_cpu->events()[e].instance->params());
+    for (const CudaStepper* m : m_members) params.push_back(m->m_cpu->events()[e].instance->params());
     auto driver = (*factory)(params.data(), worlds());
     if (event.phase == EventPhase::Pair) m_device->addPairEvent(std::move(driver));
     else if (event.phase == EventPhase::Solo) m_device->addSoloEvent(std::move(driver));
@@ -239,7 +239,7 @@ CudaBatch::CudaBatch(std::vector<CudaSimulation*> members, int deviceOrdinal)
   if (worlds() > 1) {
     // Room for each world's ids, new floes from breaks included: a power of two past 4x the most.
     std::int64_t most = 1;
-    for (CudaSimulation* m : m_members) most = std::max(most, m->world().nextId);
+    for (CudaStepper* m : m_members) most = std::max(most, m->world().nextId);
     m_idStride = 1024;
     while (m_idStride < 4 * most) m_idStride *= 2;
     if (static_cast<std::int64_t>(worlds()) * m_idStride > (std::int64_t(1) << 31))
@@ -249,7 +249,7 @@ CudaBatch::CudaBatch(std::vector<CudaSimulation*> members, int deviceOrdinal)
   m_device->setGridCell(s.broadphase == "uniform_grid" ? s.broadphaseSettings.cellSize : 0);
   if (worlds() > 1 && m_device->broadphase())
     throw BackendUnsupported("cases run together on one device need the uniform_grid broadphase (it keeps their worlds apart)");
-  for (CudaSimulation* m : m_members) m->locateVessel();
+  for (CudaStepper* m : m_members) m->locateVessel();
   uploadAll();
   ++liveOn(m_deviceOrdinal);  // last: a constructor that threw has no destructor to count it out
 }
@@ -272,7 +272,7 @@ CudaBatch::~CudaBatch() {
 
 std::vector<int> CudaBatch::vesselDofs() const {
   std::vector<int> dofs;
-  for (const CudaSimulation* m : m_members) dofs.push_back(m->scenario().vessel.dof);
+  for (const CudaStepper* m : m_members) dofs.push_back(m->scenario().vessel.dof);
   return dofs;
 }
 
@@ -287,14 +287,14 @@ const std::vector<int>& CudaBatch::slotsOfWorld(int world) {
 
 void CudaBatch::uploadAll() {
   if (worlds() == 1) {
-    CudaSimulation& m = *m_members.front();
+    CudaStepper& m = *m_members.front();
     m_device->upload(m.world(), m.scenario().vessel.dof, m.m_vesselSlot);
   } else {
     // The worlds one after the other, each in its own order.
     World all;
     std::vector<int> worldOf, vesselSlots;
     for (int w = 0; w < worlds(); ++w) {
-      const CudaSimulation& m = *m_members[static_cast<size_t>(w)];
+      const CudaStepper& m = *m_members[static_cast<size_t>(w)];
       const int base = all.size();
       appendRows(all, m.m_cpu->world(), 0, idOffset(w));
       worldOf.insert(worldOf.end(), static_cast<size_t>(all.size() - base), w);
@@ -304,7 +304,7 @@ void CudaBatch::uploadAll() {
     m_device->upload(all, worldOf, vesselSlots, vesselDofs());
   }
   m_slotsOfWorld.clear();
-  for (CudaSimulation* m : m_members) {
+  for (CudaStepper* m : m_members) {
     m->m_slotOfId.clear();
     m->m_hostCurrent = true;
   }
@@ -312,7 +312,7 @@ void CudaBatch::uploadAll() {
 
 void CudaBatch::ensureStep(long step) {
   if (step >= m_resultFirst && step < m_resultFirst + static_cast<long>(m_result->steps.size())) return;
-  for (const CudaSimulation* m : m_members)
+  for (const CudaStepper* m : m_members)
     if (m->m_step != step) throw std::logic_error("CUDA backend: the cases of one device state must be stepped together");
   runBatch(step);
 }
@@ -338,7 +338,7 @@ void CudaBatch::runBatch(long step) {
   m_resultFirst = step;
   times.batch += clock.lap();
   ++times.batches;
-  for (CudaSimulation* m : m_members) m->m_hostCurrent = false;
+  for (CudaStepper* m : m_members) m->m_hostCurrent = false;
 }
 
 void CudaBatch::addEdit(int world, const std::vector<int>& removedLocal, const World& mirror, int firstAdded) {
@@ -378,7 +378,7 @@ void CudaBatch::applyEdits() {
   if (!followed) {
     // A strategy that cannot follow the edit on the device (a plugin's, say; one world only)
     // rebuilds from the mirror, which must then be in the device's order.
-    CudaSimulation& m = *m_members.front();
+    CudaStepper& m = *m_members.front();
     m.flushPendingOrder();
     m_device->uploadBroadphase(m.world());
   }
@@ -407,30 +407,30 @@ void CudaBatch::reSortAlongCurve() {
   if (!followed) {
     // A device broadphase that keeps per-body storage but cannot permute it (a plugin's, say; one
     // world only) rebuilds from the whole world, in the new order.
-    for (CudaSimulation* m : m_members) m->downloadState();
+    for (CudaStepper* m : m_members) m->downloadState();
     uploadAll();
   }
 }
 
-long CudaSimulation::broadphaseRebuilds() const {
+long CudaStepper::broadphaseRebuilds() const {
   const cuda::CudaBroadphase* b = m_batch->device().broadphase();
   return b ? b->rebuilds() : 0;
 }
 
-int CudaSimulation::casesOnDevice() const { return m_batch->worlds(); }
+int CudaStepper::casesOnDevice() const { return m_batch->worlds(); }
 
-CudaSimulation::CudaSimulation(const Scenario& scenario, Member)
-    : m_deviceOrdinal(bindThreadToDevice()), m_cpu(std::make_unique<Simulation>(scenario)), m_deviceName(cudaDeviceName()) {
+CudaStepper::CudaStepper(const Scenario& scenario, Member)
+    : m_deviceOrdinal(bindThreadToDevice()), m_cpu(std::make_unique<CpuStepper>(scenario)), m_deviceName(cudaDeviceName()) {
   const World& w = world();
   for (int i = 0; i < w.size(); ++i)
     if (w.kind[i] == BodyKind::Vessel) m_vesselId = w.id[i];
 }
 
-CudaSimulation::CudaSimulation(const Scenario& scenario) : CudaSimulation(scenario, Member{}) {
-  m_batch = std::make_shared<CudaBatch>(std::vector<CudaSimulation*>{this}, m_deviceOrdinal);
+CudaStepper::CudaStepper(const Scenario& scenario) : CudaStepper(scenario, Member{}) {
+  m_batch = std::make_shared<CudaBatch>(std::vector<CudaStepper*>{this}, m_deviceOrdinal);
 }
 
-std::vector<std::unique_ptr<CudaSimulation>> CudaSimulation::together(const std::vector<const Scenario*>& scenarios) {
+std::vector<std::unique_ptr<CudaStepper>> CudaStepper::together(const std::vector<const Scenario*>& scenarios) {
   if (scenarios.empty()) return {};
   const std::string key = batchKey(*scenarios.front());
   for (const Scenario* s : scenarios) {
@@ -443,7 +443,7 @@ std::vector<std::unique_ptr<CudaSimulation>> CudaSimulation::together(const std:
   // The cases' set-up (parsing, field generation: CPU work, tens of ms each for the load study's
   // fields) on the host's cores, every thread on this thread's device.
   const size_t count = scenarios.size();
-  std::vector<std::unique_ptr<CudaSimulation>> members(count);
+  std::vector<std::unique_ptr<CudaStepper>> members(count);
   std::vector<std::exception_ptr> errors(count);
   const int device = bindThreadToDevice();
   std::atomic<size_t> next{0};
@@ -451,7 +451,7 @@ std::vector<std::unique_ptr<CudaSimulation>> CudaSimulation::together(const std:
     if (cudaSetDevice(device) != cudaSuccess) return;  // the constructor's own CUDA calls then say why
     for (size_t i = next++; i < count; i = next++) {
       try {
-        members[i].reset(new CudaSimulation(*scenarios[i], Member{}));
+        members[i].reset(new CudaStepper(*scenarios[i], Member{}));
       } catch (...) {
         errors[i] = std::current_exception();
       }
@@ -464,7 +464,7 @@ std::vector<std::unique_ptr<CudaSimulation>> CudaSimulation::together(const std:
   for (std::thread& t : threads) t.join();
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
-  std::vector<CudaSimulation*> raw;
+  std::vector<CudaStepper*> raw;
   for (const auto& m : members) raw.push_back(m.get());
   auto batch = std::make_shared<CudaBatch>(raw, members.front()->m_deviceOrdinal);
   for (auto& m : members) m->m_batch = batch;
@@ -472,22 +472,22 @@ std::vector<std::unique_ptr<CudaSimulation>> CudaSimulation::together(const std:
   return members;
 }
 
-CudaSimulation::~CudaSimulation() = default;
+CudaStepper::~CudaStepper() = default;
 
-void CudaSimulation::locateVessel() {
+void CudaStepper::locateVessel() {
   const World& w = world();
   m_vesselSlot = -1;
   for (int i = 0; i < w.size(); ++i)
     if (w.id[i] == m_vesselId) m_vesselSlot = i;
 }
 
-int CudaSimulation::mirrorSlot(int deviceSlot) const {
+int CudaStepper::mirrorSlot(int deviceSlot) const {
   return m_pendingOrder.empty() ? deviceSlot : m_pendingOrder[static_cast<size_t>(deviceSlot)];
 }
 
 // Device slot by body id (ids are dense: never reused, a few new ones per break): one pass over
 // the mirror's ids per world order, not per step (at 10^6 floes a pass per step was most of a step).
-const std::vector<int>& CudaSimulation::slotOfId() {
+const std::vector<int>& CudaStepper::slotOfId() {
   if (m_slotOfId.empty()) {
     const World& w = world();
     m_slotOfId.assign(static_cast<size_t>(w.nextId), -1);
@@ -499,9 +499,9 @@ const std::vector<int>& CudaSimulation::slotOfId() {
 // 6. Topology (flexural breaking), in a step that asked for it. The events run on the host mirror,
 // whose structure (shapes, mass properties) is always current; only the kinematics of the bodies
 // the requests name are fetched. What they removed and appended is then replayed on the device
-// (CudaBatch::addEdit, DeviceWorld::editBodies): the world's arrays never cross the bus, only the
+// (CudaBatch::addEdit, DeviceStep::editBodies): the world's arrays never cross the bus, only the
 // few new bodies do.
-void CudaSimulation::runTopology() {
+void CudaStepper::runTopology() {
   CudaBatch& batch = *m_batch;
   Stopwatch clock;
   ++batch.times.topologies;
@@ -515,7 +515,7 @@ void CudaSimulation::runTopology() {
     hostSlots.push_back(mirrorSlot(k));
   }
   if (m_topologyThroughHost) {
-    if (batch.worlds() > 1) throw std::logic_error("CudaSimulation::setTopologyThroughHost: for a simulation alone on its device");
+    if (batch.worlds() > 1) throw std::logic_error("CudaStepper::setTopologyThroughHost: for a simulation alone on its device");
     downloadState();  // the reference path (tests): the whole world round trips
   } else {
     batch.device().downloadKinematics(deviceSlots, hostSlots, w);
@@ -580,13 +580,13 @@ void CudaSimulation::runTopology() {
   batch.times.bookkeeping += clock.lap();
 }
 
-void CudaSimulation::flushPendingOrder() {
+void CudaStepper::flushPendingOrder() {
   if (m_pendingOrder.empty()) return;
   world().permute(m_pendingOrder);
   m_pendingOrder.clear();
 }
 
-void CudaSimulation::downloadState() {
+void CudaStepper::downloadState() {
   if (m_hostCurrent) return;
   if (deviceAhead()) throw std::logic_error("CUDA backend: the world was asked for in the middle of a copy-back batch");
   flushPendingOrder();
@@ -602,18 +602,18 @@ void CudaSimulation::downloadState() {
   m_hostCurrent = true;
 }
 
-bool CudaSimulation::deviceAhead() const {
+bool CudaStepper::deviceAhead() const {
   return m_taken < m_batch->resultFirst() + static_cast<long>(m_batch->result().steps.size());
 }
 
-const World& CudaSimulation::hostWorld() {
+const World& CudaStepper::hostWorld() {
   // Batches end where the runner needs the state (frames, the last step): downloadState refuses a
   // caller that asks elsewhere, who would get a later state than the step it is at.
   downloadState();
   return world();
 }
 
-VesselSample CudaSimulation::vessel() {
+VesselSample CudaStepper::vessel() {
   if (m_vesselSlot < 0) return VesselSample{false, {0, 0}, 0, {0, 0}};
   if (m_hostCurrent) {
     const World& w = world();
@@ -622,7 +622,7 @@ VesselSample CudaSimulation::vessel() {
   return m_vessel;
 }
 
-void CudaSimulation::step() {
+void CudaStepper::step() {
   CudaBatch& batch = *m_batch;
   batch.ensureStep(m_step);
   const cuda::DeviceBatchResult& result = batch.result();
@@ -679,7 +679,7 @@ void CudaSimulation::step() {
 }
 
 // A device re-sort: this world's device slot k now holds its old device slot order[k].
-void CudaSimulation::followReorder(const std::vector<int>& order) {
+void CudaStepper::followReorder(const std::vector<int>& order) {
   m_slotOfId.clear();
   if (m_pendingOrder.empty()) {
     m_pendingOrder = order;
@@ -701,11 +701,11 @@ void CudaSimulation::followReorder(const std::vector<int>& order) {
 static const bool kRegistered = [] {
   registerBackend(BackendEntry{
       "cuda", [] { return cudaAvailable(); }, [] { return cudaDeviceName(); },
-      [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CudaSimulation>(s); }, useCudaDeviceForWorker,
-      CudaSimulation::batchKey,
+      [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CudaStepper>(s); }, useCudaDeviceForWorker,
+      CudaStepper::batchKey,
       [](const std::vector<const Scenario*>& scenarios) {
         std::vector<std::unique_ptr<Stepper>> steppers;
-        for (auto& s : CudaSimulation::together(scenarios)) steppers.push_back(std::move(s));
+        for (auto& s : CudaStepper::together(scenarios)) steppers.push_back(std::move(s));
         return steppers;
       },
       deviceCount});

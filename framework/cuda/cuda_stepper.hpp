@@ -1,4 +1,4 @@
-// The CUDA backend: the scheduler of framework/step/simulation.cpp (docs/model.md 8) with the world on the
+// The CUDA backend: the scheduler of framework/step/cpu_stepper.cpp (docs/model.md 8) with the world on the
 // device for the whole run. Per step, on one stream:
 //   1 prepare: world vertices, boxes, the pair/solo views of every body
 //   2 broadphase: the scenario's, on the device (device_broadphase.hpp; broadphase/NAME.cu), its pairs
@@ -17,7 +17,7 @@
 // A batch never runs past a step whose state the host needs: a frame, a re-sort, the run's last
 // step, or a break (the device stops itself there).
 //
-// A device state may hold several cases (CudaSimulation::together): a world each, with its own
+// A device state may hold several cases (CudaStepper::together): a world each, with its own
 // Params, vessel and records, its bodies never paired with another world's (gem sweep, issue 5).
 #pragma once
 #include <memory>
@@ -28,23 +28,23 @@
 
 namespace gem {
 
-class Simulation;
+class CpuStepper;
 
 class CudaBatch;
 
-class CudaSimulation final : public Stepper {
+class CudaStepper final : public Stepper {
  public:
-  explicit CudaSimulation(const Scenario& scenario);  // alone on its device state
+  explicit CudaStepper(const Scenario& scenario);  // alone on its device state
   // Several cases in one device state, a world each, so that small cases fill the GPU (gem sweep
   // batches them). Each steps exactly as it would alone, bit for bit: its bodies keep the order
   // of its own run, its events their own Params. They share the step loop, so they are stepped
   // together: every case's step k before any case's step k + 1 (runScenariosTogether does). The
   // scenarios must agree on batchKey (else BackendUnsupported says what differs).
-  static std::vector<std::unique_ptr<CudaSimulation>> together(const std::vector<const Scenario*>& scenarios);
+  static std::vector<std::unique_ptr<CudaStepper>> together(const std::vector<const Scenario*>& scenarios);
   // What cases must share to run together: "" when a scenario cannot share a device state (a
   // device broadphase other than the built-in uniform_grid, which alone keeps worlds apart).
   static std::string batchKey(const Scenario& scenario);
-  ~CudaSimulation() override;
+  ~CudaStepper() override;
 
   void step() override;
   long stepIndex() const override { return m_step; }
@@ -69,7 +69,7 @@ class CudaSimulation final : public Stepper {
  private:
   friend class CudaBatch;
   struct Member {};
-  CudaSimulation(const Scenario& scenario, Member);  // a case of a batch; the batch attaches itself
+  CudaStepper(const Scenario& scenario, Member);  // a case of a batch; the batch attaches itself
 
   void downloadState();      // device kinematics -> host mirror
   bool deviceAhead() const;  // the device has run steps that step() has not handed out yet
@@ -85,7 +85,7 @@ class CudaSimulation final : public Stepper {
 
   static int bindThreadToDevice();  // the worker's device (useCudaDeviceForWorker), before any CUDA call
   int m_deviceOrdinal;               // first: every member after it lives on this device
-  std::unique_ptr<Simulation> m_cpu;  // parses the events (and runs the topology ones) and holds the host world
+  std::unique_ptr<CpuStepper> m_cpu;  // parses the events (and runs the topology ones) and holds the host world
   std::shared_ptr<CudaBatch> m_batch;  // the device state, alone or shared
   int m_world = 0;                     // this case's world in it
   bool m_hostCurrent = true;
