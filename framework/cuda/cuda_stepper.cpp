@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "framework/api/cuda_check.hpp"
+#include "framework/cuda/cuda_batch.hpp"
 #include "framework/cuda/device_step.hpp"
 #include "framework/api/log_channel.hpp"
 #include "framework/api/registry.hpp"
@@ -25,21 +26,6 @@
 
 namespace gem {
 
-namespace {
-// Wall time in parts: lap() gives the seconds since the last lap (or since it was made).
-class Stopwatch {
- public:
-  double lap() {
-    const auto now = std::chrono::steady_clock::now();
-    const double seconds = std::chrono::duration<double>(now - m_last).count();
-    m_last = now;
-    return seconds;
-  }
-
- private:
-  std::chrono::steady_clock::time_point m_last = std::chrono::steady_clock::now();
-};
-}  // namespace
 
 bool cudaAvailable() {
   static const bool available = [] {
@@ -76,9 +62,6 @@ void useCudaDeviceForWorker(int worker) {
   t_workerDevice = count > 0 ? worker % count : -1;
 }
 
-// Simulations alive on each device in this process (a sweep runs several at once).
-static std::atomic<int> g_liveOnDevice[64];
-static std::atomic<int>& liveOn(int device) { return g_liveOnDevice[static_cast<unsigned>(device) % 64]; }
 
 int CudaStepper::bindThreadToDevice() {
   int device = 0;
@@ -90,104 +73,8 @@ int CudaStepper::bindThreadToDevice() {
 World& CudaStepper::world() { return m_cpu->world(); }
 const Scenario& CudaStepper::scenario() const { return m_cpu->scenario(); }
 
-// The scenario's broadphase on the device, found by name and origin as the events' drivers are: a
-// plugin's broadphase runs on the device only with its own plugin's device part. nullptr is the
-// step's built-in grid (uniform_grid).
-static std::unique_ptr<cuda::CudaBroadphase> deviceBroadphase(const Scenario& scenario) {
-  const std::string& name = scenario.broadphase;
-  const std::string origin = Registry::global().broadphase(name).origin;
-  const cuda::CudaBroadphaseFactory* factory = cuda::findCudaBroadphase(name, origin);
-  if (!factory && origin != "built-in")
-    throw BackendUnsupported("broadphase \"" + name + "\" comes from a plugin (" + origin +
-                             ") that has no CUDA part for it (a .cu with GEM_REGISTER_CUDA_BROADPHASE, built by "
-                             "gem_add_plugin's CUDA_SOURCES); run it with --backend cpu");
-  if (!factory) throw BackendUnsupported("broadphase \"" + name + "\" has no CUDA part (broadphase/" + name + ".cu is missing)");
-  // Every setting the scenario gave must be honoured by the device part, or the run is refused.
-  const std::vector<std::string> honoured = cuda::cudaBroadphaseSettings(name, origin);
-  for (const std::string& key : scenario.broadphaseSettings.given)
-    if (std::find(honoured.begin(), honoured.end(), key) == honoured.end())
-      throw BackendUnsupported("broadphase \"" + name + "\": its CUDA part does not honour the setting " + key +
-                               " ([broadphase." + name + "] or [simulation]); leave it out, or run with --backend cpu");
-  return (*factory)(scenario.broadphaseSettings);
-}
 
-// The device state of one run, or of several cases run together (a world each). It owns the
-// device and the step loop; each case (a CudaStepper) keeps its own host mirror and hands out
-// its own world's records. With several worlds, body ids on the device are the case's own plus
-// world x idStride (unique over the state, so contacts' onset keys never mix worlds), and a
-// world's device slots are the state's slots of that world in ascending order.
-class CudaBatch {
- public:
-  CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal);
-  ~CudaBatch();
 
-  int worlds() const { return static_cast<int>(m_members.size()); }
-  cuda::DeviceStep& device() { return *m_device; }
-  const cuda::DeviceBatchResult& result() const { return *m_result; }
-  long resultFirst() const { return m_resultFirst; }  // step index of result().steps[0]
-  std::int64_t idOffset(int world) const { return static_cast<std::int64_t>(world) * m_idStride; }
-  int worldOfId(std::int64_t id) const { return static_cast<int>(id / m_idStride); }
-  // World w's device slot `local` in the shared state.
-  int sharedSlot(int world, int local) {
-    return worlds() == 1 ? local : slotsOfWorld(world)[static_cast<size_t>(local)];
-  }
-  const std::vector<int>& slotsOfWorld(int world);
-
-  // The host mirrors to the device (set-up; a strategy that could not follow a re-sort).
-  void uploadAll();
-  // Step `step` of every case is on the host (a case asking for it runs the next batch of steps).
-  void ensureStep(long step);
-  // A case's topology edit: its device slots removedLocal leave, its mirror's rows from
-  // [firstAdded..] are appended (applied once every case is done with the step).
-  void addEdit(int world, const std::vector<int>& removedLocal, const World& mirror, int firstAdded);
-  // A case finished its step: the last one of a step applies the edits and re-sorts when due.
-  void finishedStep(long step);
-  std::vector<int> vesselDofs() const;
-
-  struct HostTimes {
-    long batches = 0, topologies = 0, resorts = 0;
-    double batch = 0, fetch = 0, events = 0, edit = 0, bookkeeping = 0, resort = 0, ordering = 0;
-  } times;  // host wall time by part (GEM_CUDA_TIMING=1 prints it when the state goes), s
-
- private:
-  void runBatch(long step);
-  void applyEdits();
-  void reSortAlongCurve();
-
-  std::vector<CudaStepper*> m_members;
-  int m_deviceOrdinal;
-  std::unique_ptr<cuda::DeviceStep> m_device;
-  std::unique_ptr<cuda::DeviceBatchResult> m_result;
-  long m_resultFirst = 0;
-  std::int64_t m_idStride = std::int64_t(1) << 62;  // one world: the ids as they are
-  std::vector<std::vector<int>> m_slotsOfWorld;      // empty: stale
-  int m_finished = 0;                                // cases done with the current step
-  long m_stepsDone = 0;
-  // The step's edits, applied together: shared slots, and the new bodies with their worlds.
-  std::vector<int> m_removed;
-  World m_added;
-  std::vector<int> m_addedWorlds;
-  bool m_edited = false;
-};
-
-namespace {
-
-// Rows [first, from.size()) of `from` appended to `to`, ids shifted by idOffset.
-void appendRows(World& to, const World& from, int first, std::int64_t idOffset) {
-  const size_t f = static_cast<size_t>(first);
-  for (size_t i = f; i < from.id.size(); ++i) to.id.push_back(from.id[i] + idOffset);
-  to.kind.insert(to.kind.end(), from.kind.begin() + first, from.kind.end());
-  to.vertexCount.insert(to.vertexCount.end(), from.vertexCount.begin() + first, from.vertexCount.end());
-  to.localVertices.insert(to.localVertices.end(), from.localVertices.begin() + static_cast<std::ptrdiff_t>(f * kMaxVertices),
-                          from.localVertices.end());
-  std::vector<Real> World::*reals[] = {&World::x, &World::y, &World::angle, &World::vx, &World::vy, &World::omega,
-                                       &World::area, &World::thickness, &World::mass, &World::invMass, &World::invInertia,
-                                       &World::gyration2, &World::gyrationX2, &World::gyrationY2, &World::principalAngle,
-                                       &World::radius};
-  for (auto r : reals) (to.*r).insert((to.*r).end(), (from.*r).begin() + first, (from.*r).end());
-}
-
-}  // namespace
 
 std::string CudaStepper::batchKey(const Scenario& s) {
   if (s.broadphase != "uniform_grid") return "";
@@ -198,219 +85,6 @@ std::string CudaStepper::batchKey(const Scenario& s) {
   return key;
 }
 
-CudaBatch::CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal)
-    : m_members(std::move(members)),
-      m_deviceOrdinal(deviceOrdinal),
-      m_device(std::make_unique<cuda::DeviceStep>()),
-      m_result(std::make_unique<cuda::DeviceBatchResult>()) {
-  const CudaStepper& first = *m_members.front();
-  const Scenario& s = first.scenario();
-  m_device->configure(s.copyBackEvery, s.cudaBlockSize);
-  // The CPU simulations parsed every event (strictly) and sorted their worlds along the curve; their
-  // instances give the Params the device drivers are made from, in the same order, a set per world.
-  const std::vector<EnabledEvent>& events = first.m_cpu->events();
-  for (const CudaStepper* m : m_members) {
-    const std::vector<EnabledEvent>& own = m->m_cpu->events();
-    bool same = own.size() == events.size();
-    for (size_t e = 0; same && e < own.size(); ++e) same = own[e].name == events[e].name && own[e].phase == events[e].phase;
-    if (!same) throw BackendUnsupported("cases run together on one device must enable the same events");
-  }
-  for (size_t e = 0; e < events.size(); ++e) {
-    const EnabledEvent& event = events[e];
-    if (event.phase == EventPhase::Topology) continue;  // runs on the host
-    // Device drivers are found by name and origin: the registry entry's (built-in, or the plugin
-    // that registered it). A plugin's event runs only with its own plugin's driver, never with a
-    // built-in's of the same name (that would read its Params wrongly).
-    const EventEntry* entry = Registry::global().findEvent(event.name);
-    const std::string origin = entry ? entry->origin : std::string("built-in");
-    const cuda::CudaEventFactory* factory = cuda::findCudaEvent(event.name, origin);
-    if (!factory && origin != "built-in")
-      throw BackendUnsupported("event \"" + event.name + "\" comes from a plugin (" + origin +
-                               ") that has no CUDA driver for it (a .cu with GEM_REGISTER_CUDA_*_EVENT, built by "
-                               "gem_add_plugin's CUDA_SOURCES); run it with --backend cpu");
-    if (!factory) throw BackendUnsupported("event \"" + event.name + "\" has no CUDA driver (events/" + event.name + ".cu is missing)");
-    std::vector<const void*> params;
-    for (const CudaStepper* m : m_members) params.push_back(m->m_cpu->events()[e].instance->params());
-    auto driver = (*factory)(params.data(), worlds());
-    if (event.phase == EventPhase::Pair) m_device->addPairEvent(std::move(driver));
-    else if (event.phase == EventPhase::Solo) m_device->addSoloEvent(std::move(driver));
-    else m_device->addMotionEvent(std::move(driver));
-  }
-  if (worlds() > 1) {
-    // Room for each world's ids, new floes from breaks included: a power of two past 4x the most.
-    std::int64_t most = 1;
-    for (CudaStepper* m : m_members) most = std::max(most, m->world().nextId);
-    m_idStride = 1024;
-    while (m_idStride < 4 * most) m_idStride *= 2;
-    if (static_cast<std::int64_t>(worlds()) * m_idStride > (std::int64_t(1) << 31))
-      throw BackendUnsupported(fmt::format("{} cases of up to {} bodies are too many for one device state; run fewer together", worlds(), most));
-  }
-  m_device->setBroadphase(deviceBroadphase(s));
-  m_device->setGridCell(s.broadphase == "uniform_grid" ? s.broadphaseSettings.cellSize : 0);
-  if (worlds() > 1 && m_device->broadphase())
-    throw BackendUnsupported("cases run together on one device need the uniform_grid broadphase (it keeps their worlds apart)");
-  for (CudaStepper* m : m_members) m->locateVessel();
-  uploadAll();
-  ++liveOn(m_deviceOrdinal);  // last: a constructor that threw has no destructor to count it out
-}
-
-CudaBatch::~CudaBatch() {
-  --liveOn(m_deviceOrdinal);
-  // GEM_CUDA_TIMING=1: where the host's wall time went (the device's kernels are ncu's to split).
-  const char* timing = std::getenv("GEM_CUDA_TIMING");
-  if (!timing || timing[0] != '1') return;
-  const HostTimes& t = times;
-  const int bodies = static_cast<int>(m_device->worldOfSlots().size());  // the cases may be gone already
-  const auto [captures, captureSeconds] = m_device->captures();
-  std::fprintf(stderr,
-               "gem cuda timing, %ld steps, %d bodies in %d case%s: batches %ld in %.3f s (device steps, copy-back; of it, %ld graph "
-               "captures in %.3f s); topology %ld in %.3f s (fetch %.3f, events %.3f, device edit %.3f, bookkeeping %.3f); re-sorts %ld "
-               "in %.3f s; record ordering %.3f s\n",
-               m_stepsDone, bodies, worlds(), worlds() == 1 ? "" : "s", t.batches, t.batch, captures, captureSeconds, t.topologies,
-               t.fetch + t.events + t.edit + t.bookkeeping, t.fetch, t.events, t.edit, t.bookkeeping, t.resorts, t.resort, t.ordering);
-}
-
-std::vector<int> CudaBatch::vesselDofs() const {
-  std::vector<int> dofs;
-  for (const CudaStepper* m : m_members) dofs.push_back(m->scenario().vessel.dof);
-  return dofs;
-}
-
-const std::vector<int>& CudaBatch::slotsOfWorld(int world) {
-  if (m_slotsOfWorld.empty()) {
-    m_slotsOfWorld.assign(static_cast<size_t>(worlds()), {});
-    const std::vector<int>& worldOf = m_device->worldOfSlots();
-    for (int k = 0; k < static_cast<int>(worldOf.size()); ++k) m_slotsOfWorld[static_cast<size_t>(worldOf[static_cast<size_t>(k)])].push_back(k);
-  }
-  return m_slotsOfWorld[static_cast<size_t>(world)];
-}
-
-void CudaBatch::uploadAll() {
-  if (worlds() == 1) {
-    CudaStepper& m = *m_members.front();
-    m_device->upload(m.world(), m.scenario().vessel.dof, m.m_vesselSlot);
-  } else {
-    // The worlds one after the other, each in its own order.
-    World all;
-    std::vector<int> worldOf, vesselSlots;
-    for (int w = 0; w < worlds(); ++w) {
-      const CudaStepper& m = *m_members[static_cast<size_t>(w)];
-      const int base = all.size();
-      appendRows(all, m.m_cpu->world(), 0, idOffset(w));
-      worldOf.insert(worldOf.end(), static_cast<size_t>(all.size() - base), w);
-      vesselSlots.push_back(m.m_vesselSlot >= 0 ? base + m.m_vesselSlot : -1);
-    }
-    all.nextId = static_cast<std::int64_t>(worlds()) * m_idStride;
-    m_device->upload(all, worldOf, vesselSlots, vesselDofs());
-  }
-  m_slotsOfWorld.clear();
-  for (CudaStepper* m : m_members) {
-    m->m_slotOfId.clear();
-    m->m_hostCurrent = true;
-  }
-}
-
-void CudaBatch::ensureStep(long step) {
-  if (step >= m_resultFirst && step < m_resultFirst + static_cast<long>(m_result->steps.size())) return;
-  for (const CudaStepper* m : m_members)
-    if (m->m_step != step) throw std::logic_error("CUDA backend: the cases of one device state must be stepped together");
-  runBatch(step);
-}
-
-// Up to copy_back_every steps, ending where the host needs the state: the next frame, the next
-// re-sort along the curve (every kResortPeriod steps), the scenario's last step.
-void CudaBatch::runBatch(long step) {
-  const Scenario& s = m_members.front()->scenario();
-  // Alone on its device, a batch is copy_back_every steps in one launch. Sharing it (a sweep's
-  // other cases), a batch is one step: the device-side loops of concurrent graphs do not overlap
-  // (an H200 took 23 s for the 70-run load study with 16-step loops, 8.5 s with single steps).
-  // The results are the same either way (CopyBackIntervalChangesNothing).
-  const long every = liveOn(m_deviceOrdinal).load() > 1 ? 1 : s.copyBackEvery;
-  long end = step + every;
-  auto stopAtMultipleOf = [&](long every) {
-    if (every > 0) end = std::min(end, (step / every + 1) * every);
-  };
-  if (s.output.frameEvery > 0) stopAtMultipleOf(s.output.frameEvery);
-  if (s.mortonSort) stopAtMultipleOf(kResortPeriod);
-  if (step < s.steps) end = std::min(end, s.steps);
-  Stopwatch clock;
-  m_device->run(step, s.dt, static_cast<int>(end - step), *m_result);
-  m_resultFirst = step;
-  times.batch += clock.lap();
-  ++times.batches;
-  for (CudaStepper* m : m_members) m->m_hostCurrent = false;
-}
-
-void CudaBatch::addEdit(int world, const std::vector<int>& removedLocal, const World& mirror, int firstAdded) {
-  for (int local : removedLocal) m_removed.push_back(sharedSlot(world, local));
-  appendRows(m_added, mirror, firstAdded, idOffset(world));
-  m_addedWorlds.insert(m_addedWorlds.end(), static_cast<size_t>(mirror.size() - firstAdded), world);
-  m_added.nextId = worlds() == 1 ? mirror.nextId : static_cast<std::int64_t>(worlds()) * m_idStride;
-  if (worlds() > 1 && mirror.nextId > m_idStride)
-    throw std::runtime_error(fmt::format("CUDA backend: a case made more than {} bodies, the room for its ids in a shared device state", m_idStride));
-  m_edited = true;
-}
-
-void CudaBatch::finishedStep(long step) {
-  if (++m_finished < worlds()) return;
-  m_finished = 0;
-  m_stepsDone = step + 1;
-  applyEdits();
-  if (m_members.front()->scenario().mortonSort && isResortStep(step + 1)) {
-    Stopwatch clock;
-    reSortAlongCurve();
-    times.resort += clock.lap();
-    ++times.resorts;
-  }
-}
-
-void CudaBatch::applyEdits() {
-  if (!m_edited) return;
-  Stopwatch clock;
-  std::sort(m_removed.begin(), m_removed.end());
-  const bool followed = m_device->editBodies(m_removed, m_added, 0, worlds() == 1 ? std::vector<int>{} : m_addedWorlds, vesselDofs());
-  m_removed.clear();
-  m_added = World{};
-  m_addedWorlds.clear();
-  m_edited = false;
-  m_slotsOfWorld.clear();
-  times.edit += clock.lap();
-  if (!followed) {
-    // A strategy that cannot follow the edit on the device (a plugin's, say; one world only)
-    // rebuilds from the mirror, which must then be in the device's order.
-    CudaStepper& m = *m_members.front();
-    m.flushPendingOrder();
-    m_device->uploadBroadphase(m.world());
-  }
-  times.bookkeeping += clock.lap();
-}
-
-// Every kResortPeriod steps (docs/architecture.md "Speed habits": neighbours in space become neighbours in memory).
-void CudaBatch::reSortAlongCurve() {
-  // On the device, bit for bit as the host's World::curveOrder + World::permute, world by world;
-  // the mirrors follow lazily (m_pendingOrder). At 10^6 floes a round trip through the host
-  // (download, sort, permute, upload, re-capture) cost more than the kResortPeriod steps it serves.
-  const std::vector<int> worldBefore = m_device->worldOfSlots();
-  bool followed = true;
-  const std::vector<int> order = m_device->reorderAlongCurve(&followed);
-  m_slotsOfWorld.clear();
-  if (worlds() == 1) {
-    m_members.front()->followReorder(order);
-  } else {
-    // Each world's share of the order, in its own slots: the rank of a shared slot among its world's.
-    std::vector<int> localOf(worldBefore.size()), seen(static_cast<size_t>(worlds()), 0);
-    for (size_t k = 0; k < worldBefore.size(); ++k) localOf[k] = seen[static_cast<size_t>(worldBefore[k])]++;
-    std::vector<std::vector<int>> local(static_cast<size_t>(worlds()));
-    for (int old : order) local[static_cast<size_t>(worldBefore[static_cast<size_t>(old)])].push_back(localOf[static_cast<size_t>(old)]);
-    for (int w = 0; w < worlds(); ++w) m_members[static_cast<size_t>(w)]->followReorder(local[static_cast<size_t>(w)]);
-  }
-  if (!followed) {
-    // A device broadphase that keeps per-body storage but cannot permute it (a plugin's, say; one
-    // world only) rebuilds from the whole world, in the new order.
-    for (CudaStepper* m : m_members) m->downloadState();
-    uploadAll();
-  }
-}
 
 long CudaStepper::broadphaseRebuilds() const {
   const cuda::CudaBroadphase* b = m_batch->device().broadphase();
