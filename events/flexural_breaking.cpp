@@ -26,13 +26,20 @@ static void limitVertices(std::vector<Vec2>& v, int limit) {
   }
 }
 
+std::vector<std::int64_t> FlexuralBreaking::bodiesRead(const Params& p, const StepRecords& records) {
+  std::vector<std::int64_t> ids;
+  for (const BreakRequest& request : records.rows(p.breaks)) ids.push_back(request.floeId);
+  return ids;
+}
+
 void FlexuralBreaking::apply(const Params& p, TopologyData& data) {
-  if (data.breakCount == 0) return;
+  const std::vector<BreakRequest> breaks = data.records->rows(p.breaks);
+  if (breaks.empty()) return;
   World& world = *data.world;
   // The slots of the requested floes only (a few per step): one pass over the ids, no map of the
   // whole world (at 10^6 floes that map was most of the CUDA backend's time).
   std::unordered_map<std::int64_t, int> slotOf;
-  for (int r = 0; r < data.breakCount; ++r) slotOf.emplace(data.breaks[r].floeId, -1);
+  for (const BreakRequest& request : breaks) slotOf.emplace(request.floeId, -1);
   for (int i = 0; i < world.size(); ++i)
     if (auto it = slotOf.find(world.id[i]); it != slotOf.end()) it->second = i;
 
@@ -40,8 +47,7 @@ void FlexuralBreaking::apply(const Params& p, TopologyData& data) {
   std::vector<char> remove(world.size(), 0);
   std::unordered_set<int> done;
   std::vector<BodySpec> pieces;
-  for (int r = 0; r < data.breakCount; ++r) {
-    const BreakRequest& request = data.breaks[r];
+  for (const BreakRequest& request : breaks) {
     const int i = slotOf.at(request.floeId);
     if (i < 0 || !done.insert(i).second) continue;
     Vec2 polygon[kMaxVertices];
@@ -82,6 +88,7 @@ void FlexuralBreaking::apply(const Params& p, TopologyData& data) {
 static FlexuralBreaking::Params parseFlexuralBreaking(EventConfig& config) {
   FlexuralBreaking::Params p{};
   p.minArea = config.params.getNonNegative("min_area", 1);
+  p.breaks = config.records.open<BreakRequest>(kBreakStream);
   return p;
 }
 

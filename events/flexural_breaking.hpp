@@ -10,6 +10,10 @@
 // A floe is broken at most once per step; a cut that misses the floe leaves it whole.
 // Host only: it changes the set of bodies.
 #pragma once
+#include <cstdint>
+#include <vector>
+
+#include "events/break_request.hpp"
 #include "framework/api/registry.hpp"
 
 namespace gem {
@@ -17,8 +21,13 @@ namespace gem {
 struct FlexuralBreaking {
   struct Params {
     Real minArea;  // m^2: smaller pieces become rubble (1)
+    RecordStream<BreakRequest> breaks;  // what ship_impact asks to cut
   };
   static void apply(const Params& p, TopologyData& data);
+  // The topology contract (api/registry.hpp TopologyData): the streams whose rows call for this
+  // phase, and the bodies a step's rows name, the only ones apply() reads.
+  static std::vector<int> streamsRead(const Params& p) { return {p.breaks.index}; }
+  static std::vector<std::int64_t> bodiesRead(const Params& p, const StepRecords& records);
 };
 
 }  // namespace gem

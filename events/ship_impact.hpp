@@ -18,9 +18,26 @@
 #pragma once
 #include <cmath>
 
+#include "events/break_request.hpp"
 #include "framework/api/event_api.hpp"
 
 namespace gem {
+
+// A ship-ice impact at contact onset (docs/model.md 5): a row of the stream "impacts", which
+// ship_impact.cpp writes to impacts.csv.
+struct ImpactRecord {
+  Real time;
+  std::int64_t floeId;
+  Real floeMass, thickness, apexDeg, frameAngleDeg;
+  Vec2 point, normal;          // world contact point; normal from the vessel into the floe
+  Real xFromStem, yFromCenterline;
+  Real closingSpeed;           // V_n, m/s
+  Real force;                  // min(F_n, F_lim), N
+  Real forceLimit;             // F_lim, N (infinite when the edge cannot fail in bending)
+  bool broke;
+};
+
+constexpr const char* kImpactStream = "impacts";
 
 struct ShipImpact {
   static constexpr int kOrder = event_order::kObservers;  // reads the contact, applies no impulse
@@ -31,6 +48,8 @@ struct ShipImpact {
     Real pressure;       // P_0, Pa (1 MPa)
     Real flexuralStrength;  // sigma_f, Pa (0.5 MPa)
     Real hullFriction;   // mu_h (0.1)
+    RecordStream<ImpactRecord> impacts;  // the impact log
+    RecordStream<BreakRequest> breaks;   // floes whose edge failed, for flexural_breaking
   };
 
   struct Result {
@@ -134,11 +153,11 @@ struct ShipImpact {
     record.force = r.force;
     record.forceLimit = r.forceLimit;
     record.broke = r.broke;
-    sink.push(record);
+    sink.push(p.impacts, record);
     if (r.broke) {
       const Real centroidDistance = norm(f.position - c);
       const Real bendingLength = 20 * f.thickness / r.froudeFactor;
-      sink.push(BreakRequest{f.id, c, n, Real(1.2) * (bendingLength < centroidDistance ? bendingLength : centroidDistance)});
+      sink.push(p.breaks, BreakRequest{f.id, c, n, Real(1.2) * (bendingLength < centroidDistance ? bendingLength : centroidDistance)});
     }
   }
 };

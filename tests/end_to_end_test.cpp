@@ -27,7 +27,7 @@ Trajectory runWith(const std::string& broadphase, const TempDir& dir) {
   Trajectory t;
   for (long k = 0; k < s.steps; ++k) {
     sim.step();
-    for (const ImpactRecord& r : sim.impacts()) t.impacts.insert(t.impacts.end(), {r.time, r.force, r.point.x, r.point.y});
+    for (const ImpactRecord& r : ::gem::test::impactsOf(sim)) t.impacts.insert(t.impacts.end(), {r.time, r.force, r.point.x, r.point.y});
   }
   const World& w = sim.world();
   t.ids = w.id;

@@ -309,7 +309,7 @@ TEST(ShipImpact, IsLoggedOnceAtContactOnsetWithTheHullAngleOfTheStem) {
   for (int i = 0; i < 30; ++i) {
     sim.step();
     stepsInContact += sim.contactCount() > 0;
-    for (const ImpactRecord& r : sim.impacts()) {
+    for (const ImpactRecord& r : ::gem::test::impactsOf(sim)) {
       ++logged;
       EXPECT_NEAR(r.frameAngleDeg, 60, 1e-9);  // the default hull's stem
       EXPECT_NEAR(r.normal.x, 1, 1e-9);
@@ -333,7 +333,7 @@ TEST(FlexuralBreaking, ThinFloeStruckHardSplitsAndMassIsAccountedFor) {
   bool broke = false;
   for (int i = 0; i < 10 && !broke; ++i) {
     sim.step();
-    for (const ImpactRecord& r : sim.impacts()) broke |= r.broke;
+    for (const ImpactRecord& r : ::gem::test::impactsOf(sim)) broke |= r.broke;
   }
   ASSERT_TRUE(broke);
   ASSERT_EQ(sim.floesBroken(), 1);

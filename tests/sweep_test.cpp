@@ -381,7 +381,7 @@ class LockstepStepper final : public Stepper {
   Real time() const override { return m_sim.time(); }
   const World& hostWorld() override { return m_sim.hostWorld(); }
   VesselSample vessel() override { return m_sim.vessel(); }
-  const std::vector<ImpactRecord>& impacts() const override { return m_sim.impacts(); }
+  const StepRecords& records() const override { return m_sim.records(); }
   int contactCount() const override { return m_sim.contactCount(); }
   Vec2 vesselIceForce() const override { return m_sim.vesselIceForce(); }
   double rubbleMass() const override { return m_sim.rubbleMass(); }

@@ -8,7 +8,9 @@
 #include <random>
 #include <string>
 
+#include "events/ship_impact.hpp"
 #include "framework/scenario/scenario.hpp"
+#include "framework/step/stepper.hpp"
 
 namespace gem::test {
 
@@ -74,6 +76,9 @@ inline int runGem(const std::string& arguments, const std::filesystem::path& log
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
+
+// The impacts the last step logged (ship_impact's record stream).
+inline std::vector<ImpactRecord> impactsOf(const Stepper& stepper) { return stepper.records().rows<ImpactRecord>(kImpactStream); }
 
 inline std::string readFile(const std::filesystem::path& file) {
   std::ifstream in(file);

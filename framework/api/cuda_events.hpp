@@ -47,6 +47,7 @@ struct DevicePairData {
   const int* liveCount;   // device: this step's contacts
   const StepContext* ctx; // device
   RecordSink sink;        // device buffers, integer atomic counters
+  int event;              // the event's place among the phase's events: stamped on its records
 };
 
 struct DeviceSoloData {
@@ -131,7 +132,7 @@ __global__ void pairEventKernel(Params params, const Params* perWorld, DevicePai
   const StepContext ctx = *d.ctx;
   const int a = d.contactA[k];
   const Params p = paramsOf(params, perWorld, d.world, a);
-  Event::apply(p, d.bodies[a], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], ctx, d.sink);
+  Event::apply(p, d.bodies[a], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], ctx, d.sink.at(d.event, k, d.world[a]));
 }
 
 template <class Event, class Params>

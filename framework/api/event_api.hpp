@@ -6,6 +6,7 @@
 #pragma once
 #include <cstdint>
 
+#include "framework/api/record_stream.hpp"
 #include "geometry/contact.hpp"
 #include "framework/world/body_kind.hpp"
 #include "framework/world/constants.hpp"
@@ -129,75 +130,6 @@ constexpr int kImpulses = 200;   // collision impulses (impact)
 constexpr int kDefault = 300;    // after the built-in impulses: e.g. friction reading slot.normal
 constexpr int kObservers = 400;  // events that only read and record (ship_impact's log)
 }  // namespace event_order
-
-// A ship-ice impact at contact onset (docs/model.md 5), one row of impacts.csv.
-struct ImpactRecord {
-  Real time;
-  std::int64_t floeId;
-  Real floeMass, thickness, apexDeg, frameAngleDeg;
-  Vec2 point, normal;          // world contact point; normal from the vessel into the floe
-  Real xFromStem, yFromCenterline;
-  Real closingSpeed;           // V_n, m/s
-  Real force;                  // min(F_n, F_lim), N
-  Real forceLimit;             // F_lim, N (infinite when the edge cannot fail in bending)
-  bool broke;
-};
-
-// A floe to be cut by the flexural_breaking event in the topology phase (docs/model.md 6).
-struct BreakRequest {
-  std::int64_t floeId;
-  Vec2 point;      // contact point c
-  Vec2 normal;     // from the vessel into the floe
-  Real cuspLength; // m, distance of the cut from c along the normal
-};
-
-// A row that an event logs for its own output (a plugin's detector, say): the channel it was given
-// when its Params were parsed (framework/api/log_channel.hpp), the two bodies and up to six numbers.
-// Records are plain data so that device code can push them too; the host hands each one to its
-// channel's writer after the step, in contact order, on either backend.
-struct LogRecord {
-  int channel;
-  Real time;
-  std::int64_t idA, idB;
-  Real value[6];
-};
-
-// Where events append records. The CPU driver points these at host buffers; a device driver
-// points them at device buffers. Records past capacity are counted but dropped (the driver
-// grows the buffers and reports it), so a step never writes out of bounds.
-struct RecordSink {
-  ImpactRecord* impacts;
-  int impactCapacity;
-  int* impactCount;
-  BreakRequest* breaks;
-  int breakCapacity;
-  int* breakCount;
-  LogRecord* logs;
-  int logCapacity;
-  int* logCount;
-
-  // On the device many contacts push at once: an integer atomic counter (the CUDA driver then
-  // orders the records deterministically by floe slot, which is the CPU's contact order).
-  GEM_HD void push(const ImpactRecord& r) const {
-    const int k = next(impactCount);
-    if (k < impactCapacity) impacts[k] = r;
-  }
-  GEM_HD void push(const BreakRequest& r) const {
-    const int k = next(breakCount);
-    if (k < breakCapacity) breaks[k] = r;
-  }
-  GEM_HD void push(const LogRecord& r) const {
-    const int k = next(logCount);
-    if (k < logCapacity) logs[k] = r;
-  }
-  GEM_HD static int next(int* counter) {
-#if defined(__CUDA_ARCH__)
-    return atomicAdd(counter, 1);
-#else
-    return (*counter)++;
-#endif
-  }
-};
 
 // 1 / effective mass of a body for an impulse along unit n at point c (docs/model.md 4:
 // Co = l^2 + m^2 + eta^2 / r^2, M_e = M / Co). A 1-DOF vessel moves only along its heading, so

@@ -34,4 +34,9 @@ void deliverLogs(const LogRecord* records, int count) {
   }
 }
 
+void deliverLogs(const StepRecords& records) {
+  const std::vector<LogRecord> logs = records.rows(RecordStream<LogRecord>{kLogStream});
+  deliverLogs(logs.data(), static_cast<int>(logs.size()));
+}
+
 }  // namespace gem

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "framework/api/event_api.hpp"
+#include "framework/api/step_records.hpp"
 
 namespace gem {
 
@@ -20,5 +21,7 @@ int openLogChannel(LogWriter writer);
 
 // Hands each record to its channel's writer. An unknown channel is a logic error (throws).
 void deliverLogs(const LogRecord* records, int count);
+// Hands the log stream's rows of a step (stream 0) to their channels' writers, in order.
+void deliverLogs(const StepRecords& records);
 
 }  // namespace gem

@@ -129,6 +129,21 @@ std::vector<std::string> Registry::broadphaseNames() const {
   return out;
 }
 
+void Registry::addRecordOutput(RecordOutputEntry entry) {
+  for (RecordOutputEntry& e : m_recordOutputs)
+    if (e.file == entry.file) {
+      e = std::move(entry);  // a plugin overriding the event that owns it replaces its writer
+      return;
+    }
+  m_recordOutputs.push_back(std::move(entry));
+}
+
+std::vector<const RecordOutputEntry*> Registry::recordOutputs() const {
+  std::vector<const RecordOutputEntry*> out;
+  for (const RecordOutputEntry& e : m_recordOutputs) out.push_back(&e);
+  return out;
+}
+
 static PluginLibraryLoader& pluginLibraryLoader() {
   static PluginLibraryLoader loader{nullptr, nullptr};
   return loader;

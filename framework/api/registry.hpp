@@ -11,6 +11,7 @@
 
 #include "framework/api/broadphase.hpp"
 #include "framework/api/event_api.hpp"
+#include "framework/api/step_records.hpp"
 #if defined(GEM_BUILDING_PLUGIN)
 #include "framework/api/plugin_api.hpp"
 #endif
@@ -34,6 +35,7 @@ struct PairPhaseData {
   int count;
   StepContext ctx;
   RecordSink sink;
+  int event;  // the event's place among the phase's events: stamped on its records (RecordTag)
 };
 
 struct SoloPhaseData {
@@ -49,14 +51,15 @@ struct MotionPhaseData {
   StepContext ctx;
 };
 
-// Topology events run on the host after motion (docs/model.md 8, phase 6). The contract, which lets the
-// CUDA backend keep its world on the device: an event reads the state of the bodies its requests
-// name (breaks[k].floeId) and only theirs (the CUDA backend fetches just those rows), and changes
-// the bodies only through World::removeBodies and World::addBody (the device then replays the edit).
+// Topology events run on the host after motion (docs/model.md 8, phase 6), in a step whose records
+// call for them. The contract, which lets the CUDA backend keep its world on the device: an event
+// declares the streams whose rows call for it (streamsRead) and the bodies a step's rows name
+// (bodiesRead), reads the state of those bodies only (the CUDA backend fetches just those rows),
+// and changes the bodies only through World::removeBodies and World::addBody (the device then
+// replays the edit).
 struct TopologyData {
   struct World* world;
-  const BreakRequest* breaks;
-  int breakCount;
+  const StepRecords* records;  // the step's rows, in the CPU's order
   Real time;
   // Outputs: what the event did, for the summary and the broadphase.
   double rubbleMass = 0;   // kg removed as rubble this step
@@ -71,6 +74,9 @@ class EventInstance {
   virtual void runSolo(const SoloPhaseData&) {}
   virtual void runMotion(const MotionPhaseData&) {}
   virtual void runTopology(TopologyData&) {}
+  // Topology events: the streams whose rows call for the phase, and the bodies a step's rows name.
+  virtual std::vector<int> streamsRead() const { return {}; }
+  virtual std::vector<std::int64_t> bodiesRead(const StepRecords&) const { return {}; }
   // The parsed Params, so that a device driver of the same event is made from the very same values.
   virtual const void* params() const = 0;
 };
@@ -80,6 +86,7 @@ class EventInstance {
 struct EventConfig {
   TableReader& params;
   const Scenario& scenario;
+  RecordStreams& records;  // the run's record streams: open the ones the event writes or reads
 };
 
 struct EventEntry {
@@ -103,6 +110,18 @@ struct BroadphaseEntry {
   std::vector<std::string> settings;  // the keys of BroadphaseSettings it reads (its kSettings)
 };
 
+// A file of the run folder written from a record stream, one CSV row per record, registered by the
+// event that owns the record type (ship_impact: impacts.csv). countKey and statisticKey, when not
+// empty, add to summary.json the number of rows and the statistics of statisticValue over them.
+struct RecordOutputEntry {
+  std::string stream;  // the stream's name
+  std::string file;    // in the run folder
+  std::string header;  // the CSV header line, without its newline
+  void (*writeRow)(const void* record, std::string& row);  // the row, with its newline
+  std::string countKey, statisticKey;
+  double (*statisticValue)(const void* record);
+};
+
 class Registry {
  public:
   static Registry& global();
@@ -115,6 +134,9 @@ class Registry {
   // By phase (pair, solo, motion, topology), then each event's declared order, then name: the
   // order in which every driver runs them.
   std::vector<const EventEntry*> events() const;
+  // The run folder's writers of record streams (impacts.csv), in registration order.
+  void addRecordOutput(RecordOutputEntry entry);
+  std::vector<const RecordOutputEntry*> recordOutputs() const;
   std::vector<const BroadphaseEntry*> broadphases() const;
   std::vector<std::string> eventNames() const;
   std::vector<std::string> broadphaseNames() const;
@@ -133,6 +155,7 @@ class Registry {
  private:
   std::map<std::string, EventEntry> m_events;
   std::map<std::string, BroadphaseEntry> m_broadphases;
+  std::vector<RecordOutputEntry> m_recordOutputs;
   struct Staging {
     std::string origin;
     bool allowOverride = false;
@@ -151,7 +174,7 @@ class CpuPairDriver final : public EventInstance {
   explicit CpuPairDriver(const Params& p) : m_params(p) {}
   void runPairs(const PairPhaseData& d) override {
     for (int k = 0; k < d.count; ++k)
-      Event::apply(m_params, d.bodies[d.contactA[k]], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], d.ctx, d.sink);
+      Event::apply(m_params, d.bodies[d.contactA[k]], d.bodies[d.contactB[k]], d.contacts[k], d.slots[k], d.ctx, d.sink.at(d.event, k, 0));
   }
   const void* params() const override { return &m_params; }
 
@@ -196,6 +219,14 @@ class TopologyDriver final : public EventInstance {
   using Params = typename Event::Params;
   explicit TopologyDriver(const Params& p) : m_params(p) {}
   void runTopology(TopologyData& d) override { Event::apply(m_params, d); }
+  std::vector<int> streamsRead() const override {
+    if constexpr (requires { Event::streamsRead(m_params); }) return Event::streamsRead(m_params);
+    else return {};
+  }
+  std::vector<std::int64_t> bodiesRead(const StepRecords& records) const override {
+    if constexpr (requires { Event::bodiesRead(m_params, records); }) return Event::bodiesRead(m_params, records);
+    else return {};
+  }
   const void* params() const override { return &m_params; }
 
  private:
@@ -259,6 +290,11 @@ struct RegisterNow {
   GEM_REGISTER_EVENT(::gem::CpuMotionDriver, ::gem::EventPhase::Motion, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
 #define GEM_REGISTER_TOPOLOGY_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
   GEM_REGISTER_EVENT(::gem::TopologyDriver, ::gem::EventPhase::Topology, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
+
+// Registers the writer of a record stream to a file of the run folder (RecordOutputEntry).
+#define GEM_REGISTER_RECORD_OUTPUT(STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, STATISTIC_KEY, STATISTIC_VALUE) \
+  GEM_REGISTRATION(record_output_, registry.addRecordOutput(::gem::RecordOutputEntry{                       \
+      STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, STATISTIC_KEY, STATISTIC_VALUE}))
 
 // Registers a broadphase class constructible from BroadphaseSettings; its kSettings, if any, name
 // the settings it reads.

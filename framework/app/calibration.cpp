@@ -117,9 +117,10 @@ CalibrationResult runCalibrationCase(const Scenario& base, const CalibrationCase
   CpuStepper sim(s);
   for (long k = 0; k < s.steps && !result.logged; ++k) {
     sim.step();
-    if (!sim.impacts().empty()) {
+    const std::vector<ImpactRecord> impacts = sim.records().rows<ImpactRecord>(kImpactStream);
+    if (!impacts.empty()) {
       result.logged = true;
-      result.record = sim.impacts().front();
+      result.record = impacts.front();
     }
   }
   return result;

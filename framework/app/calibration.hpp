@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "events/ship_impact.hpp"
 #include "framework/api/event_api.hpp"
 #include "framework/scenario/scenario.hpp"
 

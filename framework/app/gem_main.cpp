@@ -66,9 +66,14 @@ int commandRun(const RunArguments& a) {
   if (!a.quiet) {
     std::printf("  floes          %d at start, %d at end (%ld broken, %.4g kg rubble)\n", r.floesInitial, r.floesFinal,
                 r.floesBroken, r.rubbleMass);
-    std::printf("  impacts        %ld ship-ice impacts", r.impacts);
-    if (r.impactForce.count) std::printf(", force mean %.3g kN, max %.3g kN", r.impactForce.mean / 1e3, r.impactForce.max / 1e3);
-    std::printf("\n");
+    // The record streams' totals, under the names their events give them (ship_impact: impacts).
+    for (const RecordTotals& t : r.records) {
+      if (t.countKey.empty()) continue;
+      std::printf("  %-14s %ld", t.countKey.c_str(), t.count);
+      if (!t.statisticKey.empty() && t.statistic.count)
+        std::printf(", %s mean %.4g, max %.4g", t.statisticKey.c_str(), t.statistic.mean, t.statistic.max);
+      std::printf("\n");
+    }
     if (r.shipSpeed.count)
       std::printf("  ship speed     mean %.3f m/s (min %.3f, max %.3f); mean net thrust %.1f kN\n", r.shipSpeed.mean,
                   r.shipSpeed.min, r.shipSpeed.max, r.netThrust.mean / 1e3);

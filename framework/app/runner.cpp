@@ -16,6 +16,7 @@
 #include "framework/api/errors.hpp"
 #include "framework/field/ice_file.hpp"
 #include "framework/output/ice_file_writer.hpp"
+#include "framework/api/registry.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/output/vtk_writer.hpp"
 
@@ -63,6 +64,16 @@ void writeStateCsv(const std::filesystem::path& file, const World& w) {
 
 }  // namespace
 
+// The record streams' totals (ship_impact's "impacts" and "impact_force_n"), one line each.
+static std::string recordTotalsJson(const RunSummary& s) {
+  std::string out;
+  for (const RecordTotals& t : s.records) {
+    if (!t.countKey.empty()) out += fmt::format("  \"{}\": {},\n", t.countKey, t.count);
+    if (!t.statisticKey.empty()) out += fmt::format("  \"{}\": {},\n", t.statisticKey, jsonStats(t.statistic));
+  }
+  return out;
+}
+
 std::string summaryJson(const RunSummary& s) {
   return fmt::format(
       "{{\n"
@@ -70,12 +81,12 @@ std::string summaryJson(const RunSummary& s) {
       "  \"real_time_factor\": {},\n  \"backend\": \"{}\",\n  \"broadphase\": \"{}\",\n  \"device\": \"{}\",\n"
       "  \"floes_initial\": {},\n  \"floes_final\": {},\n  \"floes_broken\": {},\n"
       "  \"ice_mass_initial_kg\": {},\n  \"ice_mass_final_kg\": {},\n  \"rubble_mass_kg\": {},\n"
-      "  \"cases_on_device\": {},\n  \"impacts\": {},\n  \"ship_speed\": {},\n  \"impact_force_n\": {},\n  \"net_thrust_n\": {},\n"
+      "  \"cases_on_device\": {},\n{}  \"ship_speed\": {},\n  \"net_thrust_n\": {},\n"
       "  \"resistance_mean_n\": {},\n  \"ship_speed_in_ice\": {},\n  \"resistance_in_ice_n\": {}\n}}\n",
       GEM_VERSION, s.steps, jsonNumber(s.simTime), jsonNumber(s.wallTime),
       jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY), s.backend, s.broadphase, s.device,
       s.floesInitial, s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial), jsonNumber(s.iceMassFinal),
-      jsonNumber(s.rubbleMass), s.casesOnDevice, s.impacts, jsonStats(s.shipSpeed), jsonStats(s.impactForce), jsonStats(s.netThrust),
+      jsonNumber(s.rubbleMass), s.casesOnDevice, recordTotalsJson(s), jsonStats(s.shipSpeed), jsonStats(s.netThrust),
       s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null", jsonStats(s.shipSpeedInIce),
       s.netThrustInIce.count ? jsonNumber(s.netThrustInIce.mean) : "null");
 }
@@ -92,8 +103,7 @@ class ScenarioRun {
       : m_scenario(scenario),
         m_stepper(&stepper),
         m_dir(scenario.output.dir),
-        m_timeseries((std::filesystem::create_directories(m_dir), m_dir / "timeseries.csv")),
-        m_impacts(m_dir / "impacts.csv") {
+        m_timeseries((std::filesystem::create_directories(m_dir), m_dir / "timeseries.csv")) {
     Stepper& sim = *m_stepper;
     m_summary.backend = sim.backend();  // "auto" may have fallen back to the cpu
     m_summary.broadphase = scenario.broadphase;
@@ -109,7 +119,13 @@ class ScenarioRun {
     if (m_frames && has("vtk")) m_vtk = std::make_unique<VtkSeriesWriter>(m_dir);
     if (m_frames && has("ice")) m_ice = std::make_unique<IceFileWriter>(m_dir / "frames.ice");
     m_timeseries.stream() << "t,ship_x,ship_y,ship_heading,ship_speed,net_thrust,ice_force_x,contacts\n";
-    m_impacts.stream() << "t,floe_id,floe_mass,thickness,apex_deg,frame_angle_deg,x,y,nx,ny,x_from_stem,y_from_centerline,vn,fn,flim,broke\n";
+    // The record streams' files, from the events that own them (ship_impact: impacts.csv).
+    for (const RecordOutputEntry* output : Registry::global().recordOutputs()) {
+      const int stream = sim.records().streams().find(output->stream);
+      if (stream < 0) continue;  // no event of this run opened it
+      m_recordFiles.push_back(RecordFile{output, stream, std::make_unique<AtomicFile>(m_dir / output->file), {}});
+      m_recordFiles.back().file->stream() << output->header << "\n";
+    }
     const VesselSpec& vessel = scenario.vessel;
     m_thrust = Propulsion::Params{vessel.bollardThrust,
                                   vessel.bollardThrust / (vessel.openWaterSpeed * vessel.openWaterSpeed * vessel.openWaterSpeed)};
@@ -120,12 +136,16 @@ class ScenarioRun {
   void record(long k) {
     Stepper& sim = *m_stepper;
     const Scenario& scenario = m_scenario;
-    for (const ImpactRecord& r : sim.impacts()) {
-      m_force.add(r.force);
-      m_impacts.stream() << fmt::format("{:.6g},{},{:.9g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{},{}\n",
-                                        r.time, r.floeId, r.floeMass, r.thickness, r.apexDeg, r.frameAngleDeg, r.point.x, r.point.y,
-                                        r.normal.x, r.normal.y, r.xFromStem, r.yFromCenterline, r.closingSpeed, r.force,
-                                        std::isfinite(r.forceLimit) ? fmt::format("{:.9g}", r.forceLimit) : "inf", r.broke ? 1 : 0);
+    std::string row;
+    for (RecordFile& f : m_recordFiles) {
+      const StepRecords& records = sim.records();
+      for (int r = 0; r < records.rowCount(f.stream); ++r) {
+        const void* record = records.record(f.stream, r);
+        f.output->writeRow(record, row);
+        f.file->stream() << row;
+        if (f.output->statisticValue) f.statistic.add(f.output->statisticValue(record));
+        else ++f.statistic.count;
+      }
     }
     const VesselSample vessel = sim.vessel();
     const Vec2 forward{std::cos(vessel.heading), std::sin(vessel.heading)};
@@ -162,9 +182,10 @@ class ScenarioRun {
     m_summary.iceMassFinal = world.floeMass();
     m_summary.rubbleMass = sim.rubbleMass();
     m_summary.floesBroken = sim.floesBroken();
-    m_summary.impacts = m_force.count;
     m_summary.shipSpeed = m_speed.stats();
-    m_summary.impactForce = m_force.stats();
+    m_summary.records.clear();
+    for (const RecordFile& f : m_recordFiles)
+      m_summary.records.push_back(RecordTotals{f.output->countKey, f.output->statisticKey, f.statistic.count, f.statistic.stats()});
     m_summary.netThrust = m_netThrust.stats();
     m_summary.shipSpeedInIce = m_speedInIce.stats();
     m_summary.netThrustInIce = m_netThrustInIce.stats();
@@ -187,7 +208,7 @@ class ScenarioRun {
   }
   void closeFiles() {
     m_timeseries.commit();
-    m_impacts.commit();
+    for (RecordFile& f : m_recordFiles) f.file->commit();
     if (m_vtk) m_vtk->finish();
     if (m_ice) m_ice->finish();
   }
@@ -199,9 +220,16 @@ class ScenarioRun {
   bool m_frames = false;
   std::unique_ptr<VtkSeriesWriter> m_vtk;
   std::unique_ptr<IceFileWriter> m_ice;
-  AtomicFile m_timeseries, m_impacts;
+  AtomicFile m_timeseries;
+  struct RecordFile {
+    const RecordOutputEntry* output;
+    int stream;
+    std::unique_ptr<AtomicFile> file;
+    Accumulator statistic;  // of output->statisticValue, or only the count
+  };
+  std::vector<RecordFile> m_recordFiles;
   Propulsion::Params m_thrust{};
-  Accumulator m_speed, m_force, m_netThrust, m_speedInIce, m_netThrustInIce;
+  Accumulator m_speed, m_netThrust, m_speedInIce, m_netThrustInIce;
 };
 
 }  // namespace

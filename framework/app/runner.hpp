@@ -22,14 +22,23 @@ struct Stats {
   long count = 0;
 };
 
+// A record stream's totals for summary.json, under the keys its output declares (ship_impact:
+// "impacts", "impact_force_n").
+struct RecordTotals {
+  std::string countKey, statisticKey;
+  long count = 0;
+  Stats statistic;
+};
+
 struct RunSummary {
   long steps = 0;
   double simTime = 0, wallTime = 0;
   std::string backend, broadphase, device;
   int floesInitial = 0, floesFinal = 0;
   double iceMassInitial = 0, iceMassFinal = 0, rubbleMass = 0;
-  long impacts = 0, floesBroken = 0;
-  Stats shipSpeed, impactForce, netThrust;
+  long floesBroken = 0;
+  Stats shipSpeed, netThrust;
+  std::vector<RecordTotals> records;  // per record stream written to the run folder (impacts.csv)
   // Over the steady part of the transit: the whole hull within the domain's x range.
   Stats shipSpeedInIce, netThrustInIce;
   std::string outputDir;

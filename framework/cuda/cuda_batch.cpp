@@ -118,6 +118,20 @@ CudaBatch::CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal)
   }
   m_device->setBroadphase(deviceBroadphase(s));
   m_device->setGridCell(s.broadphase == "uniform_grid" ? s.broadphaseSettings.cellSize : 0);
+  m_device->setIdStride(m_idStride);
+  // The record streams, as the events opened them (the same in every case: the same events parsed
+  // them in the same order); a row of a stream that a topology event reads ends the batch.
+  const RecordStreams& streams = first.m_cpu->recordStreams();
+  for (const CudaStepper* m : m_members)
+    if (m->m_cpu->recordStreams().count() != streams.count()) throw BackendUnsupported("cases run together on one device must open the same record streams");
+  std::vector<int> strides;
+  for (int q = 0; q < streams.count(); ++q) strides.push_back(streams.info(q).stride);
+  unsigned halt = 0;
+  for (const EnabledEvent& event : events)
+    if (event.phase == EventPhase::Topology)
+      for (int q : event.instance->streamsRead())
+        if (q >= 0) halt |= 1u << q;
+  m_device->setRecordStreams(strides, halt);
   if (worlds() > 1 && m_device->broadphase())
     throw BackendUnsupported("cases run together on one device need the uniform_grid broadphase (it keeps their worlds apart)");
   for (CudaStepper* m : m_members) m->locateVessel();

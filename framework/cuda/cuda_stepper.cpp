@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 #include <thread>
 
@@ -98,6 +99,7 @@ CudaStepper::CudaStepper(const Scenario& scenario, Member)
   const World& w = world();
   for (int i = 0; i < w.size(); ++i)
     if (w.kind[i] == BodyKind::Vessel) m_vesselId = w.id[i];
+  m_records.reset(m_cpu->recordStreams());
 }
 
 CudaStepper::CudaStepper(const Scenario& scenario) : CudaStepper(scenario, Member{}) {
@@ -182,8 +184,14 @@ void CudaStepper::runTopology() {
   World& w = world();
   const std::vector<int>& slotOf = slotOfId();
   std::vector<int> deviceSlots, hostSlots;
-  for (const BreakRequest& b : m_breaks) {
-    const int k = b.floeId < static_cast<std::int64_t>(slotOf.size()) ? slotOf[static_cast<size_t>(b.floeId)] : -1;
+  std::vector<std::int64_t> named;  // the bodies the step's rows name, as the events declare them
+  for (const EnabledEvent& e : m_cpu->events())
+    if (e.phase == EventPhase::Topology) {
+      const std::vector<std::int64_t> ids = e.instance->bodiesRead(m_records);
+      named.insert(named.end(), ids.begin(), ids.end());
+    }
+  for (const std::int64_t id : named) {
+    const int k = id >= 0 && id < static_cast<std::int64_t>(slotOf.size()) ? slotOf[static_cast<size_t>(id)] : -1;
     if (k < 0 || std::find(hostSlots.begin(), hostSlots.end(), mirrorSlot(k)) != hostSlots.end()) continue;
     deviceSlots.push_back(batch.sharedSlot(m_world, k));
     hostSlots.push_back(mirrorSlot(k));
@@ -198,7 +206,7 @@ void CudaStepper::runTopology() {
 
   const std::vector<std::int64_t> idsBefore = w.id;
   const std::int64_t nextIdBefore = w.nextId;
-  TopologyData topology{&w, m_breaks.data(), static_cast<int>(m_breaks.size()), m_time};
+  TopologyData topology{&w, &m_records, m_time};
   for (const EnabledEvent& e : m_cpu->events())
     if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
   m_rubbleMass += topology.rubbleMass;
@@ -308,44 +316,43 @@ void CudaStepper::step() {
   m_candidateCount = r.candidates;
   m_contactCount = mine.contacts;
 
-  // Records: the device appends in any order; the CPU's order is contact order, sorted by slot
-  // pair (a, b). Impacts and breaks have the vessel as one side, so ascending floe slot is that
-  // order; logs are sorted by the slots of both bodies. Slots do not change within a batch. With
-  // several worlds, a record is this case's when its body ids are (and they become its own ids).
-  m_impacts.assign(result.impacts.begin() + before.impactEnd, result.impacts.begin() + r.impactEnd);
-  m_breaks.assign(result.breaks.begin() + before.breakEnd, result.breaks.begin() + r.breakEnd);
-  m_logs.assign(result.logs.begin() + before.logEnd, result.logs.begin() + r.logEnd);
-  if (batch.worlds() > 1) {
-    auto other = [&](std::int64_t id) { return batch.worldOfId(id) != m_world; };
-    const std::int64_t offset = batch.idOffset(m_world);
-    m_impacts.erase(std::remove_if(m_impacts.begin(), m_impacts.end(), [&](const ImpactRecord& x) { return other(x.floeId); }), m_impacts.end());
-    m_breaks.erase(std::remove_if(m_breaks.begin(), m_breaks.end(), [&](const BreakRequest& x) { return other(x.floeId); }), m_breaks.end());
-    m_logs.erase(std::remove_if(m_logs.begin(), m_logs.end(), [&](const LogRecord& x) { return other(x.idA); }), m_logs.end());
-    for (ImpactRecord& x : m_impacts) x.floeId -= offset;
-    for (BreakRequest& x : m_breaks) x.floeId -= offset;
-    for (LogRecord& x : m_logs) x.idA -= offset, x.idB -= offset;
-  }
-  if (m_impacts.size() > 1 || m_breaks.size() > 1 || !m_logs.empty()) {
+  // Records: the device appends in any order; the CPU's order is by event, then by contact, which
+  // each row's tag gives (a contact's index orders this world's contacts as its run alone does).
+  // With several worlds, a row is this case's when its tag says so; the events saw the case's own
+  // body ids, so the rows need no translation.
+  {
     Stopwatch clock;
-    const std::vector<int>& slots = slotOfId();
-    auto slotOf = [&slots](std::int64_t id) { return slots.at(static_cast<size_t>(id)); };
-    std::stable_sort(m_impacts.begin(), m_impacts.end(),
-                     [&](const ImpactRecord& a, const ImpactRecord& b) { return slotOf(a.floeId) < slotOf(b.floeId); });
-    std::stable_sort(m_breaks.begin(), m_breaks.end(),
-                     [&](const BreakRequest& a, const BreakRequest& b) { return slotOf(a.floeId) < slotOf(b.floeId); });
-    auto pairOf = [&](const LogRecord& x) {
-      const int a = slotOf(x.idA), b = slotOf(x.idB);
-      return std::pair<int, int>{std::min(a, b), std::max(a, b)};
-    };
-    std::stable_sort(m_logs.begin(), m_logs.end(), [&](const LogRecord& a, const LogRecord& b) { return pairOf(a) < pairOf(b); });
-    deliverLogs(m_logs.data(), static_cast<int>(m_logs.size()));
+    m_records.clear();
+    std::vector<int> rows;
+    for (int q = 0; q < m_cpu->recordStreams().count(); ++q) {
+      const size_t stride = static_cast<size_t>(m_cpu->recordStreams().info(q).stride);
+      const unsigned char* all = result.records[q].data();
+      auto tagOf = [&](int row) {
+        RecordTag t;
+        std::memcpy(&t, all + static_cast<size_t>(row) * stride, sizeof t);
+        return t;
+      };
+      rows.clear();
+      for (int row = before.recordEnd[q]; row < r.recordEnd[q]; ++row)
+        if (tagOf(row).world == m_world) rows.push_back(row);
+      std::stable_sort(rows.begin(), rows.end(), [&](int x, int y) {
+        const RecordTag a = tagOf(x), b = tagOf(y);
+        return a.event != b.event ? a.event < b.event : a.contact < b.contact;
+      });
+      for (int row : rows) m_records.append(q, all + static_cast<size_t>(row) * stride, 1);
+    }
+    deliverLogs(m_records);
     batch.times.ordering += clock.lap();
   }
   m_vesselIceForce = forceOfImpulse(mine.vesselImpulse, scenario().dt);
   if (m_vesselSlot >= 0) m_vessel = VesselSample{true, mine.vesselPosition, mine.vesselAngle, mine.vesselVelocity};
 
-  // 6. Topology, only in a step that asked for a break (the device stopped the batch there).
-  if (!m_breaks.empty()) runTopology();
+  // 6. Topology, only in a step whose rows a topology event reads (the device stopped the batch there).
+  bool topology = false;
+  for (const EnabledEvent& e : m_cpu->events())
+    if (e.phase == EventPhase::Topology)
+      for (int q : e.instance->streamsRead()) topology = topology || m_records.rowCount(q) > 0;
+  if (topology) runTopology();
 
   const long done = m_step++;
   m_time = stepTime(m_step, scenario().dt);

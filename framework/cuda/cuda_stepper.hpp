@@ -51,7 +51,7 @@ class CudaStepper final : public Stepper {
   Real time() const override { return m_time; }
   const World& hostWorld() override;
   VesselSample vessel() override;
-  const std::vector<ImpactRecord>& impacts() const override { return m_impacts; }
+  const StepRecords& records() const override { return m_records; }
   int contactCount() const override { return m_contactCount; }
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }
   double rubbleMass() const override { return m_rubbleMass; }
@@ -103,9 +103,7 @@ class CudaStepper final : public Stepper {
   std::int64_t m_vesselId = -1;
   int m_vesselSlot = -1;
   int m_contactCount = 0, m_candidateCount = 0;
-  std::vector<ImpactRecord> m_impacts;
-  std::vector<BreakRequest> m_breaks;
-  std::vector<LogRecord> m_logs;
+  StepRecords m_records;  // the last step's rows, this case's, in the CPU's order
   Vec2 m_vesselIceForce{0, 0};
   VesselSample m_vessel{false, {0, 0}, 0, {0, 0}};
   double m_rubbleMass = 0;

@@ -28,6 +28,18 @@ void DeviceStep::setGridCell(Real cellSize) {
   m_state->dropGraph();
   m_state->cellSetting = cellSize;
 }
+void DeviceStep::setRecordStreams(const std::vector<int>& strides, unsigned haltStreams) {
+  DeviceState& d = *m_state;
+  d.dropGraph();
+  if (strides.size() > static_cast<size_t>(kMaxRecordStreams)) throw std::invalid_argument("DeviceStep::setRecordStreams: too many streams");
+  d.recordStreams = static_cast<int>(strides.size());
+  for (int s = 0; s < kMaxRecordStreams; ++s) d.recordStride[s] = s < d.recordStreams ? strides[static_cast<size_t>(s)] : 0;
+  d.haltStreams = haltStreams;
+}
+void DeviceStep::setIdStride(std::int64_t idStride) {
+  m_state->dropGraph();
+  m_state->idStride = idStride;
+}
 
 // What a captured graph baked in: when it is the same after an upload (a re-sort along the curve
 // every kResortPeriod steps changes only the arrays' contents) the graph is kept, not captured again.

@@ -38,8 +38,8 @@ enum : int { kRunning = 0, kHaltDone = 1, kHaltBreak = 2, kHaltOverflow = 3 };
 // The batch's counters, on the device (kernels read and write them), copied to pinned host memory
 // at the end of the batch: the one host sync of a batch of steps.
 struct StepStats {
-  int impactCount, breakCount, logCount;  // RecordSink's counters, over the whole batch
-  int impactBegin, breakBegin, logBegin;  // at the start of the step: a step that fails rewinds to them
+  int recordCount[kMaxRecordStreams];  // RecordSink's counters, over the whole batch
+  int recordBegin[kMaxRecordStreams];  // at the start of the step: a step that fails rewinds to them
   int candidatesNeeded;         // the broadphase's pair count, even past the capacity
   int candidates;               // min(needed, capacity)
   int contacts, previousContacts;
@@ -98,11 +98,13 @@ struct DeviceState {
   GraphArray<PairSlot> slots;
   GraphArray<unsigned long long> contactKey, previousKeys, sortedKeys;
   int idBits = 0;  // a contact's id pair is keyed (lo << idBits) | hi: a short radix sort
-  // Records, over a batch of steps.
-  GraphArray<ImpactRecord> impacts;
-  GraphArray<BreakRequest> breaks;
-  GraphArray<LogRecord> logs;
-  int recordCapacity = 0;  // of each record buffer (grows when a single step needs more)
+  // Records, over a batch of steps: the rows of each record stream (framework/api/record_stream.hpp).
+  GraphArray<unsigned char> records[kMaxRecordStreams];
+  int recordStride[kMaxRecordStreams] = {};
+  int recordStreams = 0;
+  unsigned haltStreams = 0;       // streams whose rows end the batch (topology follows)
+  int recordCapacity = 0;         // rows of each record buffer (grows when a single step needs more)
+  std::int64_t idStride = std::int64_t(1) << 62;  // several worlds: ids are world x idStride + own id
   GraphArray<StepStats> stats;
   GraphArray<StepContext> ctx;  // written on the device at the start of each step
   GraphArray<BatchControl> control;

@@ -16,10 +16,11 @@ namespace gem::cuda {
 struct DeviceState;
 
 // One completed step's results, as the device's step graph writes them into its ring. The record
-// ends index the batch's record arrays: step s's impacts are [steps[s-1].impactEnd, steps[s].impactEnd).
+// ends index the batch's rows of each record stream: step s's rows of stream q are
+// [steps[s-1].recordEnd[q], steps[s].recordEnd[q]).
 struct StepRecord {
   int candidates, contacts;  // over all worlds
-  int impactEnd, breakEnd, logEnd;
+  int recordEnd[kMaxRecordStreams];
 };
 
 // One world's share of a completed step. A device state holds one world per case: one for a run,
@@ -32,15 +33,13 @@ struct WorldStepRecord {
 };
 
 // What a run of steps hands back: copied off the device once, through pinned buffers, at its end
-// (thesis 5.7). Records of a step are in device order (atomic counters): the caller orders them
-// (and, with several worlds, tells them apart by their body ids).
+// (thesis 5.7). The rows of a step are in device order (atomic counters): the caller orders them by
+// their tags (event, contact) and, with several worlds, keeps its own (tag.world).
 struct DeviceBatchResult {
   int worlds = 1;
   std::vector<StepRecord> steps;
   std::vector<WorldStepRecord> worldSteps;  // steps.size() x worlds: step s's world w at s * worlds + w
-  std::vector<ImpactRecord> impacts;
-  std::vector<BreakRequest> breaks;
-  std::vector<LogRecord> logs;
+  std::vector<unsigned char> records[kMaxRecordStreams];  // rows (RecordTag + record) of each stream
 };
 
 class DeviceStep {
@@ -58,6 +57,12 @@ class DeviceStep {
   void setBroadphase(std::unique_ptr<CudaBroadphase> broadphase);
   // The step's own grid (uniform_grid): its cell, m; 0 = twice the largest floe's bounding radius.
   void setGridCell(Real cellSize);
+  // The run's record streams: each one's row stride (bytes), and the streams whose rows end a batch
+  // (a topology event reads them: the host's topology phase comes next), one bit each.
+  void setRecordStreams(const std::vector<int>& strides, unsigned haltStreams);
+  // Several worlds: body ids on the device are world x idStride + the case's own id; the views the
+  // events see (PairBody::id) carry the case's own, so that their records need no translation.
+  void setIdStride(std::int64_t idStride);
   const CudaBroadphase* broadphase() const;
 
   // The whole host world to the device (set-up, after breaks and re-sorts). worldOf[i] is body i's

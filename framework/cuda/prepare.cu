@@ -21,6 +21,7 @@ struct PrepareArgs {
       *gyrationY2, *principalAngle;
   const unsigned char* isLarge;
   const int* world;
+  std::int64_t idStride;  // the events see each case's own ids (PairBody::id)
   Real cell;
   unsigned mask, largeKey;
   Vec2* worldVertices;
@@ -69,7 +70,8 @@ __global__ void prepareDirectKernel(PrepareArgs a) {
   toWorld(a.local + static_cast<size_t>(i) * kMaxVertices, count, Vec2{a.x[i], a.y[i]}, a.angle[i], v);
   const Box box = boundingBox(v, count);
   a.boxes[i] = box;
-  const PairBody b = pairBodyOf(a, i, a.dof[i], v, count);
+  PairBody b = pairBodyOf(a, i, a.dof[i], v, count);
+  b.id -= static_cast<std::int64_t>(a.world[i]) * a.idStride;
   a.pairBodies[i] = b;
   a.soloBodies[i] = SoloBody{b.kind, b.dof, b.position, b.angle, b.velocity, b.omega, b.mass, b.area, b.thickness};
   a.changes[i] = VelocityChange{{0, 0}, 0};
@@ -107,6 +109,7 @@ __global__ void __launch_bounds__(kPrepareBlock) prepareStagedKernel(PrepareArgs
   if (mine) {
     a.boxes[i] = box;
     b = pairBodyOf(a, i, a.dof[i], worldRow + threadIdx.x * kMaxVertices, count);
+    b.id -= static_cast<std::int64_t>(a.world[i]) * a.idStride;
     pairRows[threadIdx.x] = b;
     a.changes[i] = VelocityChange{{0, 0}, 0};
     // A small body lives in the cell of its box's lower-left corner; large ones stay out of the grid.
@@ -131,7 +134,7 @@ void enqueuePrepare(DeviceState& d, unsigned largeKey) {
   PrepareArgs a{n, d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.local.get(), d.x.get(), d.y.get(),
                 d.angle.get(), d.vx.get(), d.vy.get(), d.omega.get(), d.area.get(), d.thickness.get(), d.mass.get(),
                 d.invMass.get(), d.invInertia.get(), d.gyration2.get(), d.gyrationX2.get(), d.gyrationY2.get(),
-                d.principalAngle.get(), d.isLarge.get(), d.world.get(), d.cell, d.tableSize - 1, largeKey, d.worldVertices.get(), d.boxes.get(),
+                d.principalAngle.get(), d.isLarge.get(), d.world.get(), d.idStride, d.cell, d.tableSize - 1, largeKey, d.worldVertices.get(), d.boxes.get(),
                 d.pairBodies.get(), d.soloBodies.get(), d.changes.get(), d.cellKey.get(), d.slot.get()};
   if (stagedPrepare(n)) prepareStagedKernel<<<blocksFor(n, kPrepareBlock), kPrepareBlock, 0, s>>>(a);  // a fixed block
   else prepareDirectKernel<<<blocksFor(n, block), block, 0, s>>>(a);

@@ -66,7 +66,7 @@ namespace {
 
 // The batch's start: its record counters and step count (previousContacts carries over).
 __global__ void beginBatchKernel(StepStats* s) {
-  s->impactCount = s->breakCount = s->logCount = 0;
+  for (int q = 0; q < kMaxRecordStreams; ++q) s->recordCount[q] = 0;
   s->stepsDone = 0;
   s->halt = kRunning;
 }
@@ -82,20 +82,22 @@ __global__ void beginStepKernel(const BatchControl* c, StepStats* s, StepContext
   if (threadIdx.x != 0) return;
   const long step = c->firstStep + s->stepsDone;
   *ctx = StepContext{c->dt, stepTime(step, c->dt), step};
-  s->impactBegin = s->impactCount, s->breakBegin = s->breakCount, s->logBegin = s->logCount;
+  for (int q = 0; q < kMaxRecordStreams; ++q) s->recordBegin[q] = s->recordCount[q];
   s->overflow = 0;
 }
 
 // After the pair events: records past a buffer's end fail the step like too many candidates do.
 __global__ void checkRecordsKernel(StepStats* s, int capacity) {
-  if (s->impactCount > capacity || s->breakCount > capacity || s->logCount > capacity) s->overflow = 1;
+  for (int q = 0; q < kMaxRecordStreams; ++q)
+    if (s->recordCount[q] > capacity) s->overflow = 1;
 }
 
 // A step's end: its record into the ring, and whether the loop goes on. It stops when the batch is
-// done, after a step that asked for a break (the host's topology phase comes next), or at a step
-// that overflowed (rewound: the host grows the buffers and runs it again).
+// done, after a step that recorded rows a topology event reads (haltStreams: the host's topology
+// phase comes next), or at a step that overflowed (rewound: the host grows the buffers and runs it
+// again).
 __global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, const BatchControl* c, StepStats* s, StepRecord* ring,
-                              int worlds, const WorldStepRecord* worldStats, WorldStepRecord* worldRing) {
+                              int worlds, const WorldStepRecord* worldStats, WorldStepRecord* worldRing, unsigned haltStreams) {
   // The worlds' records beside the step's, at its place in the ring (read before thread 0 moves on).
   const int done = s->stepsDone;
   if (!s->overflow)
@@ -103,12 +105,18 @@ __global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, con
   __syncthreads();
   if (threadIdx.x != 0) return;
   if (s->overflow) {
-    s->impactCount = s->impactBegin, s->breakCount = s->breakBegin, s->logCount = s->logBegin;
+    for (int q = 0; q < kMaxRecordStreams; ++q) s->recordCount[q] = s->recordBegin[q];
     s->halt = kHaltOverflow;
   } else {
-    ring[s->stepsDone] = StepRecord{s->candidates, s->contacts, s->impactCount, s->breakCount, s->logCount};
+    StepRecord r{s->candidates, s->contacts, {}};
+    bool topology = false;
+    for (int q = 0; q < kMaxRecordStreams; ++q) {
+      r.recordEnd[q] = s->recordCount[q];
+      topology = topology || ((haltStreams >> q) & 1u && s->recordCount[q] > s->recordBegin[q]);
+    }
+    ring[s->stepsDone] = r;
     ++s->stepsDone;
-    if (s->breakCount > s->breakBegin) s->halt = kHaltBreak;
+    if (topology) s->halt = kHaltBreak;
     else if (s->stepsDone >= c->steps) s->halt = kHaltDone;
   }
   if (inGraph) cudaGraphSetConditional(loop, s->halt == kRunning ? 1u : 0u);
@@ -140,11 +148,14 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
 
   // 4. Two-body events write into each contact's slot; solo events from the start-of-step state.
   const int records = d.recordCapacity;
-  const RecordSink sink{d.impacts.get(), records, &stats->impactCount, d.breaks.get(), records, &stats->breakCount,
-                        d.logs.get(), records, &stats->logCount};
-  const DevicePairData pairData{d.pairBodies.get(), d.world.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(), d.slots.get(),
-                                capacity, block, &stats->contacts, d.ctx.get(), sink};
-  for (auto& e : d.pairEvents) e->launchPairs(pairData, s);
+  RecordSink sink{};
+  for (int q = 0; q < d.recordStreams; ++q) sink.streams[q] = RecordBuffer{d.records[q].get(), d.recordStride[q], records, &stats->recordCount[q]};
+  DevicePairData pairData{d.pairBodies.get(), d.world.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(), d.slots.get(),
+                          capacity, block, &stats->contacts, d.ctx.get(), sink, 0};
+  for (auto& e : d.pairEvents) {
+    e->launchPairs(pairData, s);
+    ++pairData.event;
+  }
   checkRecordsKernel<<<1, 1, 0, s>>>(stats, records);
   GEM_CUDA_CHECK_LAUNCH();
   const DeviceSoloData soloData{d.soloBodies.get(), d.world.get(), d.changes.get(), n, block, d.ctx.get()};
@@ -157,7 +168,7 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   enqueueWriteBack(d);
   enqueueCommitContacts(d);
   endStepKernel<<<1, stepEdgeThreads(d.worlds), 0, s>>>(loop, inGraph, d.control.get(), stats, d.ring.get(), d.worlds,
-                                                       d.worldStats.get(), d.worldRing.get());
+                                                       d.worldStats.get(), d.worldRing.get(), d.haltStreams);
   GEM_CUDA_CHECK_LAUNCH();
 }
 
@@ -167,11 +178,12 @@ void prepareBuffers(DeviceState& d) {
   d.candA.ensure(cap), d.candB.ensure(cap), d.candContact.ensure(cap), d.flag.ensure(cap + 1), d.flagOffset.ensure(cap + 1);
   d.contactA.ensure(cap), d.contactB.ensure(cap), d.contacts.ensure(cap), d.slots.ensure(cap), d.contactKey.ensure(cap);
   d.sortedKeys.ensure(cap), d.bKey.ensure(cap), d.bKeySorted.ensure(cap), d.bIndex.ensure(cap), d.bIndexSorted.ensure(cap);
-  // Records of a whole batch: a step needs one impact and one break per contact at most, and
-  // a batch that fills the buffers stops there (the next batch starts them empty).
+  // Records of a whole batch: room for a row per contact in each stream at first; a batch that
+  // fills a buffer stops there (the next batch starts them empty), and a single step that passes
+  // one grows them all (DeviceStep::run).
   d.recordCapacity = std::max(d.recordCapacity, d.capacity);
   const size_t records = static_cast<size_t>(d.recordCapacity);
-  d.impacts.ensure(records), d.breaks.ensure(records), d.logs.ensure(records);
+  for (int q = 0; q < d.recordStreams; ++q) d.records[q].ensure(records * static_cast<size_t>(d.recordStride[q]));
   d.previousKeys.ensureKeeping(cap, static_cast<size_t>(d.h_stats->previousContacts));
 
   size_t bytes = 1;
@@ -279,7 +291,8 @@ void DeviceStep::configure(int copyBackEvery, int blockSize) {
 
 void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& result) {
   DeviceState& d = *m_state;
-  result.steps.clear(), result.worldSteps.clear(), result.impacts.clear(), result.breaks.clear(), result.logs.clear();
+  result.steps.clear(), result.worldSteps.clear();
+  for (auto& rows : result.records) rows.clear();
   result.worlds = d.worlds;
   if (d.n == 0) {
     result.steps.assign(static_cast<size_t>(steps), StepRecord{});
@@ -310,18 +323,18 @@ void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& resu
     const int done = stats.stepsDone;
 
     // The completed steps' records, appended; their ends shifted past what earlier batches added.
-    const int impactBase = static_cast<int>(result.impacts.size()), breakBase = static_cast<int>(result.breaks.size()),
-              logBase = static_cast<int>(result.logs.size());
     const StepRecord last = done > 0 ? d.h_ring[done - 1] : StepRecord{};
-    result.impacts.resize(static_cast<size_t>(impactBase + last.impactEnd));
-    result.breaks.resize(static_cast<size_t>(breakBase + last.breakEnd));
-    result.logs.resize(static_cast<size_t>(logBase + last.logEnd));
-    d.impacts.download(result.impacts.data() + impactBase, static_cast<size_t>(last.impactEnd));
-    d.breaks.download(result.breaks.data() + breakBase, static_cast<size_t>(last.breakEnd));
-    d.logs.download(result.logs.data() + logBase, static_cast<size_t>(last.logEnd));
+    int base[kMaxRecordStreams] = {};
+    for (int q = 0; q < d.recordStreams; ++q) {
+      const size_t stride = static_cast<size_t>(d.recordStride[q]);
+      std::vector<unsigned char>& rows = result.records[q];
+      base[q] = static_cast<int>(rows.size() / stride);
+      rows.resize(rows.size() + static_cast<size_t>(last.recordEnd[q]) * stride);
+      d.records[q].download(rows.data() + static_cast<size_t>(base[q]) * stride, static_cast<size_t>(last.recordEnd[q]) * stride);
+    }
     for (int k = 0; k < done; ++k) {
       StepRecord r = d.h_ring[k];
-      r.impactEnd += impactBase, r.breakEnd += breakBase, r.logEnd += logBase;
+      for (int q = 0; q < kMaxRecordStreams; ++q) r.recordEnd[q] += base[q];
       result.steps.push_back(r);
     }
     result.worldSteps.insert(result.worldSteps.end(), d.h_worldRing, d.h_worldRing + static_cast<size_t>(done) * static_cast<size_t>(d.worlds));

@@ -125,11 +125,12 @@ void CpuStepper::setUp() {
     const bool enabled = it == m_scenario.events.end() ? entry->enabledByDefault : it->second.enabled;
     TableReader reader(table, "events." + entry->name, m_scenario.fileName);
     reader.accept("enabled");
-    EventConfig config{reader, m_scenario};
+    EventConfig config{reader, m_scenario, m_streams};
     auto instance = entry->makeCpu(config);  // parsed even when off, so its table is still checked
     reader.finish();
     if (enabled) m_events.push_back({entry->name, entry->phase, std::move(instance)});
   }
+  m_records.reset(m_streams);
   for (int i = 0; i < m_world.size(); ++i)
     if (m_world.kind[i] == BodyKind::Vessel) m_vesselId = m_world.id[i];
   if (m_scenario.mortonSort) reorderAlongCurve();
@@ -218,30 +219,44 @@ void CpuStepper::step() {
                                  m_world.vertexCount[i]);
   const int contacts = static_cast<int>(m_contacts.size());
   m_slots.assign(contacts, PairSlot{{0, 0}});
-  // Each contact yields at most one impact and one break: the buffers can never overflow.
-  // Logs: an event may log more than one row per contact; the buffer grows and the phase runs
-  // again in the rare step that passes it (pair events only write their slots and records).
-  m_impacts.resize(contacts);
-  m_breaks.resize(contacts);
-  if (m_logs.size() < static_cast<size_t>(contacts)) m_logs.resize(static_cast<size_t>(contacts));
+  // Records: each stream has room for one row per contact at first; an event may push more (a
+  // log of several rows), and then the buffer grows and the phase runs again (pair events only
+  // write their slots and records, so running them again is running them once).
+  const int streams = m_streams.count();
+  if (static_cast<int>(m_recordRoom.size()) != streams) m_recordRoom.assign(static_cast<size_t>(streams), 0);
+  m_recordRows.resize(static_cast<size_t>(streams));
+  std::vector<int> counts(static_cast<size_t>(streams));
   for (;;) {
-    int impactCount = 0, breakCount = 0, logCount = 0;
-    const RecordSink sink{m_impacts.data(), contacts, &impactCount, m_breaks.data(), contacts, &breakCount,
-                          m_logs.data(), static_cast<int>(m_logs.size()), &logCount};
-    const PairPhaseData pairData{m_pairBodies.data(), m_contactA.data(), m_contactB.data(), m_contacts.data(),
-                                 m_slots.data(), contacts, ctx, sink};
+    RecordSink sink{};
+    for (int s = 0; s < streams; ++s) {
+      int& room = m_recordRoom[static_cast<size_t>(s)];
+      room = std::max(room, contacts);
+      m_recordRows[static_cast<size_t>(s)].resize(static_cast<size_t>(room) * static_cast<size_t>(m_streams.info(s).stride));
+      counts[static_cast<size_t>(s)] = 0;
+      sink.streams[s] = RecordBuffer{m_recordRows[static_cast<size_t>(s)].data(), m_streams.info(s).stride, room, &counts[static_cast<size_t>(s)]};
+    }
+    PairPhaseData pairData{m_pairBodies.data(), m_contactA.data(), m_contactB.data(), m_contacts.data(), m_slots.data(), contacts, ctx, sink, 0};
     for (auto& e : m_events)
-      if (e.phase == EventPhase::Pair) e.instance->runPairs(pairData);
-    if (logCount > static_cast<int>(m_logs.size())) {
-      m_logs.resize(static_cast<size_t>(logCount));
+      if (e.phase == EventPhase::Pair) {
+        e.instance->runPairs(pairData);
+        ++pairData.event;
+      }
+    bool overflow = false;
+    for (int s = 0; s < streams; ++s)
+      if (counts[static_cast<size_t>(s)] > m_recordRoom[static_cast<size_t>(s)]) {
+        m_recordRoom[static_cast<size_t>(s)] = counts[static_cast<size_t>(s)];
+        overflow = true;
+      }
+    if (overflow) {
       m_slots.assign(contacts, PairSlot{{0, 0}});
       continue;
     }
-    m_impacts.resize(impactCount);
-    m_breaks.resize(breakCount);
-    deliverLogs(m_logs.data(), logCount);
     break;
   }
+  // Rows are in the CPU's order as pushed: event by event, contact by contact.
+  m_records.clear();
+  for (int s = 0; s < streams; ++s) m_records.append(s, m_recordRows[static_cast<size_t>(s)].data(), counts[static_cast<size_t>(s)]);
+  deliverLogs(m_records);
 
   // 4. Solo events, from the state at the start of the step.
   m_soloBodies.resize(n);
@@ -258,7 +273,7 @@ void CpuStepper::step() {
   gatherAndMove();
 
   // 6. Topology: breaks, rubble, new floes.
-  TopologyData topology{&m_world, m_breaks.data(), static_cast<int>(m_breaks.size()), m_time};
+  TopologyData topology{&m_world, &m_records, m_time};
   for (auto& e : m_events)
     if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
   m_rubbleMass += topology.rubbleMass;

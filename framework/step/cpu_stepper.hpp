@@ -49,7 +49,8 @@ class CpuStepper final : public Stepper {
   Broadphase& broadphase() { return *m_broadphase; }
 
   // What the last step produced.
-  const std::vector<ImpactRecord>& impacts() const override { return m_impacts; }
+  const StepRecords& records() const override { return m_records; }
+  const RecordStreams& recordStreams() const { return m_streams; }
   int contactCount() const override { return static_cast<int>(m_contacts.size()); }
   int candidateCount() const { return static_cast<int>(m_pairs.size()); }
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
@@ -92,9 +93,10 @@ class CpuStepper final : public Stepper {
   std::vector<VelocityChange> m_changes;
   std::vector<MotionBody> m_motionBodies;
   std::vector<std::pair<std::int64_t, std::int64_t>> m_previousContacts, m_currentContacts;
-  std::vector<ImpactRecord> m_impacts;
-  std::vector<BreakRequest> m_breaks;
-  std::vector<LogRecord> m_logs;
+  RecordStreams m_streams;  // opened by the events as their Params are parsed
+  StepRecords m_records;    // the last step's rows
+  std::vector<std::vector<unsigned char>> m_recordRows;  // per stream: the pair phase's buffer
+  std::vector<int> m_recordRoom;                         // per stream: rows the buffer holds
   Vec2 m_vesselIceForce{0, 0};
   double m_rubbleMass = 0;
   long m_floesBroken = 0;

@@ -8,6 +8,7 @@
 
 #include "framework/api/errors.hpp"
 #include "framework/api/event_api.hpp"
+#include "framework/api/step_records.hpp"
 #include "framework/scenario/scenario.hpp"
 #include "framework/world/world.hpp"
 
@@ -31,7 +32,8 @@ class Stepper {
   virtual const World& hostWorld() = 0;
   virtual VesselSample vessel() = 0;
   // What the last step produced.
-  virtual const std::vector<ImpactRecord>& impacts() const = 0;
+  // The rows the events recorded (record streams: ship_impact's impacts, say), in the CPU's order.
+  virtual const StepRecords& records() const = 0;
   virtual int contactCount() const = 0;
   virtual Vec2 vesselIceForce() const = 0;  // N, from the step's impulses on the vessel
   // Totals since the start.
