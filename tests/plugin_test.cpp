@@ -4,6 +4,7 @@
 // plugins/ out of tree against it, run its scenario with the installed gem, see it in gem info.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -205,6 +206,26 @@ TEST(PluginOrder, AFrictionEventRunsAfterImpactAndReadsItsNormalImpulse) {
   const double without = vyOfFloe1("without", ""), with = vyOfFloe1("with", "[events.floe_friction]\nmu = 0.5\n");
   EXPECT_LT(std::abs(without), 0.01);  // the impact alone pushes floe 1 (almost) along x only
   EXPECT_GT(with, without + 0.05);
+}
+
+// A plugin's own record stream and output file (tests/plugins/contact_areas.cpp): written to the
+// run folder, one row per floe-floe contact, counted in summary.json under the plugin's keys.
+TEST(PluginRecords, APluginsRecordStreamIsWrittenToItsOwnFile) {
+  TempDir dir;
+  const fs::path scenario = dir.write("areas.toml", "[simulation]\ndt = 0.1\nsteps = 30\nbroadphase = \"all_pairs\"\n"
+                                                    "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]\nvelocity = [1.0, 0.0]\n"
+                                                    "[[floes]]\nvertices = [[4.5, 0.0], [8.5, 0.0], [8.5, 4.0], [4.5, 4.0]]\n"
+                                                    "[[plugins]]\npath = \"" + plugin("contact_areas") + "\"\n[events.contact_area_log]\n");
+  ASSERT_EQ(gem::test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / "out").string(), dir.path() / "log"), 0)
+      << readFile(dir.path() / "log");
+  const std::string csv = readFile(dir.path() / "out" / "contact_areas.csv");
+  ASSERT_EQ(csv.rfind("t,id_a,id_b,area_m2\n", 0), 0u) << csv;
+  const long rows = std::count(csv.begin(), csv.end(), '\n') - 1;
+  EXPECT_GT(rows, 0) << "the floes meet: rows are logged";
+  const std::string summary = readFile(dir.path() / "out" / "summary.json");
+  EXPECT_TRUE(contains(summary, "\"contact_rows\": " + std::to_string(rows) + ",")) << summary;
+  EXPECT_TRUE(contains(summary, "\"contact_area_m2\": {\"min\"")) << summary;
+  EXPECT_TRUE(contains(summary, "\"impacts\": 0,")) << summary;  // ship_impact's stream, no vessel here
 }
 
 // The SDK from the build, as a user does it: install, build each example out of tree, run it.
