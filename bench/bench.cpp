@@ -78,8 +78,10 @@ CaseKey parseCase(const std::string& key) {
     used = 0;
   }
   if (used != key.size() || n < 10 || n > 10000000)
-    throw InputError(fmt::format("gem bench --cases {}: valid cases are 456, 824 (the thesis fields) or a floe count "
-                                 "from 10 to 10^7 (random convex floes at 40 %), e.g. 10000 100000 1000000", key));
+    throw InputError(
+        fmt::format("gem bench --cases {}: valid cases are 456, 824 (the thesis fields) or a floe count "
+                    "from 10 to 10^7 (random convex floes at 40 %), e.g. 10000 100000 1000000",
+                    key));
   int power = 0;
   for (long m = n; m % 10 == 0 && m > 1; m /= 10) ++power;
   const bool powerOfTen = n == static_cast<long>(std::llround(std::pow(10.0, power)));
@@ -189,8 +191,8 @@ Row timeRow(CaseScenarios& scenarios, const CaseKey& c, const std::string& backe
   const bool large = c.floes >= 50000;
   const auto start = Clock::now();
   if (large)
-    std::fprintf(stderr, "gem bench: %s, %s, %s%s%s...\n", c.name.c_str(), backend.c_str(), broadphase.c_str(),
-                 param.empty() ? "" : ", ", param.c_str());
+    std::fprintf(stderr, "gem bench: %s, %s, %s%s%s...\n", c.name.c_str(), backend.c_str(), broadphase.c_str(), param.empty() ? "" : ", ",
+                 param.c_str());
   std::unique_ptr<Stepper> sim = makeStepper(s);
   Row r;
   r.caseName = c.name, r.backend = backend, r.broadphase = broadphase, r.param = param;
@@ -246,8 +248,7 @@ std::vector<std::string> backendsOf(const TableRun& run, const std::string& tabl
   for (const std::string& b : backends) {
     if (std::find(allowed.begin(), allowed.end(), b) == allowed.end()) {
       if (run.partOfAll) continue;
-      throw InputError(fmt::format("gem bench --table {}: --backend {}: this table times {} only", table, b,
-                                   fmt::join(allowed, ", ")));
+      throw InputError(fmt::format("gem bench --table {}: --backend {}: this table times {} only", table, b, fmt::join(allowed, ", ")));
     }
     try {
       resolveBackend(b);
@@ -272,8 +273,10 @@ std::string caseList(const std::vector<CaseKey>& cases) {
 }
 
 void printTiming(const BenchOptions& o) {
-  std::printf("%ld timed steps per case (fewer for large fields; whole 200-step periods on a device) after a warm-up; "
-              "median of 5 chunks; real time at the scenario's dt (0.1 s)\n", o.steps);
+  std::printf(
+      "%ld timed steps per case (fewer for large fields; whole 200-step periods on a device) after a warm-up; "
+      "median of 5 chunks; real time at the scenario's dt (0.1 s)\n",
+      o.steps);
 }
 
 // --table step: every case x backend x broadphase (the README's table).
@@ -312,8 +315,10 @@ void fieldsTable(const TableRun& run) {
   const auto backends = backendsOf(run, "fields", {"cpu", "cuda"}, {"cpu", "cuda"});
   if (backends.empty()) return;
   const std::vector<std::string> broadphases = o.broadphases.empty() ? builtInBroadphases() : o.broadphases;
-  std::printf("gem bench --table fields: time per step CPU vs GPU on %s; fixed vs variable radius, and uniform grid, "
-              "triangulation mesh and all pairs against variable radius\n", caseList(cases).c_str());
+  std::printf(
+      "gem bench --table fields: time per step CPU vs GPU on %s; fixed vs variable radius, and uniform grid, "
+      "triangulation mesh and all pairs against variable radius\n",
+      caseList(cases).c_str());
   printTiming(o);
   Table table("fields", "", run.csvPath);
   table.printHeader();
@@ -337,8 +342,10 @@ void sweepTable(const TableRun& run, const std::string& name) {
   if (blocks)
     std::printf("gem bench --table blocks: CUDA threads per block (simulation.cuda_block_size) on %s\n", caseList(cases).c_str());
   else
-    std::printf("gem bench --table copyback: CUDA steps between copies of results to the host (simulation.copy_back_every, "
-                "thesis 5.7) on %s; the time per step includes the copies\n", caseList(cases).c_str());
+    std::printf(
+        "gem bench --table copyback: CUDA steps between copies of results to the host (simulation.copy_back_every, "
+        "thesis 5.7) on %s; the time per step includes the copies\n",
+        caseList(cases).c_str());
   printTiming(o);
   Table table(name, blocks ? "block_size" : "copy_back_every", run.csvPath);
   table.printHeader();
@@ -359,8 +366,10 @@ void scalingTable(const TableRun& run) {
   const auto backends = backendsOf(run, "scaling", {"cuda", "cpu"}, {"cpu", "cuda"});
   if (backends.empty()) return;
   constexpr long kAllPairsMax = 10000;
-  std::printf("gem bench --table scaling: %s; every built-in broadphase on the GPU, "
-              "variable_radius on the CPU up to 10^5 floes; all_pairs only up to 10^4 floes\n", caseList(cases).c_str());
+  std::printf(
+      "gem bench --table scaling: %s; every built-in broadphase on the GPU, "
+      "variable_radius on the CPU up to 10^5 floes; all_pairs only up to 10^4 floes\n",
+      caseList(cases).c_str());
   printTiming(o);
   Table table("scaling", "", run.csvPath);
   table.printHeader();
@@ -368,10 +377,9 @@ void scalingTable(const TableRun& run) {
     for (const std::string& backend : backends) {
       // The CPU rows: variable radius up to 10^5 unless --broadphase or --cases ask for more.
       if (backend == "cpu" && o.cases.empty() && c.floes > 100000) continue;
-      const std::vector<std::string> broadphases =
-          !o.broadphases.empty() ? o.broadphases
-          : backend == "cpu"     ? std::vector<std::string>{"variable_radius"}
-                                 : builtInBroadphases();
+      const std::vector<std::string> broadphases = !o.broadphases.empty() ? o.broadphases
+                                                   : backend == "cpu"     ? std::vector<std::string>{"variable_radius"}
+                                                                          : builtInBroadphases();
       for (const std::string& broadphase : broadphases) {
         if (broadphase == "all_pairs" && c.floes > kAllPairsMax) {
           std::printf("%-20s %-7s %-18s skipped: all_pairs tests N^2/2 pairs, timed only up to 10^4 floes\n", c.name.c_str(),
@@ -386,8 +394,8 @@ void scalingTable(const TableRun& run) {
     if (cpu.backend != "cpu") continue;
     for (const Row& gpu : table.rows())
       if (gpu.backend != "cpu" && gpu.caseName == cpu.caseName && gpu.broadphase == cpu.broadphase)
-        std::printf("GPU/CPU speed, %s, %s: %.1fx (%s %.4g ms, cpu %.4g ms per step)\n", cpu.caseName.c_str(),
-                    cpu.broadphase.c_str(), cpu.seconds / gpu.seconds, gpu.backend.c_str(), gpu.seconds * 1e3, cpu.seconds * 1e3);
+        std::printf("GPU/CPU speed, %s, %s: %.1fx (%s %.4g ms, cpu %.4g ms per step)\n", cpu.caseName.c_str(), cpu.broadphase.c_str(),
+                    cpu.seconds / gpu.seconds, gpu.backend.c_str(), gpu.seconds * 1e3, cpu.seconds * 1e3);
   }
   table.finish();
 }
@@ -398,11 +406,16 @@ void geometryTable(const TableRun& run, const std::string& name) {
 }
 
 void runTable(const TableRun& run, const std::string& name) {
-  if (name == "step") stepTable(run);
-  else if (name == "fields") fieldsTable(run);
-  else if (name == "blocks" || name == "copyback") sweepTable(run, name);
-  else if (name == "scaling") scalingTable(run);
-  else geometryTable(run, name);
+  if (name == "step")
+    stepTable(run);
+  else if (name == "fields")
+    fieldsTable(run);
+  else if (name == "blocks" || name == "copyback")
+    sweepTable(run, name);
+  else if (name == "scaling")
+    scalingTable(run);
+  else
+    geometryTable(run, name);
 }
 
 // --csv: a file for one table; a directory with TABLE.csv for "all", or when it is a directory

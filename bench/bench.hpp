@@ -15,10 +15,10 @@
 namespace gem {
 
 struct BenchOptions {
-  std::string table = "step";      // see above
-  std::vector<long> sizes;         // geometry tables: N per row (empty: the thesis's sizes)
-  int reps = 50;                   // geometry tables: timed repetitions (median)
-  long steps = 2000;               // timed steps per case (after a warm-up); fewer for large fields
+  std::string table = "step";  // see above
+  std::vector<long> sizes;     // geometry tables: N per row (empty: the thesis's sizes)
+  int reps = 50;               // geometry tables: timed repetitions (median)
+  long steps = 2000;           // timed steps per case (after a warm-up); fewer for large fields
   // A CSV file for one table; a directory (TABLE.csv in it) for "all", or when it names an existing
   // directory or ends in '/'. Empty: no CSV.
   std::string csv;

@@ -41,8 +41,7 @@ int convexPolygon(std::mt19937_64& rng, int n, Real r, Vec2 centre, Vec2* out) {
   for (int i = 0; i < n; ++i) angles[i] = 2 * kPi * u(rng);
   std::sort(angles, angles + n);
   const Real squash = Real(0.5) + Real(0.5) * u(rng), turn = 2 * kPi * u(rng);
-  for (int i = 0; i < n; ++i)
-    out[i] = centre + rotate(Vec2{r * std::cos(angles[i]), r * squash * std::sin(angles[i])}, turn);
+  for (int i = 0; i < n; ++i) out[i] = centre + rotate(Vec2{r * std::cos(angles[i]), r * squash * std::sin(angles[i])}, turn);
   return n;
 }
 
@@ -215,9 +214,10 @@ Row triangulationRow(long n, int reps, const GeometryBenchKernels* gpu) {
       if (!ok && bad++ == 0) first = i;
     }
     if (bad)
-      throw std::runtime_error(fmt::format("gem bench --table triangulation: GPU and CPU disagree on {} of {} polygons (N = {}); first: "
-                                           "polygon {} ({} vertices), CPU {} triangles, GPU {}",
-                                           bad, cpu.count.size(), n, first, in.n[first], cpu.count[first], dev.count[first]));
+      throw std::runtime_error(
+          fmt::format("gem bench --table triangulation: GPU and CPU disagree on {} of {} polygons (N = {}); first: "
+                      "polygon {} ({} vertices), CPU {} triangles, GPU {}",
+                      bad, cpu.count.size(), n, first, in.n[first], cpu.count[first], dev.count[first]));
   }
   return row;
 }
@@ -231,8 +231,7 @@ int runGeometryBench(const GeometryBenchOptions& options) {
   if (options.reps < 1) throw InputError("gem bench --reps: must be at least 1");
   std::vector<long> sizes = options.sizes;
   if (sizes.empty())
-    sizes = intersection ? std::vector<long>{100, 300, 1000, 3000, 100000, 1000000}
-                         : std::vector<long>{500, 1000, 2000, 4000, 8000, 16000};
+    sizes = intersection ? std::vector<long>{100, 300, 1000, 3000, 100000, 1000000} : std::vector<long>{500, 1000, 2000, 4000, 8000, 16000};
   for (long n : sizes)
     if (n < 2 || n > 4000000) throw InputError(fmt::format("gem bench --sizes: {} is out of range (2 to 4000000)", n));
 

@@ -219,8 +219,8 @@ DeviceTiming timeTriangulation(const TriangulationBenchInput& in, int reps, Tria
 }
 
 const bool kRegistered = [] {
-  registerGeometryBenchKernels(GeometryBenchKernels{[] { return cudaAvailable(); }, [] { return cudaDeviceName(); }, timeContacts,
-                                                    timeTriangulation});
+  registerGeometryBenchKernels(
+      GeometryBenchKernels{[] { return cudaAvailable(); }, [] { return cudaDeviceName(); }, timeContacts, timeTriangulation});
   return true;
 }();
 

@@ -29,8 +29,8 @@ struct ContactBenchInput {
 // `sets` independent sets of `polygons` simple counter-clockwise polygons, stride kMaxVertices.
 struct TriangulationBenchInput {
   int polygons = 0, sets = 0;
-  std::vector<Vec2> v;   // sets * polygons * kMaxVertices
-  std::vector<int> n;    // sets * polygons vertex counts
+  std::vector<Vec2> v;  // sets * polygons * kMaxVertices
+  std::vector<int> n;   // sets * polygons vertex counts
 };
 
 // Triangles of each polygon: count and (kMaxVertices - 2) index triples per polygon.
@@ -59,10 +59,10 @@ void registerGeometryBenchKernels(GeometryBenchKernels kernels);
 const GeometryBenchKernels* geometryBenchKernels();
 
 struct GeometryBenchOptions {
-  std::string table;       // "intersection" or "triangulation"
-  std::vector<long> sizes; // N per row; empty: the thesis's sizes (and 10^5, 10^6 pairs for intersection)
-  std::string csv;         // also write the table here when not empty
-  int reps = 50;           // GPU repetitions timed (median); the CPU does up to this many within a time budget
+  std::string table;        // "intersection" or "triangulation"
+  std::vector<long> sizes;  // N per row; empty: the thesis's sizes (and 10^5, 10^6 pairs for intersection)
+  std::string csv;          // also write the table here when not empty
+  int reps = 50;            // GPU repetitions timed (median); the CPU does up to this many within a time budget
 };
 
 int runGeometryBench(const GeometryBenchOptions& options);

@@ -33,7 +33,6 @@ class AllPairs final : public Broadphase {
 
 }  // namespace
 
-GEM_REGISTER_BROADPHASE(AllPairs, "all_pairs",
-                        "every pair whose bounding circles overlap, O(n^2) each step (the reference)");
+GEM_REGISTER_BROADPHASE(AllPairs, "all_pairs", "every pair whose bounding circles overlap, O(n^2) each step (the reference)");
 
 }  // namespace gem

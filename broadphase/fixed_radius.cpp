@@ -16,8 +16,7 @@ namespace {
 class FixedRadius final : public KeptListBroadphase {
  public:
   static constexpr const char* kSettings[] = {"skin", "fixed_radius"};  // docs/scenario.md [broadphase.NAME]
-  explicit FixedRadius(const BroadphaseSettings& s)
-      : KeptListBroadphase(checkedSettings(s).skin), m_fixedRadius(s.fixedRadius) {}
+  explicit FixedRadius(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin), m_fixedRadius(s.fixedRadius) {}
   std::string name() const override { return "fixed_radius"; }
 
  protected:
@@ -39,8 +38,7 @@ class FixedRadius final : public KeptListBroadphase {
 
 }  // namespace
 
-GEM_REGISTER_BROADPHASE(
-    FixedRadius, "fixed_radius",
-    "kept list of pairs within one global radius (default 2 x largest floe radius + skin; thesis 5.4)");
+GEM_REGISTER_BROADPHASE(FixedRadius, "fixed_radius",
+                        "kept list of pairs within one global radius (default 2 x largest floe radius + skin; thesis 5.4)");
 
 }  // namespace gem

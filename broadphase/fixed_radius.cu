@@ -12,7 +12,8 @@ namespace {
 class DeviceFixedRadius final : public DeviceKeptListBroadphase {
  public:
   static constexpr const char* kSettings[] = {"skin", "fixed_radius"};  // honoured on the device too
-  explicit DeviceFixedRadius(const BroadphaseSettings& s) : DeviceKeptListBroadphase(checkedSettings(s).skin), m_fixedRadius(s.fixedRadius) {}
+  explicit DeviceFixedRadius(const BroadphaseSettings& s)
+      : DeviceKeptListBroadphase(checkedSettings(s).skin), m_fixedRadius(s.fixedRadius) {}
   // An edit keeps the global radius: the R_a + R_b + skin reach covers the pieces (see the top).
   void upload(const World& world) override {
     uploadList(world, m_fixedRadius > 0 ? m_fixedRadius : 2 * largestFloeRadius(world) + m_list.skin());

@@ -57,7 +57,8 @@ class DeviceTriangulationMesh final : public DeviceKeptListBroadphase {
     std::vector<int> count(static_cast<size_t>(std::max(n, 1)), 0);
     std::vector<int> triangles(static_cast<size_t>(std::max(n, 1)) * kMaxTriangles * 3, 0);
     for (int i = 0; i < n; ++i)
-      count[i] = earClip(world.local(i), world.vertexCount[i], reinterpret_cast<int(*)[3]>(&triangles[static_cast<size_t>(i) * kMaxTriangles * 3]));
+      count[i] = earClip(world.local(i), world.vertexCount[i],
+                         reinterpret_cast<int(*)[3]>(&triangles[static_cast<size_t>(i) * kMaxTriangles * 3]));
     m_count.upload(count.data(), count.size());
     m_triangles.upload(triangles.data(), triangles.size());
   }
@@ -68,7 +69,8 @@ class DeviceTriangulationMesh final : public DeviceKeptListBroadphase {
     const long long rows = n, width = kMaxTriangles * 3;
     m_countBefore.ensure(static_cast<size_t>(rows)), m_trianglesBefore.ensure(static_cast<size_t>(rows * width));
     GEM_CUDA_CHECK(cudaMemcpyAsync(m_countBefore.get(), m_count.get(), rows * sizeof(int), cudaMemcpyDeviceToDevice, stream));
-    GEM_CUDA_CHECK(cudaMemcpyAsync(m_trianglesBefore.get(), m_triangles.get(), rows * width * sizeof(int), cudaMemcpyDeviceToDevice, stream));
+    GEM_CUDA_CHECK(
+        cudaMemcpyAsync(m_trianglesBefore.get(), m_triangles.get(), rows * width * sizeof(int), cudaMemcpyDeviceToDevice, stream));
     gatherByOrderKernel<int><<<blocksFor(n), kBlock, 0, stream>>>(rows, 1, order, m_countBefore.get(), m_count.get());
     GEM_CUDA_CHECK_LAUNCH();
     gatherByOrderKernel<int><<<static_cast<unsigned>((rows * width + kBlock - 1) / kBlock), kBlock, 0, stream>>>(
@@ -82,10 +84,12 @@ class DeviceTriangulationMesh final : public DeviceKeptListBroadphase {
     // The survivors' triangles follow them; only the new bodies are ear-clipped (on the host).
     const long long width = kMaxTriangles * 3, added = after.size() - firstAdded, n = kept + added;
     const long long before = static_cast<long long>(m_rows);
-    m_countBefore.ensure(static_cast<size_t>(std::max(before, 1LL))), m_trianglesBefore.ensure(static_cast<size_t>(std::max(before, 1LL) * width));
+    m_countBefore.ensure(static_cast<size_t>(std::max(before, 1LL))),
+        m_trianglesBefore.ensure(static_cast<size_t>(std::max(before, 1LL) * width));
     if (before) {
       GEM_CUDA_CHECK(cudaMemcpyAsync(m_countBefore.get(), m_count.get(), before * sizeof(int), cudaMemcpyDeviceToDevice, stream));
-      GEM_CUDA_CHECK(cudaMemcpyAsync(m_trianglesBefore.get(), m_triangles.get(), before * width * sizeof(int), cudaMemcpyDeviceToDevice, stream));
+      GEM_CUDA_CHECK(
+          cudaMemcpyAsync(m_trianglesBefore.get(), m_triangles.get(), before * width * sizeof(int), cudaMemcpyDeviceToDevice, stream));
     }
     GEM_CUDA_CHECK(cudaStreamSynchronize(stream));  // ensure() below may move the arrays just copied
     m_count.ensure(static_cast<size_t>(std::max(n, 1LL))), m_triangles.ensure(static_cast<size_t>(std::max(n, 1LL) * width));
@@ -117,7 +121,7 @@ class DeviceTriangulationMesh final : public DeviceKeptListBroadphase {
  private:
   DeviceArray<int> m_count, m_triangles;
   DeviceArray<int> m_countBefore, m_trianglesBefore;  // reorder()'s and edited()'s copies
-  int m_rows = 0;  // bodies the triangle arrays hold
+  int m_rows = 0;                                     // bodies the triangle arrays hold
 };
 
 }  // namespace

@@ -33,7 +33,6 @@ class VariableRadius final : public KeptListBroadphase {
 
 }  // namespace
 
-GEM_REGISTER_BROADPHASE(VariableRadius, "variable_radius",
-                        "kept list of pairs with |c_a - c_b| <= R_a + R_b + skin (thesis 5.4)");
+GEM_REGISTER_BROADPHASE(VariableRadius, "variable_radius", "kept list of pairs with |c_a - c_b| <= R_a + R_b + skin (thesis 5.4)");
 
 }  // namespace gem

@@ -16,9 +16,9 @@ namespace gem {
 
 struct Autopilot {
   struct Params {
-    Real setHeading;   // rad
-    Vec2 trackPoint;   // a point of the set track line, m
-    Real g1, g2, g3, g4;  // N m/rad, N m s/rad, N/m, N s/m
+    Real setHeading;        // rad
+    Vec2 trackPoint;        // a point of the set track line, m
+    Real g1, g2, g3, g4;    // N m/rad, N m s/rad, N/m, N s/m
     Real mass, yawInertia;  // kg, kg m^2
   };
 
@@ -26,7 +26,7 @@ struct Autopilot {
     if (body.kind != BodyKind::Vessel || body.dof != 3) return;
     Real headingError = body.angle - p.setHeading;
     headingError = std::atan2(std::sin(headingError), std::cos(headingError));  // wrap to (-pi, pi]
-    const Vec2 across{-std::sin(p.setHeading), std::cos(p.setHeading)};  // to port of the track
+    const Vec2 across{-std::sin(p.setHeading), std::cos(p.setHeading)};         // to port of the track
     const Real offset = dot(body.position - p.trackPoint, across);
     const Real offsetRate = dot(body.velocity, across);
     const Real yawMoment = -(p.g1 * headingError + p.g2 * body.omega);

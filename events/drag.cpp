@@ -17,6 +17,7 @@ static Drag::Params parseDrag(EventConfig& config) {
   return p;
 }
 
-GEM_REGISTER_SOLO_EVENT(Drag, "drag", "water drag on floes, quadratic per component (A.105-A.107), optional isotropic and linear terms", true, parseDrag);
+GEM_REGISTER_SOLO_EVENT(Drag, "drag", "water drag on floes, quadratic per component (A.105-A.107), optional isotropic and linear terms",
+                        true, parseDrag);
 
 }  // namespace gem

@@ -28,8 +28,10 @@ struct Drag {
     if (body.kind != BodyKind::Floe) return;
     const Real k = Real(0.5) * p.rhoWater * p.cd * ctx.dt / (kRhoIce * body.thickness);  // 1/m
     const Vec2 v = body.velocity;
-    if (p.isotropic) change.dv -= k * norm(v) * v;
-    else change.dv -= Vec2{k * v.x * std::fabs(v.x), k * v.y * std::fabs(v.y)};
+    if (p.isotropic)
+      change.dv -= k * norm(v) * v;
+    else
+      change.dv -= Vec2{k * v.x * std::fabs(v.x), k * v.y * std::fabs(v.y)};
     change.domega -= k * p.rotationLength * body.omega * std::fabs(body.omega);
     change.dv -= p.linear * ctx.dt * v;
     change.domega -= p.linear * ctx.dt * body.omega;

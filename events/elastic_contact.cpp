@@ -14,6 +14,7 @@ static ElasticContact::Params parseElasticContact(EventConfig& config) {
   return p;
 }
 
-GEM_REGISTER_PAIR_EVENT(ElasticContact, "elastic_contact", "steady elastic push-apart 0.05 C sigma_max w h dt while bodies overlap (MODEL 4)", true, parseElasticContact);
+GEM_REGISTER_PAIR_EVENT(ElasticContact, "elastic_contact",
+                        "steady elastic push-apart 0.05 C sigma_max w h dt while bodies overlap (MODEL 4)", true, parseElasticContact);
 
 }  // namespace gem

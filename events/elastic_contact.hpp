@@ -21,8 +21,8 @@ struct ElasticContact {
     Real factor;     // the 0.05 of the formula
   };
 
-  GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact,
-                           PairSlot& slot, const StepContext& ctx, const RecordSink&) {
+  GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact, PairSlot& slot,
+                           const StepContext& ctx, const RecordSink&) {
     const Real w = contact.geometry.width;
     if (!(w > 0)) return;
     const Real h = a.thickness < b.thickness ? a.thickness : b.thickness;

@@ -16,11 +16,11 @@ namespace gem {
 
 struct EnvironmentalForce {
   struct Params {
-    Vec2 stress;         // F (cos theta, sin theta), N/m^2
-    Vec2 flowVelocity;   // U, m/s
-    Real density;        // rho of the moving fluid, kg/m^3
-    Real coefficient;    // C_a or C_w, dimensionless
-    Real relative;       // s: 1 when the stress depends on the floe's velocity relative to U
+    Vec2 stress;        // F (cos theta, sin theta), N/m^2
+    Vec2 flowVelocity;  // U, m/s
+    Real density;       // rho of the moving fluid, kg/m^3
+    Real coefficient;   // C_a or C_w, dimensionless
+    Real relative;      // s: 1 when the stress depends on the floe's velocity relative to U
   };
 
   GEM_HD static void apply(const Params& p, const SoloBody& body, VelocityChange& change, const StepContext& ctx) {

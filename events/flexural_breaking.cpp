@@ -92,6 +92,8 @@ static FlexuralBreaking::Params parseFlexuralBreaking(EventConfig& config) {
   return p;
 }
 
-GEM_REGISTER_TOPOLOGY_EVENT(FlexuralBreaking, "flexural_breaking", "splits a floe whose edge failed in bending at the cusp length; small pieces leave as rubble (A.100-A.104)", true, parseFlexuralBreaking);
+GEM_REGISTER_TOPOLOGY_EVENT(FlexuralBreaking, "flexural_breaking",
+                            "splits a floe whose edge failed in bending at the cusp length; small pieces leave as rubble (A.100-A.104)",
+                            true, parseFlexuralBreaking);
 
 }  // namespace gem

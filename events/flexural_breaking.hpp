@@ -20,7 +20,7 @@ namespace gem {
 
 struct FlexuralBreaking {
   struct Params {
-    Real minArea;  // m^2: smaller pieces become rubble (1)
+    Real minArea;                       // m^2: smaller pieces become rubble (1)
     RecordStream<BreakRequest> breaks;  // what ship_impact asks to cut
   };
   static void apply(const Params& p, TopologyData& data);

@@ -11,6 +11,7 @@ static Impact::Params parseImpact(EventConfig& config) {
   return p;
 }
 
-GEM_REGISTER_PAIR_EVENT(Impact, "impact", "inelastic impulse I = M_ec V_c at the contact point (A.31-A.49), optional Coulomb friction", true, parseImpact);
+GEM_REGISTER_PAIR_EVENT(Impact, "impact", "inelastic impulse I = M_ec V_c at the contact point (A.31-A.49), optional Coulomb friction",
+                        true, parseImpact);
 
 }  // namespace gem

@@ -20,8 +20,8 @@ struct Impact {
     Real friction;  // mu, dimensionless
   };
 
-  GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact,
-                           PairSlot& slot, const StepContext&, const RecordSink&) {
+  GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact, PairSlot& slot,
+                           const StepContext&, const RecordSink&) {
     const Vec2 n = contact.geometry.normal, c = contact.geometry.point;
     const Real closing = closingSpeed(a, b, contact);
     if (!(closing > 0)) return;

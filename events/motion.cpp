@@ -6,6 +6,7 @@ namespace gem {
 
 static Motion::Params parseMotion(EventConfig&) { return Motion::Params{0}; }
 
-GEM_REGISTER_MOTION_EVENT(Motion, "motion", "semi-implicit Euler position update, degrees of freedom enforced (A.21-A.23)", true, parseMotion);
+GEM_REGISTER_MOTION_EVENT(Motion, "motion", "semi-implicit Euler position update, degrees of freedom enforced (A.21-A.23)", true,
+                          parseMotion);
 
 }  // namespace gem

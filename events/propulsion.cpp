@@ -15,6 +15,7 @@ static Propulsion::Params parsePropulsion(EventConfig& config) {
   return p;
 }
 
-GEM_REGISTER_SOLO_EVENT(Propulsion, "propulsion", "vessel net thrust T_bollard - C_res V^3, zero at the open-water speed (eq. 3.2)", true, parsePropulsion);
+GEM_REGISTER_SOLO_EVENT(Propulsion, "propulsion", "vessel net thrust T_bollard - C_res V^3, zero at the open-water speed (eq. 3.2)", true,
+                        parsePropulsion);
 
 }  // namespace gem

@@ -14,7 +14,7 @@ namespace gem {
 
 struct Propulsion {
   struct Params {
-    Real bollardThrust;  // N
+    Real bollardThrust;          // N
     Real resistanceCoefficient;  // C_res, N s^3/m^3
   };
 

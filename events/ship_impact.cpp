@@ -36,17 +36,19 @@ static ShipImpact::Params parseShipImpact(EventConfig& config) {
 // the statistics of their force.
 static void writeImpactRow(const void* record, std::string& row) {
   const ImpactRecord& r = *static_cast<const ImpactRecord*>(record);
-  row = fmt::format("{:.6g},{},{:.9g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{},{}\n", r.time, r.floeId,
-                    r.floeMass, r.thickness, r.apexDeg, r.frameAngleDeg, r.point.x, r.point.y, r.normal.x, r.normal.y, r.xFromStem,
-                    r.yFromCenterline, r.closingSpeed, r.force, std::isfinite(r.forceLimit) ? fmt::format("{:.9g}", r.forceLimit) : "inf",
-                    r.broke ? 1 : 0);
+  row = fmt::format("{:.6g},{},{:.9g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{},{}\n", r.time,
+                    r.floeId, r.floeMass, r.thickness, r.apexDeg, r.frameAngleDeg, r.point.x, r.point.y, r.normal.x, r.normal.y,
+                    r.xFromStem, r.yFromCenterline, r.closingSpeed, r.force,
+                    std::isfinite(r.forceLimit) ? fmt::format("{:.9g}", r.forceLimit) : "inf", r.broke ? 1 : 0);
 }
 
-GEM_REGISTER_RECORD_OUTPUT(kImpactStream, "impacts.csv",
-                           "t,floe_id,floe_mass,thickness,apex_deg,frame_angle_deg,x,y,nx,ny,x_from_stem,y_from_centerline,vn,fn,flim,broke",
-                           writeImpactRow, "impacts", "impact_force_n",
-                           [](const void* record) { return static_cast<double>(static_cast<const ImpactRecord*>(record)->force); });
+GEM_REGISTER_RECORD_OUTPUT(
+    kImpactStream, "impacts.csv",
+    "t,floe_id,floe_mass,thickness,apex_deg,frame_angle_deg,x,y,nx,ny,x_from_stem,y_from_centerline,vn,fn,flim,broke", writeImpactRow,
+    "impacts", "impact_force_n", [](const void* record) { return static_cast<double>(static_cast<const ImpactRecord*>(record)->force); });
 
-GEM_REGISTER_PAIR_EVENT(ShipImpact, "ship_impact", "2.5D ship-ice impact force at contact onset, logged to impacts.csv; flags flexural failure (A.50-A.99)", true, parseShipImpact);
+GEM_REGISTER_PAIR_EVENT(ShipImpact, "ship_impact",
+                        "2.5D ship-ice impact force at contact onset, logged to impacts.csv; flags flexural failure (A.50-A.99)", true,
+                        parseShipImpact);
 
 }  // namespace gem

@@ -29,11 +29,11 @@ struct ImpactRecord {
   Real time;
   std::int64_t floeId;
   Real floeMass, thickness, apexDeg, frameAngleDeg;
-  Vec2 point, normal;          // world contact point; normal from the vessel into the floe
+  Vec2 point, normal;  // world contact point; normal from the vessel into the floe
   Real xFromStem, yFromCenterline;
-  Real closingSpeed;           // V_n, m/s
-  Real force;                  // min(F_n, F_lim), N
-  Real forceLimit;             // F_lim, N (infinite when the edge cannot fail in bending)
+  Real closingSpeed;  // V_n, m/s
+  Real force;         // min(F_n, F_lim), N
+  Real forceLimit;    // F_lim, N (infinite when the edge cannot fail in bending)
   bool broke;
 };
 
@@ -42,14 +42,14 @@ constexpr const char* kImpactStream = "impacts";
 struct ShipImpact {
   static constexpr int kOrder = event_order::kObservers;  // reads the contact, applies no impulse
   struct Params {
-    Real frameAngle[kMaxVertices];  // beta per vessel edge (edge i joins vertex i and i + 1), rad
+    Real frameAngle[kMaxVertices];            // beta per vessel edge (edge i joins vertex i and i + 1), rad
     Real gyrationX2, gyrationY2, gyrationZ2;  // vessel r_xs^2, r_ys^2, r_zs^2 (A.67-A.69), m^2
-    Real stemX;          // stem position along the vessel's x axis from its centroid, m
-    Real pressure;       // P_0, Pa (1 MPa)
-    Real flexuralStrength;  // sigma_f, Pa (0.5 MPa)
-    Real hullFriction;   // mu_h (0.1)
-    RecordStream<ImpactRecord> impacts;  // the impact log
-    RecordStream<BreakRequest> breaks;   // floes whose edge failed, for flexural_breaking
+    Real stemX;                               // stem position along the vessel's x axis from its centroid, m
+    Real pressure;                            // P_0, Pa (1 MPa)
+    Real flexuralStrength;                    // sigma_f, Pa (0.5 MPa)
+    Real hullFriction;                        // mu_h (0.1)
+    RecordStream<ImpactRecord> impacts;       // the impact log
+    RecordStream<BreakRequest> breaks;        // floes whose edge failed, for flexural_breaking
   };
 
   struct Result {
@@ -67,8 +67,8 @@ struct ShipImpact {
   GEM_HD static Real massReduction(bool vessel, Real nx, Real ny, Real nz, Real xr, Real yr, Real rx2, Real ry2, Real rz2) {
     const Real lambda = nz * yr, mu = -nz * xr, eta = ny * xr - nx * yr;
     if (vessel)
-      return nx * nx + ny * ny / Real(1.5) + nz * nz / 2 + lambda * lambda / (Real(1.25) * rx2) +
-             mu * mu / (2 * ry2) + eta * eta / (Real(1.6) * rz2);
+      return nx * nx + ny * ny / Real(1.5) + nz * nz / 2 + lambda * lambda / (Real(1.25) * rx2) + mu * mu / (2 * ry2) +
+             eta * eta / (Real(1.6) * rz2);
     return nx * nx + ny * ny + nz * nz / 2 + lambda * lambda / (2 * rx2) + mu * mu / (2 * ry2) + eta * eta / rz2;
   }
 
@@ -81,8 +81,7 @@ struct ShipImpact {
 
   // The force of docs/model.md 5 for vessel s and floe f meeting at c with normal n (vessel into floe),
   // closing speed vn (m/s), frame angle beta and apex angle phi (rad).
-  GEM_HD static Result evaluate(const Params& p, const PairBody& s, const PairBody& f, Vec2 c, Vec2 n, Real vn,
-                                Real beta, Real phi) {
+  GEM_HD static Result evaluate(const Params& p, const PairBody& s, const PairBody& f, Vec2 c, Vec2 n, Real vn, Real beta, Real phi) {
     Result r{};
     const Real coS = bodyReduction(true, s, c, n, beta, p.gyrationX2, p.gyrationY2, p.gyrationZ2);
     const Real coF = bodyReduction(false, f, c, n, beta, f.gyrationX2, f.gyrationY2, f.gyration2);
@@ -98,8 +97,7 @@ struct ShipImpact {
     r.froudeFactor = r.froudeFactor > 1 ? r.froudeFactor : Real(1);
     const Real sb = std::sin(beta), cb = std::cos(beta), mu = p.hullFriction;
     const Real denominator = (sb - mu * cb) - Real(0.039) * (cb + mu * sb);
-    r.forceLimit = denominator > 0 ? Real(0.382) * p.flexuralStrength * h * h * phi * r.froudeFactor / denominator
-                                   : Real(INFINITY);
+    r.forceLimit = denominator > 0 ? Real(0.382) * p.flexuralStrength * h * h * phi * r.froudeFactor / denominator : Real(INFINITY);
     r.broke = r.forceNormal > r.forceLimit;
     r.force = r.broke ? r.forceLimit : r.forceNormal;
     return r;
@@ -119,8 +117,8 @@ struct ShipImpact {
     return best;
   }
 
-  GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact,
-                           PairSlot&, const StepContext& ctx, const RecordSink& sink) {
+  GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact, PairSlot&,
+                           const StepContext& ctx, const RecordSink& sink) {
     if (!contact.onset) return;
     const bool vesselFirst = a.kind == BodyKind::Vessel && b.kind == BodyKind::Floe;
     const bool vesselSecond = b.kind == BodyKind::Vessel && a.kind == BodyKind::Floe;

@@ -7,6 +7,7 @@ static EnvironmentalForce::Params parseWind(EventConfig& config) {
   return parseEnvironmentalForce(config.params, kRhoAir, Real(1.2e-3), 0);
 }
 
-GEM_REGISTER_SOLO_EVENT(EnvironmentalForce, "wind", "wind stress on floes: a given force per area (A.108-A.113) or rho_a C_a |U_a| U_a", false, parseWind);
+GEM_REGISTER_SOLO_EVENT(EnvironmentalForce, "wind", "wind stress on floes: a given force per area (A.108-A.113) or rho_a C_a |U_a| U_a",
+                        false, parseWind);
 
 }  // namespace gem

@@ -35,9 +35,7 @@ GEM_HD inline void extentAndMagnitude(const Vec2* v, int n, Real* extent, Real* 
   *magnitude = maxR(maxR(std::fabs(x0), std::fabs(x1)), maxR(std::fabs(y0), std::fabs(y1)));
 }
 
-GEM_HD inline bool nearPoint(Vec2 a, Vec2 b, Real tol) {
-  return std::fabs(a.x - b.x) <= tol && std::fabs(a.y - b.y) <= tol;
-}
+GEM_HD inline bool nearPoint(Vec2 a, Vec2 b, Real tol) { return std::fabs(a.x - b.x) <= tol && std::fabs(a.y - b.y) <= tol; }
 
 // Appends a vertex, merging it into the previous one when they coincide within tol: the merged
 // vertex keeps the arriving tag of the first and the leaving tag of the second, so a crossing that

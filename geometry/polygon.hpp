@@ -120,9 +120,7 @@ GEM_HD inline Box boundingBox(const Vec2* v, int n) {
   return box;
 }
 
-GEM_HD inline bool boxesOverlap(const Box& a, const Box& b) {
-  return !(a.x0 > b.x1 || b.x0 > a.x1 || a.y0 > b.y1 || b.y0 > a.y1);
-}
+GEM_HD inline bool boxesOverlap(const Box& a, const Box& b) { return !(a.x0 > b.x1 || b.x0 > a.x1 || a.y0 > b.y1 || b.y0 > a.y1); }
 
 // Farthest vertex distance from the body origin: the bounding radius of docs/model.md 9.
 GEM_HD inline Real boundingRadius(const Vec2* local, int n) {

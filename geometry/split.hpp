@@ -36,8 +36,7 @@ GEM_HD inline int finishPiece(Vec2* out, int k, Real tol) {
 // misses (or only touches a vertex or an edge). Outputs have room for kMaxClipVertices.
 // Both pieces stay counter-clockwise and convex; points on the line go to both, and the two new
 // vertices are computed once and shared, so the pieces meet exactly along the cut.
-GEM_HD inline void splitByLine(const Vec2* v, int n, Vec2 point, Vec2 dir, Vec2* left, int* nLeft, Vec2* right,
-                               int* nRight) {
+GEM_HD inline void splitByLine(const Vec2* v, int n, Vec2 point, Vec2 dir, Vec2* left, int* nLeft, Vec2* right, int* nRight) {
   *nLeft = *nRight = 0;
   if (n < 3) return;
   Real extent, magnitude;

@@ -16,8 +16,16 @@ GEM_HD inline Vec2 operator-(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
 GEM_HD inline Vec2 operator-(Vec2 a) { return {-a.x, -a.y}; }
 GEM_HD inline Vec2 operator*(Real s, Vec2 a) { return {s * a.x, s * a.y}; }
 GEM_HD inline Vec2 operator*(Vec2 a, Real s) { return {s * a.x, s * a.y}; }
-GEM_HD inline Vec2& operator+=(Vec2& a, Vec2 b) { a.x += b.x; a.y += b.y; return a; }
-GEM_HD inline Vec2& operator-=(Vec2& a, Vec2 b) { a.x -= b.x; a.y -= b.y; return a; }
+GEM_HD inline Vec2& operator+=(Vec2& a, Vec2 b) {
+  a.x += b.x;
+  a.y += b.y;
+  return a;
+}
+GEM_HD inline Vec2& operator-=(Vec2& a, Vec2 b) {
+  a.x -= b.x;
+  a.y -= b.y;
+  return a;
+}
 GEM_HD inline Real dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
 // z component of the 3D cross product: positive when b is counter-clockwise of a.
 GEM_HD inline Real cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }

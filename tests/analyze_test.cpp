@@ -40,8 +40,8 @@ void writeImpacts(const fs::path& dir, int n, unsigned seed, double yLo = -5.0, 
     const double apex = kApexLambda * std::pow(-std::log1p(-u(rng)), 1.0 / kApexK);
     const double mass = std::exp(kMassMu + kMassSigma * z(rng));
     const double xStem = 0.5 + 30.0 * u(rng), y = yLo + (yHi - yLo) * u(rng), vn = 0.2 + 2.0 * u(rng);
-    out << fmt::format("{:.6g},{},{:.9g},0.7,{:.6g},10,{:.6g},{:.6g},0,1,{:.6g},{:.6g},{:.6g},{:.9g},inf,0\n", 0.1 * i, i, mass,
-                       apex, xStem, y, xStem, y, vn, fn);
+    out << fmt::format("{:.6g},{},{:.9g},0.7,{:.6g},10,{:.6g},{:.6g},0,1,{:.6g},{:.6g},{:.6g},{:.9g},inf,0\n", 0.1 * i, i, mass, apex,
+                       xStem, y, xStem, y, vn, fn);
   }
   std::ofstream(dir / "impacts.csv") << out.str();
 }
@@ -67,8 +67,8 @@ std::map<std::string, std::map<std::string, std::string>> readStatistics(const f
 
 double num(const std::string& s) { return s.empty() ? NAN : std::stod(s); }
 
-const std::vector<std::string> kPlots = {"force_cdf.svg", "floe_mass_hist.svg", "apex_hist.svg", "across_bow.svg",
-                                         "force_vs_stem_distance.svg", "force_vs_speed.svg"};
+const std::vector<std::string> kPlots = {"force_cdf.svg",  "floe_mass_hist.svg",         "apex_hist.svg",
+                                         "across_bow.svg", "force_vs_stem_distance.svg", "force_vs_speed.svg"};
 
 void expectDrawnSvg(const fs::path& file) {
   pugi::xml_document doc;

@@ -32,7 +32,8 @@ std::vector<BadCase> badCases() {
       {"non_convex", kSim + floe("[[0.0, 0.0], [10.0, 0.0], [5.0, 2.0], [10.0, 10.0], [0.0, 10.0]]"), {"floes[0]", "not convex", ":4:"}},
       {"self_intersecting", kSim + floe("[[0.0, 0.0], [10.0, 10.0], [10.0, 0.0], [0.0, 10.0]]"), {"floes[0]", "not convex"}},
       {"two_vertices", kSim + floe("[[0.0, 0.0], [10.0, 0.0]]"), {"floes[0]", "3 to 19 vertices"}},
-      {"too_many_vertices", kSim + floe([] {
+      {"too_many_vertices",
+       kSim + floe([] {
          std::string v = "[";
          for (int k = 0; k < 20; ++k)
            v += (k ? ", [" : "[") + std::to_string(10 * std::cos(k * 0.314159)) + ", " + std::to_string(10 * std::sin(k * 0.314159)) + "]";
@@ -45,7 +46,9 @@ std::vector<BadCase> badCases() {
       {"negative_dt", "[simulation]\ndt = -0.1\n", {"simulation.dt", "positive"}},
       {"zero_duration", "[simulation]\nduration = 0.0\n", {"simulation.duration", "positive"}},
       {"zero_mass", kSim + "[vessel]\nmass = 0.0\n", {"vessel.mass", "positive"}},
-      {"overlap", kSim + floe(kSquare) + floe("[[5.0, 5.0], [15.0, 5.0], [15.0, 15.0], [5.0, 15.0]]"), {"overlap at the start", "floes[0]", "floes[1]"}},
+      {"overlap",
+       kSim + floe(kSquare) + floe("[[5.0, 5.0], [15.0, 5.0], [15.0, 15.0], [5.0, 15.0]]"),
+       {"overlap at the start", "floes[0]", "floes[1]"}},
       {"unknown_top_key", kSim + "[simulaton]\ndt = 0.1\n", {"unknown key \"simulaton\"", "simulation"}},
       {"unknown_section_key", "[simulation]\ndtt = 0.1\n", {"simulation.dtt", "valid keys here", "dt"}},
       {"unknown_event", kSim + "[events.dragg]\n", {"events.dragg", "unknown event", "drag"}},
@@ -69,13 +72,15 @@ class BadInput : public ::testing::TestWithParam<BadCase> {};
 TEST_P(BadInput, ExitsWithStatus2AndAClearMessageAndWritesNoSummary) {
   const BadCase& c = GetParam();
   TempDir dir;
-  dir.write("bad.ice", "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 1 0</coordinates\n</frame></iceFloeSim>\n");
+  dir.write(
+      "bad.ice",
+      "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 1 0</coordinates\n</frame></iceFloeSim>\n");
   const auto scenario = dir.write("case.toml", c.toml);
   const auto out = dir.path() / "run";
   for (const char* command : {"run", "check"}) {
-    const int status = gem::test::runGem(std::string(command) + " " + scenario.string() + " --quiet" +
-                                             (std::string(command) == "run" ? " --out " + out.string() : ""),
-                                         dir.path() / "log.txt");
+    const int status = gem::test::runGem(
+        std::string(command) + " " + scenario.string() + " --quiet" + (std::string(command) == "run" ? " --out " + out.string() : ""),
+        dir.path() / "log.txt");
     const std::string log = gem::test::readFile(dir.path() / "log.txt");
     EXPECT_EQ(status, 2) << command << ": " << log;
     EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << "one message: " << log;

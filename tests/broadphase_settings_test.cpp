@@ -58,7 +58,8 @@ TEST(BroadphaseSettings, UnknownStrategiesKeysAndTwiceGivenKeysAreRefused) {
   EXPECT_TRUE(contains(unknown, "uniform_grid")) << unknown;  // the valid names are listed
   const std::string typo = errorOf(kBase + "broadphase = \"uniform_grid\"\n[broadphase.uniform_grid]\ncellsize = 20.0\n");
   EXPECT_TRUE(contains(typo, "broadphase.uniform_grid.cellsize")) << typo;
-  const std::string twice = errorOf(kBase + "broadphase = \"uniform_grid\"\ncell_size = 20.0\n[broadphase.uniform_grid]\ncell_size = 30.0\n");
+  const std::string twice =
+      errorOf(kBase + "broadphase = \"uniform_grid\"\ncell_size = 20.0\n[broadphase.uniform_grid]\ncell_size = 30.0\n");
   EXPECT_TRUE(contains(twice, "given twice")) << twice;
 }
 

@@ -22,14 +22,11 @@
 namespace gem {
 namespace {
 
-const std::vector<std::string> kStrategies = {"all_pairs", "fixed_radius", "variable_radius", "uniform_grid",
-                                              "triangulation_mesh"};
+const std::vector<std::string> kStrategies = {"all_pairs", "fixed_radius", "variable_radius", "uniform_grid", "triangulation_mesh"};
 // Strategies whose per-step output is exactly "bounding circles overlap" (the same set as all_pairs).
 const std::vector<std::string> kCircleStrategies = {"fixed_radius", "variable_radius"};
 
-std::unique_ptr<Broadphase> make(const std::string& name, BroadphaseSettings s = {}) {
-  return Registry::global().broadphase(name).make(s);
-}
+std::unique_ptr<Broadphase> make(const std::string& name, BroadphaseSettings s = {}) { return Registry::global().broadphase(name).make(s); }
 
 // ------------------------------------------------------------------------------------ worlds
 BodySpec spec(BodyKind kind, std::vector<Vec2> vertices) {
@@ -143,8 +140,7 @@ void checkCandidates(const World& w, const PairSet& got, const PairSet& truth, c
     }
   }
   for (auto p : truth)
-    ASSERT_TRUE(std::binary_search(got.begin(), got.end(), p))
-        << what << ": missed overlapping pair " << p.first << "," << p.second;
+    ASSERT_TRUE(std::binary_search(got.begin(), got.end(), p)) << what << ": missed overlapping pair " << p.first << "," << p.second;
 }
 
 // One query of every strategy on w: candidate checks, and agreement with all_pairs.
@@ -453,8 +449,7 @@ TEST(Broadphase, SparseFieldKilometresWide) {
   for (int cluster = 0; cluster < 6; ++cluster) {
     Vec2 c{20000 * u(rng) - 10000, 20000 * u(rng) - 10000};
     for (int k = 0; k < 30; ++k)
-      w.addBody(
-          spec(BodyKind::Floe, regularPolygon({c.x + 30 * u(rng), c.y + 30 * u(rng)}, 1 + 3 * u(rng), 6, u(rng))));
+      w.addBody(spec(BodyKind::Floe, regularPolygon({c.x + 30 * u(rng), c.y + 30 * u(rng)}, 1 + 3 * u(rng), 6, u(rng))));
   }
   auto all = makeAll();
   for (int step = 0; step < 10; ++step) {

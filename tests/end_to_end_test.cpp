@@ -73,11 +73,12 @@ TEST(Scenario, EveryEventCanBeTurnedOff) {
 TEST(Scenario, RelativeFieldFileResolvesAgainstTheScenarioFolder) {
   TempDir dir;
   std::filesystem::create_directories(dir.path() / "sub" / "fields");
-  std::ofstream(dir.path() / "sub" / "fields" / "two.ice")
-      << "<iceFloeSim numFrames=\"1\"><frame index=\"0\">"
-         "<object index=\"4\"><coordinates>0 0 4 0 4 4 0 4</coordinates><velocity x=\"1\" y=\"0\" a=\"0\"/><thickness>0.5</thickness></object>"
-         "<object index=\"9\"><coordinates>10 0 14 0 12 3</coordinates><velocity x=\"0\" y=\"0\" a=\"0.1\"/><thickness>1.5</thickness></object>"
-         "</frame></iceFloeSim>";
+  std::ofstream(dir.path() / "sub" / "fields" / "two.ice") << "<iceFloeSim numFrames=\"1\"><frame index=\"0\">"
+                                                              "<object index=\"4\"><coordinates>0 0 4 0 4 4 0 4</coordinates><velocity "
+                                                              "x=\"1\" y=\"0\" a=\"0\"/><thickness>0.5</thickness></object>"
+                                                              "<object index=\"9\"><coordinates>10 0 14 0 12 3</coordinates><velocity "
+                                                              "x=\"0\" y=\"0\" a=\"0.1\"/><thickness>1.5</thickness></object>"
+                                                              "</frame></iceFloeSim>";
   const auto file = dir.write("sub/s.toml", "[simulation]\nsteps = 3\n[field]\nkind = \"file\"\nfile = \"fields/two.ice\"\n");
   CpuStepper sim(loadScenario(file));
   ASSERT_EQ(sim.world().size(), 2);
@@ -89,9 +90,9 @@ TEST(GemRun, WritesEveryOutputOfTheContract) {
   TempDir dir;
   const auto scenario = dir.write("busy.toml", kBusyScene);
   const auto out = dir.path() / "run";
-  const int status = test::runGem("run " + scenario.string() + " --steps 60 --out " + out.string() +
-                                      " --set output.frame_every=20 --broadphase uniform_grid",
-                                  dir.path() / "log.txt");
+  const int status = test::runGem(
+      "run " + scenario.string() + " --steps 60 --out " + out.string() + " --set output.frame_every=20 --broadphase uniform_grid",
+      dir.path() / "log.txt");
   const std::string log = test::readFile(dir.path() / "log.txt");
   ASSERT_EQ(status, 0) << log;
   EXPECT_NE(log.find("real time"), std::string::npos);
@@ -129,9 +130,8 @@ TEST(GemInfo, ListsEveryBuiltInEventAndBroadphase) {
   TempDir dir;
   ASSERT_EQ(test::runGem("info", dir.path() / "log.txt"), 0);
   const std::string log = test::readFile(dir.path() / "log.txt");
-  for (const char* name : {"motion", "drag", "wind", "current", "propulsion", "autopilot", "impact", "elastic_contact",
-                           "ship_impact", "flexural_breaking", "all_pairs", "fixed_radius", "variable_radius",
-                           "uniform_grid", "triangulation_mesh"})
+  for (const char* name : {"motion", "drag", "wind", "current", "propulsion", "autopilot", "impact", "elastic_contact", "ship_impact",
+                           "flexural_breaking", "all_pairs", "fixed_radius", "variable_radius", "uniform_grid", "triangulation_mesh"})
     EXPECT_NE(log.find(std::string("  ") + name + " "), std::string::npos) << name;
   EXPECT_NE(log.find("built-in"), std::string::npos);
 }

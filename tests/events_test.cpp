@@ -160,8 +160,9 @@ TEST(Drag, OneStepIsTheFormulaAndAFloeSlowsAsTheClosedForm) {
 
 TEST(Propulsion, VesselAloneSettlesAtTheOpenWaterSpeed) {
   TempDir dir;
-  Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"propulsion"}) +
-                                               "[vessel]\nposition = [0.0, 0.0]\nspeed = 0.0\nbollard_thrust = 370e3\nopen_water_speed = 4.9\n");
+  Scenario s =
+      test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"propulsion"}) +
+                                      "[vessel]\nposition = [0.0, 0.0]\nspeed = 0.0\nbollard_thrust = 370e3\nopen_water_speed = 4.9\n");
   World w;
   addVessel(w, s.vessel);
   CpuStepper sim(s, std::move(w));
@@ -179,11 +180,11 @@ TEST(Propulsion, VesselAloneSettlesAtTheOpenWaterSpeed) {
 
 TEST(Autopilot, ThreeDofVesselReturnsToItsTrackAndHeading) {
   TempDir dir;
-  Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"propulsion", "autopilot"}) +
-                                               "[vessel]\ndof = 3\nposition = [0.0, 0.0]\n");
+  Scenario s = test::scenarioFromToml(
+      dir, std::string(kBase) + eventsOnly({"propulsion", "autopilot"}) + "[vessel]\ndof = 3\nposition = [0.0, 0.0]\n");
   World w;
   const int v = addVessel(w, s.vessel);
-  w.y[v] = 5;                 // 5 m off the track
+  w.y[v] = 5;                  // 5 m off the track
   w.angle[v] = 5 * kPi / 180;  // 5 degrees off the heading
   CpuStepper sim(s, std::move(w));
   Real largestOffset = 0;
@@ -198,8 +199,8 @@ TEST(Autopilot, ThreeDofVesselReturnsToItsTrackAndHeading) {
 
 TEST(Motion, OneDofVesselNeitherSwaysNorTurnsWhenHitObliquely) {
   TempDir dir;
-  Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"impact", "elastic_contact"}) +
-                                               "[vessel]\nposition = [0.0, 0.0]\nspeed = 3.0\n");
+  Scenario s = test::scenarioFromToml(
+      dir, std::string(kBase) + eventsOnly({"impact", "elastic_contact"}) + "[vessel]\nposition = [0.0, 0.0]\nspeed = 3.0\n");
   World w;
   addVessel(w, s.vessel);
   BodySpec floe = square({0, 0}, 8, 1.0, {0, 0});
@@ -222,8 +223,8 @@ TEST(Motion, OneDofVesselNeitherSwaysNorTurnsWhenHitObliquely) {
 
 TEST(Wind, GivenStressAcceleratesAFloeAsFdtOverRhoH) {
   TempDir dir;
-  Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({}) +
-                                               "[events.wind]\nforce = 2.0\ndirection_deg = 90.0\n[events.current]\nforce = 1.0\n");
+  Scenario s = test::scenarioFromToml(
+      dir, std::string(kBase) + eventsOnly({}) + "[events.wind]\nforce = 2.0\ndirection_deg = 90.0\n[events.current]\nforce = 1.0\n");
   World w;
   w.addBody(square({0, 0}, 5, 0.5));
   CpuStepper sim(s, std::move(w));
@@ -323,8 +324,10 @@ TEST(ShipImpact, IsLoggedOnceAtContactOnsetWithTheHullAngleOfTheStem) {
 
 TEST(FlexuralBreaking, ThinFloeStruckHardSplitsAndMassIsAccountedFor) {
   TempDir dir;
-  Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"ship_impact", "impact", "elastic_contact", "flexural_breaking"}) +
-                                               "[vessel]\nposition = [0.0, 0.0]\nspeed = 6.0\n", {"events.flexural_breaking.min_area=20.0"});
+  Scenario s = test::scenarioFromToml(dir,
+                                      std::string(kBase) + eventsOnly({"ship_impact", "impact", "elastic_contact", "flexural_breaking"}) +
+                                          "[vessel]\nposition = [0.0, 0.0]\nspeed = 6.0\n",
+                                      {"events.flexural_breaking.min_area=20.0"});
   World w;
   addVessel(w, s.vessel);
   w.addBody(square({stemX(s) + 6.1, 0.5}, 12, 0.3, {0, 0}, 0.01));

@@ -129,8 +129,8 @@ void expectSameField(const std::vector<BodySpec>& a, const std::vector<BodySpec>
 }
 
 void printStats(const char* name, const FieldStats& s) {
-  std::printf("[ field    ] %s: %zu floes, concentration %.4f, size mean %.2f sd %.2f, sides", name, s.count,
-              s.concentration, s.sizeMean, s.sizeSd);
+  std::printf("[ field    ] %s: %zu floes, concentration %.4f, size mean %.2f sd %.2f, sides", name, s.count, s.concentration, s.sizeMean,
+              s.sizeSd);
   for (const auto& [sides, n] : s.sides) std::printf(" %d:%d", sides, n);
   std::printf("\n");
 }
@@ -176,9 +176,8 @@ TEST_P(ThesisRandomField, MatchesTable61) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Table61, ThesisRandomField,
-                         ::testing::Values(RandomCase{560, 0.35, 500}, RandomCase{581, 0.39, 500},
-                                           RandomCase{618, 0.41, 500}, RandomCase{657, 0.42, 500},
-                                           RandomCase{824, 0.50, 500}, RandomCase{721, 0.69, 250}),
+                         ::testing::Values(RandomCase{560, 0.35, 500}, RandomCase{581, 0.39, 500}, RandomCase{618, 0.41, 500},
+                                           RandomCase{657, 0.42, 500}, RandomCase{824, 0.50, 500}, RandomCase{721, 0.69, 250}),
                          [](const auto& info) { return "Floes" + std::to_string(info.param.count); });
 
 // Table 6.1, hexagon fields: 456 at 46 % and 595 at 60 %, 10.1 m hexagons. The layout may differ
@@ -240,8 +239,7 @@ TEST(RandomField, GroupsMatchTheirCoverage) {
   }
   ASSERT_EQ(area.size(), 3u);
   for (const ThicknessGroup& g : spec.groups) {
-    std::printf("[ field    ] group %.1f m: %d floes, coverage %.4f\n", double(g.thickness), count[g.thickness],
-                area[g.thickness] / 1e5);
+    std::printf("[ field    ] group %.1f m: %d floes, coverage %.4f\n", double(g.thickness), count[g.thickness], area[g.thickness] / 1e5);
     EXPECT_NEAR(area[g.thickness] / 1e5, g.coverage, 0.01);
     // Spread: each half of the channel holds between a quarter and three quarters of the group.
     EXPECT_GT(leftArea[g.thickness] / area[g.thickness], 0.25);

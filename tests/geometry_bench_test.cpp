@@ -28,5 +28,7 @@ TEST(GemBench, GeometryTablesPrintEveryRowAndWriteCsv) {
 TEST(GemBench, UnknownTableIsBadInput) {
   TempDir dir;
   EXPECT_EQ(test::runGem("bench --table nonsense", dir.path() / "log.txt"), 2);
-  EXPECT_NE(test::readFile(dir.path() / "log.txt").find("valid tables are step, fields, blocks, copyback, scaling, intersection, triangulation, all"), std::string::npos);
+  EXPECT_NE(test::readFile(dir.path() / "log.txt")
+                .find("valid tables are step, fields, blocks, copyback, scaling, intersection, triangulation, all"),
+            std::string::npos);
 }

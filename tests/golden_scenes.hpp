@@ -21,8 +21,8 @@
 namespace gem::test {
 
 struct GoldenScene {
-  std::string name;                     // letters, digits and '_' (a test name)
-  std::filesystem::path file;           // the scenario (empty: the busy scene)
+  std::string name;            // letters, digits and '_' (a test name)
+  std::filesystem::path file;  // the scenario (empty: the busy scene)
   std::vector<std::string> overrides;
 };
 

@@ -24,8 +24,7 @@ class TempDir {
     static std::atomic<int> counter{0};
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     m_path = std::filesystem::temp_directory_path() /
-             ("gem_ice_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" +
-              (info ? info->name() : "x"));
+             ("gem_ice_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" + (info ? info->name() : "x"));
     std::filesystem::remove_all(m_path);
     std::filesystem::create_directories(m_path);
   }
@@ -288,8 +287,7 @@ TEST(IceFile, ErrorsNameFileLineAndProblem) {
       {"wrong root", "<?xml version=\"1.0\"?>\n<floes><frame index=\"0\"/></floes>\n", 2, "<iceFloeSim>"},
       {"no frame 0", "<iceFloeSim>\n<frame index=\"1\"/>\n</iceFloeSim>\n", 1, "index 0"},
       {"no coordinates", object0("<thickness>1</thickness>\n"), 3, "object 5 in frame 0 has no <coordinates>"},
-      {"no thickness", object0("<coordinates>0 0 1 0 1 1</coordinates>\n"), 3,
-       "object 5 in frame 0 has no <thickness>"},
+      {"no thickness", object0("<coordinates>0 0 1 0 1 1</coordinates>\n"), 3, "object 5 in frame 0 has no <thickness>"},
       {"odd count", object0("<coordinates>0 0 1 0 1</coordinates>\n<thickness>1</thickness>\n"), 4, "odd number"},
       {"two vertices", object0("<coordinates>0 0 1 0</coordinates>\n<thickness>1</thickness>\n"), 4, "3 to"},
       {"not a number", object0("<coordinates>0 0 1 0\n 1 abc</coordinates>\n<thickness>1</thickness>\n"), 5,
@@ -302,24 +300,23 @@ TEST(IceFile, ErrorsNameFileLineAndProblem) {
        "object 5: thickness '1e999' is out of range"},
       {"bad thickness", object0("<coordinates>0 0 1 0 1 1</coordinates>\n<thickness>thick</thickness>\n"), 5,
        "object 5: thickness 'thick' is not a number"},
-      {"zero thickness", object0("<coordinates>0 0 1 0 1 1</coordinates>\n<thickness>0</thickness>\n"), 5,
-       "must be positive"},
-      {"bad kind", "<iceFloeSim>\n<frame index=\"0\">\n<object index=\"5\" kind=\"ship\">\n" + std::string(kGood) +
-                       "</object>\n</frame>\n</iceFloeSim>\n",
+      {"zero thickness", object0("<coordinates>0 0 1 0 1 1</coordinates>\n<thickness>0</thickness>\n"), 5, "must be positive"},
+      {"bad kind",
+       "<iceFloeSim>\n<frame index=\"0\">\n<object index=\"5\" kind=\"ship\">\n" + std::string(kGood) +
+           "</object>\n</frame>\n</iceFloeSim>\n",
        3, "kind='ship'"},
       {"duplicate object",
-       "<iceFloeSim>\n<frame index=\"0\">\n<object index=\"5\">\n" + std::string(kGood) +
-           "</object>\n<object index=\"5\">\n" + kGood + "</object>\n</frame>\n</iceFloeSim>\n",
+       "<iceFloeSim>\n<frame index=\"0\">\n<object index=\"5\">\n" + std::string(kGood) + "</object>\n<object index=\"5\">\n" + kGood +
+           "</object>\n</frame>\n</iceFloeSim>\n",
        7, "duplicate object index 5"},
-      {"bad object index", "<iceFloeSim>\n<frame index=\"0\">\n<object index=\"-2\">\n" + std::string(kGood) +
-                               "</object>\n</frame>\n</iceFloeSim>\n",
-       3, "non-negative integer"},
+      {"bad object index",
+       "<iceFloeSim>\n<frame index=\"0\">\n<object index=\"-2\">\n" + std::string(kGood) + "</object>\n</frame>\n</iceFloeSim>\n", 3,
+       "non-negative integer"},
       {"numFrames mismatch",
        "<iceFloeSim numFrames=\"2\">\n<frame index=\"0\">\n<object index=\"5\">\n" + std::string(kGood) +
            "</object>\n</frame>\n</iceFloeSim>\n",
        1, "numFrames=2 but the file holds 1 frames"},
-      {"duplicate frame", "<iceFloeSim>\n<frame index=\"0\"/>\n<frame index=\"0\"/>\n</iceFloeSim>\n", 3,
-       "duplicate frame index 0"},
+      {"duplicate frame", "<iceFloeSim>\n<frame index=\"0\"/>\n<frame index=\"0\"/>\n</iceFloeSim>\n", 3, "duplicate frame index 0"},
       {"removed in frame 0", object0(std::string(kGood) + "<removed/>\n"), 6, "frame 0"},
   };
   TempDir dir;
@@ -331,8 +328,7 @@ TEST(IceFile, ErrorsNameFileLineAndProblem) {
       ADD_FAILURE() << c.name << ": no error";
     } catch (const InputError& e) {
       const std::string message = e.what();
-      EXPECT_NE(message.find(file.string() + ":" + std::to_string(c.line) + ":"), std::string::npos)
-          << c.name << ": " << message;
+      EXPECT_NE(message.find(file.string() + ":" + std::to_string(c.line) + ":"), std::string::npos) << c.name << ": " << message;
       EXPECT_NE(message.find(c.fragment), std::string::npos) << c.name << ": " << message;
     }
   }
@@ -378,9 +374,7 @@ TEST(IceFile, ValueErrorsPointAtTheValue) {
     readIceFile(file);
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(file.string() + ":6:4: object 5: coordinate value 3 'x1'"),
-              std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find(file.string() + ":6:4: object 5: coordinate value 3 'x1'"), std::string::npos) << e.what();
   }
 }
 

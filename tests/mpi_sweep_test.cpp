@@ -30,12 +30,14 @@ position = [-56.0, 0.0]
 [output]
 frame_every = 0
 )");
-  const auto sweep = dir.write("sweep.toml", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [23e3, 46e3, 92e3, 185e3, 370e3, 740e3]\n");
+  const auto sweep = dir.write(
+      "sweep.toml", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [23e3, 46e3, 92e3, 185e3, 370e3, 740e3]\n");
   const auto log = dir.path() / "log.txt";
   // Root may run mpirun only when it says so; --oversubscribe lets 2 ranks share fewer cores.
-  const std::string command = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 mpirun -np 2 " +
-                              std::string(GEM_BINARY_DIR) + "/gem sweep " + sweep.string() + " --out " +
-                              (dir.path() / "out").string() + " > " + log.string() + " 2>&1";
+  const std::string command =
+      "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 mpirun -np 2 " +
+      std::string(GEM_BINARY_DIR) + "/gem sweep " + sweep.string() + " --out " + (dir.path() / "out").string() + " > " + log.string() +
+      " 2>&1";
   const int status = std::system(command.c_str());
   const std::string text = gem::test::readFile(log);
   ASSERT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0) << text;

@@ -156,7 +156,7 @@ TEST(PluginRegistry, NameClashIsAnErrorUnlessTheScenarioOverrides) {
 TEST(PluginSdk, APluginOfTheOldLayoutStillBuildsAndRuns) {
   TempDir dir;
   const fs::path scenario = dir.write("old.toml", kFloe + "[[plugins]]\npath = \"" + plugin("old_layout") +
-                                                        "\"\n[events.sideways_push]\naccel = 1.0\n[events.drag]\nenabled = false\n");
+                                                      "\"\n[events.sideways_push]\naccel = 1.0\n[events.drag]\nenabled = false\n");
   ASSERT_EQ(gem::test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / "out").string(), dir.path() / "log"), 0)
       << readFile(dir.path() / "log");
   // state.csv: id,kind,x,y,angle,vx,vy,...: 20 steps of 0.1 s at 1 m/s^2 give vy = 2 m/s.
@@ -184,10 +184,12 @@ TEST(PluginOrder, AFrictionEventRunsAfterImpactAndReadsItsNormalImpulse) {
 
   // Floe 0 slides up (+y) while it closes on floe 1 (+x): the impact stops the closing; friction
   // then passes part of the sliding to floe 1.
-  const std::string scene = "[simulation]\ndt = 0.01\nsteps = 100\nbroadphase = \"all_pairs\"\n[events.drag]\nenabled = false\n"
-                            "[[floes]]\nvertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\nthickness = 0.5\nvelocity = [2.0, 1.0]\n"
-                            "[[floes]]\nvertices = [[10.2, -5.0], [20.2, -5.0], [20.2, 5.0], [10.2, 5.0]]\nthickness = 0.5\n"
-                            "[[plugins]]\npath = \"" + plugin("floe_friction") + "\"\n";
+  const std::string scene =
+      "[simulation]\ndt = 0.01\nsteps = 100\nbroadphase = \"all_pairs\"\n[events.drag]\nenabled = false\n"
+      "[[floes]]\nvertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\nthickness = 0.5\nvelocity = [2.0, 1.0]\n"
+      "[[floes]]\nvertices = [[10.2, -5.0], [20.2, -5.0], [20.2, 5.0], [10.2, 5.0]]\nthickness = 0.5\n"
+      "[[plugins]]\npath = \"" +
+      plugin("floe_friction") + "\"\n";
   auto vyOfFloe1 = [&](const std::string& name, const std::string& extra) {
     const fs::path scenario = dir.write(name + ".toml", scene + extra);
     EXPECT_EQ(gem::test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / name).string(), dir.path() / "log"), 0)
@@ -212,10 +214,12 @@ TEST(PluginOrder, AFrictionEventRunsAfterImpactAndReadsItsNormalImpulse) {
 // run folder, one row per floe-floe contact, counted in summary.json under the plugin's keys.
 TEST(PluginRecords, APluginsRecordStreamIsWrittenToItsOwnFile) {
   TempDir dir;
-  const fs::path scenario = dir.write("areas.toml", "[simulation]\ndt = 0.1\nsteps = 30\nbroadphase = \"all_pairs\"\n"
-                                                    "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]\nvelocity = [1.0, 0.0]\n"
-                                                    "[[floes]]\nvertices = [[4.5, 0.0], [8.5, 0.0], [8.5, 4.0], [4.5, 4.0]]\n"
-                                                    "[[plugins]]\npath = \"" + plugin("contact_areas") + "\"\n[events.contact_area_log]\n");
+  const fs::path scenario = dir.write("areas.toml",
+                                      "[simulation]\ndt = 0.1\nsteps = 30\nbroadphase = \"all_pairs\"\n"
+                                      "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]\nvelocity = [1.0, 0.0]\n"
+                                      "[[floes]]\nvertices = [[4.5, 0.0], [8.5, 0.0], [8.5, 4.0], [4.5, 4.0]]\n"
+                                      "[[plugins]]\npath = \"" +
+                                          plugin("contact_areas") + "\"\n[events.contact_area_log]\n");
   ASSERT_EQ(gem::test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / "out").string(), dir.path() / "log"), 0)
       << readFile(dir.path() / "log");
   const std::string csv = readFile(dir.path() / "out" / "contact_areas.csv");
@@ -239,10 +243,9 @@ TEST(PluginSdk, InstallBuildEachExampleOutOfTreeRunItAndSeeItInGemInfo) {
   ASSERT_TRUE(fs::exists(prefix / "include" / "gem" / "framework" / "plugin_api.hpp"));
 
   std::string makeProgram = GEM_MAKE_PROGRAM;
-  const std::string configure = cmake + " -G \"" GEM_CMAKE_GENERATOR "\"" +
-                                (makeProgram.empty() ? "" : " -DCMAKE_MAKE_PROGRAM=\"" + makeProgram + "\"") +
-                                " -DCMAKE_CXX_COMPILER=\"" GEM_CXX_COMPILER "\" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=" +
-                                prefix.string();
+  const std::string configure =
+      cmake + " -G \"" GEM_CMAKE_GENERATOR "\"" + (makeProgram.empty() ? "" : " -DCMAKE_MAKE_PROGRAM=\"" + makeProgram + "\"") +
+      " -DCMAKE_CXX_COMPILER=\"" GEM_CXX_COMPILER "\" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=" + prefix.string();
   for (const std::string name : {"shear_current", "rafting_onset", "sweep_and_prune"}) {
     SCOPED_TRACE(name);
     const fs::path build = dir.path() / name;
@@ -287,8 +290,11 @@ TEST(PluginSdk, InstallBuildEachExampleOutOfTreeRunItAndSeeItInGemInfo) {
   // sweep_and_prune: the same contacts as all_pairs, so the same final state bit for bit.
   {
     const fs::path out = dir.path() / "run_all_pairs";
-    ASSERT_EQ(run(gem + " run " + (dir.path() / "sweep_and_prune" / "scenario.toml").string() +
-                      " --broadphase all_pairs --quiet --out " + out.string(), log), 0) << readFile(log);
+    ASSERT_EQ(run(gem + " run " + (dir.path() / "sweep_and_prune" / "scenario.toml").string() + " --broadphase all_pairs --quiet --out " +
+                      out.string(),
+                  log),
+              0)
+        << readFile(log);
     const std::string sap = readFile(dir.path() / "run_sweep_and_prune" / "state.csv");
     EXPECT_GT(std::count(sap.begin(), sap.end(), '\n'), 20);
     EXPECT_EQ(sap, readFile(out / "state.csv"));
@@ -300,9 +306,10 @@ TEST(PluginSdk, InstallBuildEachExampleOutOfTreeRunItAndSeeItInGemInfo) {
 // written so far under their final names, and no summary.json (a run that failed is not complete).
 TEST(PluginRun, ARunThatFailsMidwayKeepsItsRowsAndWritesNoSummary) {
   gem::test::TempDir dir;
-  const auto scenario = dir.write("fail.toml", "[simulation]\nsteps = 50\n[vessel]\nposition = [0.0, 0.0]\n"
-                                               "[events.fail_midway]\nat_step = 5\n[[plugins]]\npath = \"" +
-                                                   plugin("fail_midway") + "\"\n");
+  const auto scenario = dir.write("fail.toml",
+                                  "[simulation]\nsteps = 50\n[vessel]\nposition = [0.0, 0.0]\n"
+                                  "[events.fail_midway]\nat_step = 5\n[[plugins]]\npath = \"" +
+                                      plugin("fail_midway") + "\"\n");
   const auto out = dir.path() / "run";
   const int status = gem::test::runGem("run " + scenario.string() + " --quiet --out " + out.string(), dir.path() / "log.txt");
   const std::string log = gem::test::readFile(dir.path() / "log.txt");

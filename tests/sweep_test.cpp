@@ -72,10 +72,14 @@ std::vector<std::string> csvCells(const std::string& line) {
   bool quoted = false;
   for (size_t i = 0; i < line.size(); ++i) {
     const char c = line[i];
-    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') cells.back() += '"', ++i;
-    else if (c == '"') quoted = !quoted;
-    else if (c == ',' && !quoted) cells.emplace_back();
-    else cells.back() += c;
+    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"')
+      cells.back() += '"', ++i;
+    else if (c == '"')
+      quoted = !quoted;
+    else if (c == ',' && !quoted)
+      cells.emplace_back();
+    else
+      cells.back() += c;
   }
   return cells;
 }
@@ -265,8 +269,9 @@ TEST(Sweep, FieldFileStaysValidInTheCaseScenario) {
     runScenario(s, RunOptions{true, false});
   }
   fs::copy_file(dir.path() / "gen" / "frames.ice", dir.path() / "fields" / "pack.ice");
-  dir.write("fields/base.toml", "[simulation]\ndt = 0.1\nsteps = 5\n[field]\nkind = \"file\"\nfile = \"pack.ice\"\n"
-                               "[vessel]\nlength = 30.0\nbeam = 8.0\nmass = 5e5\nposition = [-16.0, 0.0]\n[output]\nframe_every = 0\n");
+  dir.write("fields/base.toml",
+            "[simulation]\ndt = 0.1\nsteps = 5\n[field]\nkind = \"file\"\nfile = \"pack.ice\"\n"
+            "[vessel]\nlength = 30.0\nbeam = 8.0\nmass = 5e5\nposition = [-16.0, 0.0]\n[output]\nframe_every = 0\n");
   const fs::path file = dir.write("s.toml", "[sweep]\nbase = \"fields/base.toml\"\n[[cases]]\nname = \"a\"\n");
   ASSERT_EQ(sweep(file, dir.path() / "out"), 0);
   const fs::path scenario = dir.path() / "out" / "cases" / "a" / "scenario.toml";
@@ -329,32 +334,53 @@ TEST_P(SweepBadInput, ExitsTwoNamingTheLine) {
   const fs::path file = dir.write("bad_sweep.toml", GetParam().toml), log = dir.path() / "log.txt";
   EXPECT_EQ(test::runGem("sweep " + file.string() + " --out " + (dir.path() / "out").string(), log), 2);
   const std::string message = test::readFile(log);
-  for (const std::string& e : GetParam().expected) EXPECT_NE(message.find(e), std::string::npos) << "missing \"" << e << "\" in: " << message;
+  for (const std::string& e : GetParam().expected)
+    EXPECT_NE(message.find(e), std::string::npos) << "missing \"" << e << "\" in: " << message;
   EXPECT_FALSE(fs::exists(dir.path() / "out" / "cases"));  // nothing ran
 }
 
 INSTANTIATE_TEST_SUITE_P(
     SweepFiles, SweepBadInput,
     ::testing::Values(
-        BadSweep{"missing_base", "[sweep]\nname = \"x\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n", {"bad_sweep.toml:1:1", "sweep.base: missing"}},
-        BadSweep{"no_such_base", "[sweep]\nbase = \"nope.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n", {"bad_sweep.toml:2:8", "nope.toml"}},
-        BadSweep{"unknown_sweep_key", "[sweep]\nbase = \"base.toml\"\njobs = 3\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n", {"bad_sweep.toml:3:", "sweep.jobs"}},
-        BadSweep{"unknown_top_key", "[sweep]\nbase = \"base.toml\"\n[parameter]\n\"vessel.bollard_thrust\" = [1.0]\n", {"bad_sweep.toml:3:", "parameter"}},
-        BadSweep{"empty_list", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = []\n", {"bad_sweep.toml:4:", "empty"}},
-        BadSweep{"not_a_list", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = 5.0\n", {"bad_sweep.toml:4:", "expected a list"}},
-        BadSweep{"typo_in_varied_key", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"field.concentration\" = [0.2]\n\"vessel.bolard_thrust\" = [1.0, 2.0]\n",
+        BadSweep{"missing_base",
+                 "[sweep]\nname = \"x\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n",
+                 {"bad_sweep.toml:1:1", "sweep.base: missing"}},
+        BadSweep{"no_such_base",
+                 "[sweep]\nbase = \"nope.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n",
+                 {"bad_sweep.toml:2:8", "nope.toml"}},
+        BadSweep{"unknown_sweep_key",
+                 "[sweep]\nbase = \"base.toml\"\njobs = 3\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n",
+                 {"bad_sweep.toml:3:", "sweep.jobs"}},
+        BadSweep{"unknown_top_key",
+                 "[sweep]\nbase = \"base.toml\"\n[parameter]\n\"vessel.bollard_thrust\" = [1.0]\n",
+                 {"bad_sweep.toml:3:", "parameter"}},
+        BadSweep{
+            "empty_list", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = []\n", {"bad_sweep.toml:4:", "empty"}},
+        BadSweep{"not_a_list",
+                 "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = 5.0\n",
+                 {"bad_sweep.toml:4:", "expected a list"}},
+        BadSweep{"typo_in_varied_key",
+                 "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"field.concentration\" = [0.2]\n\"vessel.bolard_thrust\" = [1.0, 2.0]\n",
                  {"bad_sweep.toml:5:", "vessel.bolard_thrust", "unknown key"}},
-        BadSweep{"value_out_of_range", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"field.concentration\" = [0.2, -0.1]\n",
+        BadSweep{"value_out_of_range",
+                 "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"field.concentration\" = [0.2, -0.1]\n",
                  {"bad_sweep.toml:4:", "case 1", "must be positive"}},
-        BadSweep{"bad_case_set", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n[[cases]]\nname = \"b\"\nset = { \"simulation.dt\" = \"fast\" }\n",
-                 {"bad_sweep.toml:7:", "case 1 \"b\"", "simulation.dt"}},
-        BadSweep{"case_without_name", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nset = { \"simulation.dt\" = 0.05 }\n", {"bad_sweep.toml:3:", "name"}},
-        BadSweep{"duplicate_case", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n[[cases]]\nname = \"a\"\n", {"bad_sweep.toml:5:", "two cases"}},
+        BadSweep{
+            "bad_case_set",
+            "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n[[cases]]\nname = \"b\"\nset = { \"simulation.dt\" = \"fast\" }\n",
+            {"bad_sweep.toml:7:", "case 1 \"b\"", "simulation.dt"}},
+        BadSweep{"case_without_name",
+                 "[sweep]\nbase = \"base.toml\"\n[[cases]]\nset = { \"simulation.dt\" = 0.05 }\n",
+                 {"bad_sweep.toml:3:", "name"}},
+        BadSweep{"duplicate_case",
+                 "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n[[cases]]\nname = \"a\"\n",
+                 {"bad_sweep.toml:5:", "two cases"}},
         BadSweep{"unsafe_case_name", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"../x\"\n", {"bad_sweep.toml:4:", "name"}},
         BadSweep{"nothing_to_run", "[sweep]\nbase = \"base.toml\"\n", {"bad_sweep.toml", "[parameters]"}},
         BadSweep{"toml_syntax", "[sweep]\nbase = \"base.toml\"\n[parameters]\nx = [1\n", {"bad_sweep.toml:4:"}},
         BadSweep{"varied_in_set_and_parameters",
-                 "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n[[cases]]\nname = \"a\"\nset = { vessel.bollard_thrust = 2.0 }\n",
+                 "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n[[cases]]\nname = \"a\"\nset = { "
+                 "vessel.bollard_thrust = 2.0 }\n",
                  {"bad_sweep.toml:7:", "also varied"}}),
     [](const auto& info) { return std::string(info.param.name); });
 
@@ -401,26 +427,26 @@ struct TogetherBackend {
   BackendEntry saved;
   TogetherBackend() : previous(findBackend("cuda")) {
     if (previous) saved = *previous;
-    registerBackend(BackendEntry{
-        "cuda", [] { return true; }, [] { return std::string("stand-in"); },
-        [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CpuStepper>(s); }, nullptr,
-        [](const Scenario& s) { return "steps=" + std::to_string(s.steps); },
-        [this](const std::vector<const Scenario*>& scenarios) {
-          if (refuse) throw BackendUnsupported("these cases cannot share a state");
-          auto batch = std::make_shared<Batch>();
-          std::vector<std::unique_ptr<Stepper>> steppers;
-          for (const Scenario* s : scenarios) {
-            steppers.push_back(std::make_unique<LockstepStepper>(*s, batch));
-            batch->members.push_back(steppers.back().get());
-          }
-          batches.push_back(batch);
-          return steppers;
-        },
-        [] { return 1; }});
+    registerBackend(BackendEntry{"cuda", [] { return true; }, [] { return std::string("stand-in"); },
+                                 [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CpuStepper>(s); }, nullptr,
+                                 [](const Scenario& s) { return "steps=" + std::to_string(s.steps); },
+                                 [this](const std::vector<const Scenario*>& scenarios) {
+                                   if (refuse) throw BackendUnsupported("these cases cannot share a state");
+                                   auto batch = std::make_shared<Batch>();
+                                   std::vector<std::unique_ptr<Stepper>> steppers;
+                                   for (const Scenario* s : scenarios) {
+                                     steppers.push_back(std::make_unique<LockstepStepper>(*s, batch));
+                                     batch->members.push_back(steppers.back().get());
+                                   }
+                                   batches.push_back(batch);
+                                   return steppers;
+                                 },
+                                 [] { return 1; }});
   }
   ~TogetherBackend() {
     // Put back what was there (the real CUDA backend in a CUDA build), or one that is never available.
-    if (previous) registerBackend(saved);
+    if (previous)
+      registerBackend(saved);
     else {
       BackendEntry none;
       none.name = "cuda";
@@ -465,7 +491,7 @@ TEST(Sweep, CasesRunTogetherWriteTheOutputsOfSingleRuns) {
   EXPECT_EQ(backend.batches[1]->members.size(), 2u);
   ASSERT_EQ(run("alone", 1), 0);
   EXPECT_EQ(backend.batches.size(), 3u);  // no case ran together with another
-  backend.refuse = true;  // the backend turns the group down: its cases run one at a time
+  backend.refuse = true;                  // the backend turns the group down: its cases run one at a time
   ASSERT_EQ(run("refused", 0), 0);
   EXPECT_EQ(backend.batches.size(), 3u);
   for (const auto& batch : backend.batches) EXPECT_FALSE(batch->outOfStep);

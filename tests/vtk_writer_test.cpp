@@ -15,8 +15,7 @@ class TempDir {
  public:
   TempDir() {
     static std::atomic<int> counter{0};
-    m_path = std::filesystem::temp_directory_path() /
-             ("gem_vtk_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    m_path = std::filesystem::temp_directory_path() / ("gem_vtk_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
     std::filesystem::remove_all(m_path);
   }
   ~TempDir() {
@@ -94,8 +93,7 @@ TEST(VtkSeriesWriter, WritesPolygonsWithCellDataAndACollection) {
   EXPECT_DOUBLE_EQ(numbers(cellArray(piece, "angular_velocity"))[0], 0.2);
   pugi::xml_node polys = piece.child("Polys");
   EXPECT_EQ(numbers(polys.find_child_by_attribute("DataArray", "Name", "offsets")), (std::vector<double>{4, 7}));
-  EXPECT_EQ(numbers(polys.find_child_by_attribute("DataArray", "Name", "connectivity")),
-            (std::vector<double>{0, 1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(numbers(polys.find_child_by_attribute("DataArray", "Name", "connectivity")), (std::vector<double>{0, 1, 2, 3, 4, 5, 6}));
 
   pugi::xml_document second;
   ASSERT_TRUE(second.load_file((dir.path() / "frames" / "frame_000001.vtp").c_str()));

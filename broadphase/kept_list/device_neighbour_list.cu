@@ -149,8 +149,8 @@ void DeviceNeighbourList::resize(int n) {
   if (m_capacity == 0) m_capacity = 8 * n + 1024;  // grows in reserve() when a build needs more
   m_pairs.ensure(static_cast<size_t>(m_capacity));
   size_t bytes = 0;
-  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, m_lo.get(), m_loSorted.get(), m_slot.get(), m_slotSorted.get(),
-                                                 n, 0, static_cast<int>(sizeof(Real) * 8)));
+  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, m_lo.get(), m_loSorted.get(), m_slot.get(), m_slotSorted.get(), n, 0,
+                                                 static_cast<int>(sizeof(Real) * 8)));
   m_temp.ensure(std::max<size_t>(bytes, 1));
   m_tempBytes = bytes;
   if (m_control.ensure(1)) GEM_CUDA_CHECK(cudaMemset(m_control.get(), 0, sizeof(ListControl)));
@@ -258,9 +258,24 @@ long DeviceNeighbourList::rebuilds() const {
 }
 
 ListView DeviceNeighbourList::view() {
-  return ListView{m_control.get(), m_half.get(), m_floor, kRebuildTrigger * m_skin / 2, m_alwaysDirect.get(), m_direct.get(),
-                  m_directList.get(), m_alwaysDirectCount + NeighbourList::kMaxDirect, m_alwaysDirectCount, m_x0.get(), m_y0.get(),
-                  m_angle0.get(), m_pairs.get(), m_capacity, m_lo.get(), m_loSorted.get(), m_slot.get(), m_slotSorted.get()};
+  return ListView{m_control.get(),
+                  m_half.get(),
+                  m_floor,
+                  kRebuildTrigger * m_skin / 2,
+                  m_alwaysDirect.get(),
+                  m_direct.get(),
+                  m_directList.get(),
+                  m_alwaysDirectCount + NeighbourList::kMaxDirect,
+                  m_alwaysDirectCount,
+                  m_x0.get(),
+                  m_y0.get(),
+                  m_angle0.get(),
+                  m_pairs.get(),
+                  m_capacity,
+                  m_lo.get(),
+                  m_loSorted.get(),
+                  m_slot.get(),
+                  m_slotSorted.get()};
 }
 
 }  // namespace gem::cuda

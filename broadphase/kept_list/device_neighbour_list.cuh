@@ -36,14 +36,14 @@ struct ListControl {
 // What the kernels see: device pointers fixed between upload() and reserve(), passed by value.
 struct ListView {
   ListControl* control;
-  const Real* half;                  // list reach per body: R + skin / 2
-  Real floor;                        // a pair within this is listed whatever its reach (fixed_radius)
-  Real limit;                        // a listed body moved past this becomes direct (half the skin)
-  const unsigned char* alwaysDirect; // vessel, walls
+  const Real* half;                   // list reach per body: R + skin / 2
+  Real floor;                         // a pair within this is listed whatever its reach (fixed_radius)
+  Real limit;                         // a listed body moved past this becomes direct (half the skin)
+  const unsigned char* alwaysDirect;  // vessel, walls
   unsigned char* direct;
-  int* directList;                   // the always-direct bodies first, then those that moved
+  int* directList;  // the always-direct bodies first, then those that moved
   int directRoom, alwaysDirectCount;
-  Real *x0, *y0, *angle0;            // reference state at the build
+  Real *x0, *y0, *angle0;  // reference state at the build
   ListedPair* pairs;
   int capacity;
   Real *lo, *loSorted;
@@ -120,7 +120,7 @@ class DeviceNeighbourList {
   ListView view();
   void markStale();
   cudaStream_t sideStream();  // made once, outside any capture (upload)
-  void resize(int n);  // per-body storage and the sort's scratch for n bodies
+  void resize(int n);         // per-body storage and the sort's scratch for n bodies
 
   Real m_skin;
   int m_n = 0, m_alwaysDirectCount = 0, m_capacity = 0;
@@ -132,7 +132,7 @@ class DeviceNeighbourList {
   DeviceArray<ListedPair> m_pairs;
   DeviceArray<unsigned char> m_temp;
   size_t m_tempBytes = 0;
-  DeviceArray<Real> m_halfBefore;                // reorder()'s copies
+  DeviceArray<Real> m_halfBefore;  // reorder()'s copies
   DeviceArray<unsigned char> m_alwaysBefore;
   DeviceArray<int> m_alwaysFound;
   cudaStream_t m_side = nullptr;

@@ -134,8 +134,8 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   auto before = [](CandidatePair p, CandidatePair q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
   std::sort(m_directPairs.begin(), m_directPairs.end(), before);
   out.resize(count + m_directPairs.size());
-  std::merge(m_filtered.begin(), m_filtered.begin() + static_cast<std::ptrdiff_t>(count), m_directPairs.begin(),
-             m_directPairs.end(), out.begin(), before);
+  std::merge(m_filtered.begin(), m_filtered.begin() + static_cast<std::ptrdiff_t>(count), m_directPairs.begin(), m_directPairs.end(),
+             out.begin(), before);
 }
 
 void KeptListBroadphase::findCandidates(const World& world, std::vector<CandidatePair>& pairs) {
@@ -191,8 +191,7 @@ void AxisSweep::build(const World& world, const std::vector<Real>& h, Real floor
 BroadphaseSettings checkedSettings(const BroadphaseSettings& settings) {
   auto check = [](Real value, const char* key) {
     if (!std::isfinite(value) || value < 0)
-      throw InputError(std::string("broadphase ") + key + " must be a finite length >= 0 m, got " +
-                       std::to_string(value));
+      throw InputError(std::string("broadphase ") + key + " must be a finite length >= 0 m, got " + std::to_string(value));
   };
   check(settings.skin, "skin");
   check(settings.fixedRadius, "fixed_radius");

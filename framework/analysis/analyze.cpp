@@ -34,7 +34,6 @@ constexpr const char* kAllColor = "#000000";
 // would set the fit of thesis Figure 6.35. They are left out of that fit and plot, and counted.
 constexpr double kMinStemDistance = 0.01;  // m
 
-
 struct Impact {
   double t, floeId, floeMass, apexDeg, xFromStem, yFromCenterline, vn, fn;
   double shipSpeed;  // from timeseries.csv at t; NaN without one
@@ -123,8 +122,8 @@ std::vector<std::vector<double>> readColumns(const fs::path& file, const std::ve
 Run readRun(const fs::path& dir, std::string name) {
   Run run;
   run.name = std::move(name);
-  const auto c = readColumns(dir / "impacts.csv",
-                             {"t", "floe_id", "floe_mass", "apex_deg", "x_from_stem", "y_from_centerline", "vn", "fn"});
+  const auto c =
+      readColumns(dir / "impacts.csv", {"t", "floe_id", "floe_mass", "apex_deg", "x_from_stem", "y_from_centerline", "vn", "fn"});
   std::vector<double> ts, speed;
   if (fs::exists(dir / "timeseries.csv")) {
     const auto s = readColumns(dir / "timeseries.csv", {"t", "ship_speed"});
@@ -135,8 +134,10 @@ Run readRun(const fs::path& dir, std::string name) {
     double ship = NAN;
     if (run.hasShipSpeed) {
       const auto it = std::lower_bound(ts.begin(), ts.end(), c[0][i]);
-      if (it == ts.begin()) ship = speed.front();
-      else if (it == ts.end()) ship = speed.back();
+      if (it == ts.begin())
+        ship = speed.front();
+      else if (it == ts.end())
+        ship = speed.back();
       else {
         const size_t k = size_t(it - ts.begin());
         const double w = ts[k] > ts[k - 1] ? (c[0][i] - ts[k - 1]) / (ts[k] - ts[k - 1]) : 1.0;
@@ -189,8 +190,8 @@ std::string statisticsCsv(const std::vector<Group>& groups, const std::vector<Gr
     out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", groups[i].name, groups[i].runs.size(), s.impacts,
                        cell(s.forceMean, s.impacts > 0), cell(s.forceMax, s.impacts > 0), cell(s.force.shape, s.force.ok),
                        cell(s.force.scale, s.force.ok), s.struckFloes, cell(s.mass.mu, s.mass.ok), cell(s.mass.sigma, s.mass.ok),
-                       cell(std::exp(s.mass.mu), s.mass.ok), cell(s.apex.shape, s.apex.ok), cell(s.apex.scale, s.apex.ok),
-                       power(s.vsStem), power(s.vsVn), power(s.vsShipSpeed));
+                       cell(std::exp(s.mass.mu), s.mass.ok), cell(s.apex.shape, s.apex.ok), cell(s.apex.scale, s.apex.ok), power(s.vsStem),
+                       power(s.vsVn), power(s.vsShipSpeed));
   }
   return out;
 }
@@ -313,8 +314,8 @@ void plotMass(const Group& all, const GroupStatistics& s, const fs::path& file) 
         mx.push_back(std::exp(l));
         my.push_back(lognormalLogDensity(l, s.mass.mu, s.mass.sigma));
       }
-      plot.addLine(fmt::format("lognormal mu={:.3g}, sigma={:.3g} (median {:.3g} kg)", s.mass.mu, s.mass.sigma, std::exp(s.mass.mu)),
-                   mx, my, "#D55E00");
+      plot.addLine(fmt::format("lognormal mu={:.3g}, sigma={:.3g} (median {:.3g} kg)", s.mass.mu, s.mass.sigma, std::exp(s.mass.mu)), mx,
+                   my, "#D55E00");
     }
   }
   plot.write(file);
@@ -352,8 +353,8 @@ void plotAcrossBow(const std::vector<Group>& groups, const AcrossBow& a, const f
     std::vector<double> edges;
     for (size_t b = 0; b <= a.perMetrePerRun[gi].size(); ++b) edges.push_back(a.y0 + double(b));
     if (!a.perMetrePerRun[gi].empty())
-      plot.addSteps(fmt::format("{} ({} run{})", groups[gi].name, groups[gi].runs.size(), groups[gi].runs.size() == 1 ? "" : "s"), edges, a.perMetrePerRun[gi],
-                    groups[gi].color);
+      plot.addSteps(fmt::format("{} ({} run{})", groups[gi].name, groups[gi].runs.size(), groups[gi].runs.size() == 1 ? "" : "s"), edges,
+                    a.perMetrePerRun[gi], groups[gi].color);
   }
   plot.write(file);
 }
@@ -361,9 +362,9 @@ void plotAcrossBow(const std::vector<Group>& groups, const AcrossBow& a, const f
 // Force against a per-impact quantity on log-log axes, with each group's power law (thesis
 // Figures 6.35 and 6.36).
 template <class F>
-void plotPowerLaw(const std::vector<Group>& groups, const std::vector<GroupStatistics>& stats, PowerLawFit GroupStatistics::*fit,
-                  F field, const std::string& title, const std::string& xLabel, const fs::path& file,
-                  AxisScale xScale = AxisScale::Log, const std::string& extraNote = "") {
+void plotPowerLaw(const std::vector<Group>& groups, const std::vector<GroupStatistics>& stats, PowerLawFit GroupStatistics::*fit, F field,
+                  const std::string& title, const std::string& xLabel, const fs::path& file, AxisScale xScale = AxisScale::Log,
+                  const std::string& extraNote = "") {
   SvgPlot plot(title, xLabel, "impact force fn [N]");
   plot.setXScale(xScale);
   plot.setLegendRight(xScale == AxisScale::Linear);  // linear distances crowd at the stem, on the left
@@ -371,7 +372,7 @@ void plotPowerLaw(const std::vector<Group>& groups, const std::vector<GroupStati
   plot.addNote("fn = a x^b, least squares in log-log space over the impacts with x > 0 and fn > 0");
   if (!extraNote.empty()) plot.addNote(extraNote);
   for (size_t gi : drawnGroups(groups)) {
-    std::vector<double> x = groups[gi].column(field), y = groups[gi].column([](const Impact& i) { return i.fn; });
+    std::vector<double> x = groups[gi].column(field), y = groups[gi].column([](const Impact&i) { return i.fn; });
     const PowerLawFit& p = stats[gi].*fit;
     double lo = INFINITY, hi = -INFINITY;
     for (size_t i = 0; i < x.size(); ++i)
@@ -392,15 +393,14 @@ void plotPowerLaw(const std::vector<Group>& groups, const std::vector<GroupStati
 
 void printTable(const std::vector<Group>& groups, const std::vector<GroupStatistics>& stats, const fs::path& outDir) {
   auto num = [](double v, bool ok) { return ok && std::isfinite(v) ? fmt::format("{:.3g}", v) : std::string("-"); };
-  std::printf("%-8s %5s %8s %10s %10s %7s %10s %7s %7s %7s %7s %7s\n", "group", "runs", "impacts", "F mean N", "F max N",
-              "F k", "F lambda", "ln m mu", "sigma", "apex k", "lambda", "F~vn b");
+  std::printf("%-8s %5s %8s %10s %10s %7s %10s %7s %7s %7s %7s %7s\n", "group", "runs", "impacts", "F mean N", "F max N", "F k", "F lambda",
+              "ln m mu", "sigma", "apex k", "lambda", "F~vn b");
   for (size_t i = 0; i < groups.size(); ++i) {
     const GroupStatistics& s = stats[i];
-    std::printf("%-8s %5zu %8zu %10s %10s %7s %10s %7s %7s %7s %7s %7s\n", groups[i].name.c_str(), groups[i].runs.size(),
-                s.impacts, num(s.forceMean, s.impacts > 0).c_str(), num(s.forceMax, s.impacts > 0).c_str(),
-                num(s.force.shape, s.force.ok).c_str(), num(s.force.scale, s.force.ok).c_str(), num(s.mass.mu, s.mass.ok).c_str(),
-                num(s.mass.sigma, s.mass.ok).c_str(), num(s.apex.shape, s.apex.ok).c_str(), num(s.apex.scale, s.apex.ok).c_str(),
-                num(s.vsVn.b, s.vsVn.ok).c_str());
+    std::printf("%-8s %5zu %8zu %10s %10s %7s %10s %7s %7s %7s %7s %7s\n", groups[i].name.c_str(), groups[i].runs.size(), s.impacts,
+                num(s.forceMean, s.impacts > 0).c_str(), num(s.forceMax, s.impacts > 0).c_str(), num(s.force.shape, s.force.ok).c_str(),
+                num(s.force.scale, s.force.ok).c_str(), num(s.mass.mu, s.mass.ok).c_str(), num(s.mass.sigma, s.mass.ok).c_str(),
+                num(s.apex.shape, s.apex.ok).c_str(), num(s.apex.scale, s.apex.ok).c_str(), num(s.vsVn.b, s.vsVn.ok).c_str());
   }
   std::printf("  tables and plots in %s\n", outDir.string().c_str());
 }
@@ -426,17 +426,20 @@ int runAnalyze(const AnalyzeOptions& options) {
       if (e.is_directory()) cases.push_back(e.path());
     std::sort(cases.begin(), cases.end());
     for (const fs::path& c : cases) {
-      if (fs::exists(c / "impacts.csv")) runs.push_back(readRun(c, c.filename().string()));
-      else ++incomplete;
+      if (fs::exists(c / "impacts.csv"))
+        runs.push_back(readRun(c, c.filename().string()));
+      else
+        ++incomplete;
     }
   }
   // A resistance sweep (cases "FIELD,bollard_thrust=T") also gets its resistance analysis.
   const bool resistance = sweep && analyzeResistance(dir, options.quiet);
   if (runs.empty() && resistance) return 0;
   if (runs.empty())
-    throw InputError(fmt::format("{}: no impacts.csv here and none in cases/*/: not a run folder or a sweep folder with a finished "
-                                 "case",
-                                 dir.string()));
+    throw InputError(
+        fmt::format("{}: no impacts.csv here and none in cases/*/: not a run folder or a sweep folder with a finished "
+                    "case",
+                    dir.string()));
 
   // Groups: a run folder is one group "all"; a sweep groups its cases by name prefix (thesis
   // Figure 6.38), plus "all" of the chosen ones.
@@ -478,12 +481,14 @@ int runAnalyze(const AnalyzeOptions& options) {
   plotPowerLaw(groups, stats, &GroupStatistics::vsStem, stemDistance, "Impact force against distance from stem (thesis Fig. 6.35)",
                "distance from stem x [m]", out / "force_vs_stem_distance.svg", AxisScale::Linear,
                atStem ? fmt::format("{} impact(s) within {} m of the stem left out", atStem, kMinStemDistance) : std::string());
-  plotPowerLaw(groups, stats, &GroupStatistics::vsVn, [](const Impact& i) { return i.vn; },
-               "Impact force against closing speed", "normal closing speed vn [m/s]", out / "force_vs_speed.svg");
+  plotPowerLaw(
+      groups, stats, &GroupStatistics::vsVn, [](const Impact& i) { return i.vn; }, "Impact force against closing speed",
+      "normal closing speed vn [m/s]", out / "force_vs_speed.svg");
   const bool shipSpeed = std::all_of(runs.begin(), runs.end(), [](const Run& r) { return r.hasShipSpeed; });
   if (shipSpeed)
-    plotPowerLaw(groups, stats, &GroupStatistics::vsShipSpeed, [](const Impact& i) { return i.shipSpeed; },
-                 "Impact force against ship speed (thesis Fig. 6.36)", "ship speed at impact [m/s]", out / "force_vs_ship_speed.svg");
+    plotPowerLaw(
+        groups, stats, &GroupStatistics::vsShipSpeed, [](const Impact& i) { return i.shipSpeed; },
+        "Impact force against ship speed (thesis Fig. 6.36)", "ship speed at impact [m/s]", out / "force_vs_ship_speed.svg");
   else
     fs::remove(out / "force_vs_ship_speed.svg");  // a stale plot must not describe this data
 

@@ -26,9 +26,12 @@ std::vector<std::string> splitCsv(const std::string& line) {
   for (size_t i = 0; i < line.size(); ++i) {
     const char c = line[i];
     if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') cells.back() += '"', ++i;
-      else if (c == '"') quoted = false;
-      else cells.back() += c;
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"')
+        cells.back() += '"', ++i;
+      else if (c == '"')
+        quoted = false;
+      else
+        cells.back() += c;
     } else if (c == '"') {
       quoted = true;
     } else if (c == ',') {
@@ -99,8 +102,7 @@ bool analyzeResistance(const fs::path& sweepDir, bool quiet) {
   writeFileAtomically(out / "resistance.csv", table);
 
   // R = a V^b per field (thesis Figure 6.26), least squares in log-log over the positive points.
-  SvgPlot vsSpeed("Ice resistance against speed (thesis Fig. 6.26)", "mean ship speed in ice V [m/s]",
-                  "mean resistance in ice R [N]");
+  SvgPlot vsSpeed("Ice resistance against speed (thesis Fig. 6.26)", "mean ship speed in ice V [m/s]", "mean resistance in ice R [N]");
   vsSpeed.setXScale(AxisScale::Log);
   vsSpeed.setYScale(AxisScale::Log);
   std::string fits = "field,concentration,a,b,r2,points\n";

@@ -77,7 +77,10 @@ WeibullFit fitWeibull(std::span<const double> values) {
   for (int i = 0; i < 200; ++i) {
     double g, dg;
     eq.evaluate(k, g, dg);
-    if (g < 0) lo = k; else hi = k;
+    if (g < 0)
+      lo = k;
+    else
+      hi = k;
     double next = k - g / dg;
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     const bool done = std::abs(next - k) <= 1e-12 * k;

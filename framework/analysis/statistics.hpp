@@ -16,8 +16,8 @@ namespace gem {
 
 // F(x) = 1 - exp(-(x / scale)^shape), x >= 0 (thesis 6.2.2.4).
 struct WeibullFit {
-  double shape = 0;  // k
-  double scale = 0;  // lambda, in the unit of the data
+  double shape = 0;       // k
+  double scale = 0;       // lambda, in the unit of the data
   std::size_t count = 0;  // positive finite values used
   bool ok = false;
   std::string reason;  // why not ok ("" when ok)
@@ -36,7 +36,7 @@ struct LognormalFit {
 struct PowerLawFit {
   double a = 0;
   double b = 0;
-  double r2 = 0;  // coefficient of determination in log-log space
+  double r2 = 0;          // coefficient of determination in log-log space
   std::size_t count = 0;  // pairs with x > 0 and y > 0 (both finite)
   bool ok = false;
   std::string reason;

@@ -16,11 +16,20 @@ std::string escapeXml(const std::string& text) {
   std::string out;
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -30,8 +39,10 @@ std::string escapeXml(const std::string& text) {
 double transform(AxisScale scale, double v) {
   if (!std::isfinite(v)) return std::numeric_limits<double>::quiet_NaN();
   switch (scale) {
-    case AxisScale::Linear: return v;
-    case AxisScale::Log: return v > 0 ? std::log10(v) : std::numeric_limits<double>::quiet_NaN();
+    case AxisScale::Linear:
+      return v;
+    case AxisScale::Log:
+      return v > 0 ? std::log10(v) : std::numeric_limits<double>::quiet_NaN();
     case AxisScale::WeibullProbability:
       return v > 0 && v < 1 ? std::log(-std::log1p(-v)) : std::numeric_limits<double>::quiet_NaN();
   }
@@ -99,9 +110,8 @@ std::vector<Tick> makeTicks(AxisScale scale, double lo, double hi) {
 
 std::string plotColor(std::size_t i) {
   // Okabe-Ito, then a few darker tones: distinguishable for colour-blind readers.
-  static const char* const kPalette[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9",
-                                         "#F0E442", "#8C564B", "#7F3C8D", "#11A579", "#3969AC", "#F2B701",
-                                         "#E73F74", "#80BA5A", "#E68310", "#008695"};
+  static const char* const kPalette[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#8C564B",
+                                         "#7F3C8D", "#11A579", "#3969AC", "#F2B701", "#E73F74", "#80BA5A", "#E68310", "#008695"};
   return kPalette[i % (sizeof(kPalette) / sizeof(kPalette[0]))];
 }
 
@@ -112,20 +122,17 @@ SvgPlot::SvgPlot(std::string title, std::string xLabel, std::string yLabel) : m_
 
 std::string SvgPlot::nextColor() { return plotColor(m_colorIndex++); }
 
-void SvgPlot::addScatter(std::string label, std::vector<double> x, std::vector<double> y, std::string color,
-                         double radius) {
-  m_series.push_back({Kind::Scatter, std::move(label), color.empty() ? nextColor() : std::move(color), std::move(x),
-                      std::move(y), false, radius});
+void SvgPlot::addScatter(std::string label, std::vector<double> x, std::vector<double> y, std::string color, double radius) {
+  m_series.push_back(
+      {Kind::Scatter, std::move(label), color.empty() ? nextColor() : std::move(color), std::move(x), std::move(y), false, radius});
 }
 
 void SvgPlot::addLine(std::string label, std::vector<double> x, std::vector<double> y, std::string color, bool dashed) {
-  m_series.push_back(
-      {Kind::Line, std::move(label), color.empty() ? nextColor() : std::move(color), std::move(x), std::move(y), dashed});
+  m_series.push_back({Kind::Line, std::move(label), color.empty() ? nextColor() : std::move(color), std::move(x), std::move(y), dashed});
 }
 
 void SvgPlot::addSteps(std::string label, std::vector<double> edges, std::vector<double> values, std::string color) {
-  m_series.push_back(
-      {Kind::Steps, std::move(label), color.empty() ? nextColor() : std::move(color), std::move(edges), std::move(values)});
+  m_series.push_back({Kind::Steps, std::move(label), color.empty() ? nextColor() : std::move(color), std::move(edges), std::move(values)});
 }
 
 std::string SvgPlot::render(int width, int height) const {
@@ -184,11 +191,15 @@ std::string SvgPlot::render(int width, int height) const {
   // Grid and ticks.
   svg += "<g stroke=\"#e4e4e4\" stroke-width=\"1\">\n";
   const std::vector<Tick> xTicks = makeTicks(m_x.scale, xLo, xHi), yTicks = makeTicks(m_y.scale, yLo, yHi);
-  for (const Tick& t : xTicks) svg += fmt::format("<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{0:.2f}\" y2=\"{2:.2f}\"/>\n", px(t.t), top, bottom);
-  for (const Tick& t : yTicks) svg += fmt::format("<line x1=\"{1:.2f}\" y1=\"{0:.2f}\" x2=\"{2:.2f}\" y2=\"{0:.2f}\"/>\n", py(t.t), left, right);
+  for (const Tick& t : xTicks)
+    svg += fmt::format("<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{0:.2f}\" y2=\"{2:.2f}\"/>\n", px(t.t), top, bottom);
+  for (const Tick& t : yTicks)
+    svg += fmt::format("<line x1=\"{1:.2f}\" y1=\"{0:.2f}\" x2=\"{2:.2f}\" y2=\"{0:.2f}\"/>\n", py(t.t), left, right);
   svg += "</g>\n<g stroke=\"black\" stroke-width=\"1\">\n";
-  for (const Tick& t : xTicks) svg += fmt::format("<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{0:.2f}\" y2=\"{2:.2f}\"/>\n", px(t.t), bottom, bottom + 5);
-  for (const Tick& t : yTicks) svg += fmt::format("<line x1=\"{1:.2f}\" y1=\"{0:.2f}\" x2=\"{2:.2f}\" y2=\"{0:.2f}\"/>\n", py(t.t), left - 5, left);
+  for (const Tick& t : xTicks)
+    svg += fmt::format("<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{0:.2f}\" y2=\"{2:.2f}\"/>\n", px(t.t), bottom, bottom + 5);
+  for (const Tick& t : yTicks)
+    svg += fmt::format("<line x1=\"{1:.2f}\" y1=\"{0:.2f}\" x2=\"{2:.2f}\" y2=\"{0:.2f}\"/>\n", py(t.t), left - 5, left);
   svg += "</g>\n";
   for (const Tick& t : xTicks)
     svg += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" text-anchor=\"middle\">{}</text>\n", px(t.t), bottom + 18, escapeXml(t.label));
@@ -196,8 +207,9 @@ std::string SvgPlot::render(int width, int height) const {
     svg += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" text-anchor=\"end\">{}</text>\n", left - 8, py(t.t) + 4, escapeXml(t.label));
   svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"13\">{}</text>\n", 0.5 * (left + right),
                      double(height) - 14, escapeXml(m_x.label));
-  svg += fmt::format("<text x=\"18\" y=\"{0:.1f}\" text-anchor=\"middle\" font-size=\"13\" transform=\"rotate(-90 18 {0:.1f})\">{1}</text>\n",
-                     0.5 * (top + bottom), escapeXml(m_y.label));
+  svg +=
+      fmt::format("<text x=\"18\" y=\"{0:.1f}\" text-anchor=\"middle\" font-size=\"13\" transform=\"rotate(-90 18 {0:.1f})\">{1}</text>\n",
+                  0.5 * (top + bottom), escapeXml(m_y.label));
 
   // Series, clipped to the plot area (fixed ranges may cut them).
   svg += "<g clip-path=\"url(#plot-area)\">\n";
@@ -237,16 +249,15 @@ std::string SvgPlot::render(int width, int height) const {
         point(tx1, ty);
       }
       if (baseline && !s.y.empty() && s.x.size() > s.y.size()) point(transform(m_x.scale, s.x[s.y.size()]), 0.0);
-      if (baseline && !d.empty())
-        svg += fmt::format("<path d=\"{}Z\" fill=\"{}\" fill-opacity=\"0.12\" stroke=\"none\"/>\n", d, s.color);
+      if (baseline && !d.empty()) svg += fmt::format("<path d=\"{}Z\" fill=\"{}\" fill-opacity=\"0.12\" stroke=\"none\"/>\n", d, s.color);
     }
     if (!d.empty())
       svg += fmt::format("<path d=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1.6\"{}/>\n", d, s.color,
                          s.dashed ? " stroke-dasharray=\"6 4\"" : "");
   }
   svg += "</g>\n";
-  svg += fmt::format("<rect x=\"{:.2f}\" y=\"{:.2f}\" width=\"{:.2f}\" height=\"{:.2f}\" fill=\"none\" stroke=\"black\"/>\n", left,
-                     top, right - left, bottom - top);
+  svg += fmt::format("<rect x=\"{:.2f}\" y=\"{:.2f}\" width=\"{:.2f}\" height=\"{:.2f}\" fill=\"none\" stroke=\"black\"/>\n", left, top,
+                     right - left, bottom - top);
   if (empty)
     svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"14\" fill=\"#888\">no data</text>\n",
                        0.5 * (left + right), 0.5 * (top + bottom));
@@ -260,9 +271,10 @@ std::string SvgPlot::render(int width, int height) const {
     for (const Series* s : labelled) longest = std::max(longest, s->label.size());
     const double w = 40 + 6.8 * double(longest), h = 8 + 16.0 * double(labelled.size());
     const double lx = m_legendRight ? right - 10 - w : left + 10, ly = top + 10;
-    svg += fmt::format("<g font-size=\"11\">\n<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"white\" "
-                       "fill-opacity=\"0.85\" stroke=\"#999\"/>\n",
-                       lx, ly, w, h);
+    svg += fmt::format(
+        "<g font-size=\"11\">\n<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"white\" "
+        "fill-opacity=\"0.85\" stroke=\"#999\"/>\n",
+        lx, ly, w, h);
     for (size_t i = 0; i < labelled.size(); ++i) {
       const Series& s = *labelled[i];
       const double y = ly + 14 + 16.0 * double(i);

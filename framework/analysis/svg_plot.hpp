@@ -38,10 +38,8 @@ class SvgPlot {
   void setLegendRight(bool right) { m_legendRight = right; }
 
   // An empty label keeps the series out of the legend; an empty colour takes the next palette one.
-  void addScatter(std::string label, std::vector<double> x, std::vector<double> y, std::string color = "",
-                  double radius = 2.0);
-  void addLine(std::string label, std::vector<double> x, std::vector<double> y, std::string color = "",
-               bool dashed = false);
+  void addScatter(std::string label, std::vector<double> x, std::vector<double> y, std::string color = "", double radius = 2.0);
+  void addLine(std::string label, std::vector<double> x, std::vector<double> y, std::string color = "", bool dashed = false);
   // A histogram outline: edges has one more entry than values.
   void addSteps(std::string label, std::vector<double> edges, std::vector<double> values, std::string color = "");
 

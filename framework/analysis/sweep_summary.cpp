@@ -57,8 +57,10 @@ class JsonReader {
       char c = m_text[m_pos++];
       if (c == '\\' && m_pos < m_text.size()) {
         c = m_text[m_pos++];
-        if (c == 'n') c = '\n';
-        else if (c == 't') c = '\t';
+        if (c == 'n')
+          c = '\n';
+        else if (c == 't')
+          c = '\t';
         else if (c == 'u') {  // GEM writes none; keep the escape as text rather than decode it
           s += "\\u";
           continue;

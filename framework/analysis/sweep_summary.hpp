@@ -19,7 +19,6 @@ const std::vector<std::string>& sweepSummaryColumns();
 
 // Writes DIR/summary.csv (atomically) from every case whose folder holds a summary.json, in case
 // order; returns the number of rows. caseDirs[i] is the folder of case i.
-int writeSweepSummary(const SweepDefinition& sweep, const std::filesystem::path& csv,
-                      const std::vector<std::filesystem::path>& caseDirs);
+int writeSweepSummary(const SweepDefinition& sweep, const std::filesystem::path& csv, const std::vector<std::filesystem::path>& caseDirs);
 
 }  // namespace gem

@@ -24,9 +24,9 @@ struct CandidatePair {
 // when the scenario is read, and one that a backend's part of the strategy does not honour is
 // refused by that backend, never silently ignored.
 struct BroadphaseSettings {
-  Real skin = 2;           // m: extra margin of a kept neighbour list (docs/model.md 9)
-  Real fixedRadius = 0;    // m: fixed_radius's global radius; 0 = 2 x the largest bounding radius
-  Real cellSize = 0;       // m: uniform_grid's cell size; 0 = the largest bounding diameter + skin
+  Real skin = 2;                   // m: extra margin of a kept neighbour list (docs/model.md 9)
+  Real fixedRadius = 0;            // m: fixed_radius's global radius; 0 = 2 x the largest bounding radius
+  Real cellSize = 0;               // m: uniform_grid's cell size; 0 = the largest bounding diameter + skin
   std::vector<std::string> given;  // the keys the scenario set ("skin", "cell_size", ...)
 };
 
@@ -39,8 +39,10 @@ inline const std::vector<std::string>& broadphaseSettingKeys() {
 // The keys a strategy class declares (its kSettings), or none.
 template <class Strategy>
 std::vector<std::string> declaredBroadphaseSettings() {
-  if constexpr (requires { Strategy::kSettings; }) return {std::begin(Strategy::kSettings), std::end(Strategy::kSettings)};
-  else return {};
+  if constexpr (requires { Strategy::kSettings; })
+    return {std::begin(Strategy::kSettings), std::end(Strategy::kSettings)};
+  else
+    return {};
 }
 
 class Broadphase {

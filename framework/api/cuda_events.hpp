@@ -42,12 +42,12 @@ struct DevicePairData {
   const int* contactB;
   const PairContact* contacts;
   PairSlot* slots;
-  int count;              // capacity covered by the launch
-  int block;              // threads per block (simulation.cuda_block_size)
-  const int* liveCount;   // device: this step's contacts
-  const StepContext* ctx; // device
-  RecordSink sink;        // device buffers, integer atomic counters
-  int event;              // the event's place among the phase's events: stamped on its records
+  int count;               // capacity covered by the launch
+  int block;               // threads per block (simulation.cuda_block_size)
+  const int* liveCount;    // device: this step's contacts
+  const StepContext* ctx;  // device
+  RecordSink sink;         // device buffers, integer atomic counters
+  int event;               // the event's place among the phase's events: stamped on its records
 };
 
 struct DeviceSoloData {
@@ -94,7 +94,8 @@ const CudaEventFactory* findCudaEvent(const std::string& name, const std::string
 template <class Params>
 class WorldParams {
  public:
-  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  static_assert(std::is_trivially_copyable_v<Params>,
+                "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
   WorldParams(const void* const* params, int worlds) : m_first(*static_cast<const Params*>(params[0])) {
     bool same = true;
     for (int w = 1; w < worlds; ++w) same = same && std::memcmp(params[w], params[0], sizeof(Params)) == 0;
@@ -209,19 +210,20 @@ struct RegisterCudaEvent {
 // A plugin: a node of the plugin's own list (registry.hpp's GEM_REGISTRATION, which needs
 // registry.hpp included), run by gem_plugin_register once the descriptor is accepted; it adds the
 // driver under the origin the loader is registering.
-#define GEM_REGISTER_CUDA_EVENT(DRIVER, EVENT, NAME)                                                       \
-  GEM_REGISTRATION(cuda_event_, ::gem::cuda::addCudaEvent(                                                \
-      NAME,                                                                                                \
-      [](const void* const* params, int worlds) -> std::unique_ptr<::gem::cuda::CudaEventDriver> {        \
-        return std::make_unique<DRIVER<EVENT>>(params, worlds);                                           \
-      },                                                                                                   \
-      registry.pluginOrigin()))
+#define GEM_REGISTER_CUDA_EVENT(DRIVER, EVENT, NAME)                                                                             \
+  GEM_REGISTRATION(cuda_event_, ::gem::cuda::addCudaEvent(                                                                       \
+                                    NAME,                                                                                        \
+                                    [](const void* const* params, int worlds) -> std::unique_ptr<::gem::cuda::CudaEventDriver> { \
+                                      return std::make_unique<DRIVER<EVENT>>(params, worlds);                                    \
+                                    },                                                                                           \
+                                    registry.pluginOrigin()))
 #else
-#define GEM_REGISTER_CUDA_EVENT(DRIVER, EVENT, NAME)                                                       \
-  static const ::gem::cuda::RegisterCudaEvent GEM_CONCAT(gem_register_cuda_event_, __LINE__){            \
-      NAME, [](const void* const* params, int worlds) -> std::unique_ptr<::gem::cuda::CudaEventDriver> {  \
-        return std::make_unique<DRIVER<EVENT>>(params, worlds);                                           \
-      }}
+#define GEM_REGISTER_CUDA_EVENT(DRIVER, EVENT, NAME)                                                   \
+  static const ::gem::cuda::RegisterCudaEvent GEM_CONCAT(gem_register_cuda_event_, __LINE__) {         \
+    NAME, [](const void* const* params, int worlds) -> std::unique_ptr<::gem::cuda::CudaEventDriver> { \
+      return std::make_unique<DRIVER<EVENT>>(params, worlds);                                          \
+    }                                                                                                  \
+  }
 #endif
 #define GEM_REGISTER_CUDA_PAIR_EVENT(EVENT, NAME) GEM_REGISTER_CUDA_EVENT(::gem::cuda::CudaPairDriver, EVENT, NAME)
 #define GEM_REGISTER_CUDA_SOLO_EVENT(EVENT, NAME) GEM_REGISTER_CUDA_EVENT(::gem::cuda::CudaSoloDriver, EVENT, NAME)

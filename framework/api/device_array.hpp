@@ -79,9 +79,12 @@ class DeviceArray {
 
  private:
   static size_t grown(size_t n) {
-    if constexpr (Use == DeviceArrayUse::Graph) return std::max<size_t>(n + n / 2, 64);
-    else if constexpr (Use == DeviceArrayUse::Scratch) return n + n / 2 + 4096;
-    else return n + n / 2 + 64;
+    if constexpr (Use == DeviceArrayUse::Graph)
+      return std::max<size_t>(n + n / 2, 64);
+    else if constexpr (Use == DeviceArrayUse::Scratch)
+      return n + n / 2 + 4096;
+    else
+      return n + n / 2 + 64;
   }
   void allocate(size_t capacity) {
     if (m_data) GEM_CUDA_CHECK(cudaFree(m_data));

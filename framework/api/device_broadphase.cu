@@ -19,7 +19,8 @@ static std::map<BroadphaseKey, DevicePart>& broadphaseTable() {
   return t;
 }
 
-void addCudaBroadphase(const std::string& name, CudaBroadphaseFactory factory, const std::string& origin, std::vector<std::string> settings) {
+void addCudaBroadphase(const std::string& name, CudaBroadphaseFactory factory, const std::string& origin,
+                       std::vector<std::string> settings) {
   broadphaseTable()[BroadphaseKey{name, origin}] = DevicePart{std::move(factory), std::move(settings)};
 }
 

@@ -42,14 +42,14 @@ namespace gem::cuda {
 // (passed by value; the pointers are fixed between uploads, the contents change every step).
 struct BroadphaseBodies {
   int n;
-  const Real* x;             // centroid, m
+  const Real* x;  // centroid, m
   const Real* y;
-  const Real* angle;         // rad
-  const Real* radius;        // bounding radius about the centroid (World::radius), m
-  const Box* boxes;          // this step's world-aligned boxes
-  const Real* invMass;       // 0: immovable (walls)
+  const Real* angle;    // rad
+  const Real* radius;   // bounding radius about the centroid (World::radius), m
+  const Box* boxes;     // this step's world-aligned boxes
+  const Real* invMass;  // 0: immovable (walls)
   const BodyKind* kind;
-  const Vec2* worldVertices; // this step's, kMaxVertices per body
+  const Vec2* worldVertices;  // this step's, kMaxVertices per body
   const int* vertexCount;
 };
 
@@ -129,19 +129,17 @@ struct RegisterCudaBroadphase {
 #if defined(GEM_BUILDING_PLUGIN)
 // A plugin: a node of the plugin's own list (registry.hpp's GEM_REGISTRATION, which needs
 // registry.hpp included), run by gem_plugin_register under the origin the loader is registering.
-#define GEM_REGISTER_CUDA_BROADPHASE(CLASS, NAME)                                                               \
-  GEM_REGISTRATION(cuda_broadphase_, ::gem::cuda::addCudaBroadphase(                                           \
-      NAME,                                                                                                     \
-      [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::cuda::CudaBroadphase> {                \
-        return std::make_unique<CLASS>(s);                                                                      \
-      },                                                                                                        \
-      registry.pluginOrigin(), ::gem::declaredBroadphaseSettings<CLASS>()))
+#define GEM_REGISTER_CUDA_BROADPHASE(CLASS, NAME)                                                                                 \
+  GEM_REGISTRATION(cuda_broadphase_, ::gem::cuda::addCudaBroadphase(                                                              \
+                                         NAME,                                                                                    \
+                                         [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::cuda::CudaBroadphase> { \
+                                           return std::make_unique<CLASS>(s);                                                     \
+                                         },                                                                                       \
+                                         registry.pluginOrigin(), ::gem::declaredBroadphaseSettings<CLASS>()))
 #else
-#define GEM_REGISTER_CUDA_BROADPHASE(CLASS, NAME)                                                               \
-  static const ::gem::cuda::RegisterCudaBroadphase GEM_CONCAT(gem_register_cuda_broadphase_, __LINE__){       \
-      NAME,                                                                                                     \
-      [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::cuda::CudaBroadphase> {                \
-        return std::make_unique<CLASS>(s);                                                                      \
-      },                                                                                                        \
-      ::gem::declaredBroadphaseSettings<CLASS>()}
+#define GEM_REGISTER_CUDA_BROADPHASE(CLASS, NAME)                                                                                        \
+  static const ::gem::cuda::RegisterCudaBroadphase GEM_CONCAT(gem_register_cuda_broadphase_, __LINE__) {                                 \
+    NAME, [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::cuda::CudaBroadphase> { return std::make_unique<CLASS>(s); }, \
+        ::gem::declaredBroadphaseSettings<CLASS>()                                                                                       \
+  }
 #endif

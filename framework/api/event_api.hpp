@@ -14,8 +14,6 @@
 
 namespace gem {
 
-
-
 struct StepContext {
   Real dt;    // s
   Real time;  // s, at the start of the step
@@ -59,9 +57,9 @@ struct PairBody {
   Vec2 velocity;
   Real omega;
   Real mass, invMass, invInertia;
-  Real gyration2;                // r_z^2, m^2
-  Real gyrationX2, gyrationY2;   // principal r_x^2, r_y^2, m^2 (docs/model.md 5)
-  Real principalAngle;           // world angle of the principal x axis, rad
+  Real gyration2;               // r_z^2, m^2
+  Real gyrationX2, gyrationY2;  // principal r_x^2, r_y^2, m^2 (docs/model.md 5)
+  Real principalAngle;          // world angle of the principal x axis, rad
   Real area, thickness;
   const Vec2* vertices;
   int vertexCount;
@@ -147,9 +145,7 @@ GEM_HD inline Real inverseEffectiveMass(const PairBody& b, Vec2 n, Vec2 c) {
 }
 
 // Velocity of the material point of b at c: v + omega x (c - centroid).
-GEM_HD inline Vec2 pointVelocity(const PairBody& b, Vec2 c) {
-  return b.velocity + crossZ(b.omega, c - b.position);
-}
+GEM_HD inline Vec2 pointVelocity(const PairBody& b, Vec2 c) { return b.velocity + crossZ(b.omega, c - b.position); }
 
 // Closing speed along n at c, positive when the contact points approach (docs/model.md 4).
 GEM_HD inline Real closingSpeed(const PairBody& a, const PairBody& b, const PairContact& contact) {

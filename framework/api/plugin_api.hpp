@@ -113,23 +113,23 @@ inline void runPluginRegistrations(const PluginRegistration* r, Registry& regist
 
 // Exactly once per plugin, at namespace scope of one source file: the descriptor and the
 // registration entry point. NAME and VERSION are string literals.
-#define GEM_PLUGIN(NAME, VERSION)                                                                             \
-  GEM_PLUGIN_NOTE(GEM_PLUGIN_STRINGIFY(GEM_PLUGIN_ABI_VERSION), GEM_REAL_NAME, GEM_PLUGIN_CUDA_ARCHITECTURES,            \
-                  GEM_COMPILER_ID, GEM_COMPILER_VERSION, GEM_VERSION, NAME, VERSION);                                     \
-  extern "C" {                                                                                                \
-  __attribute__((visibility("hidden"))) ::gem::PluginRegistration* gem_plugin_registrations = nullptr;       \
-  }                                                                                                           \
-  GEM_PLUGIN_EXPORT const GemPluginDescriptor* gem_plugin_descriptor() {                                      \
-    static const GemPluginDescriptor descriptor{GEM_PLUGIN_ABI_VERSION,                                       \
-                                                static_cast<std::uint32_t>(sizeof(::gem::Real)),             \
-                                                GEM_PLUGIN_CUDA_ARCHITECTURES,                                \
-                                                GEM_COMPILER_ID,                                              \
-                                                GEM_COMPILER_VERSION,                                         \
-                                                GEM_VERSION,                                                  \
-                                                NAME,                                                         \
-                                                VERSION};                                                     \
-    return &descriptor;                                                                                       \
-  }                                                                                                           \
-  GEM_PLUGIN_EXPORT void gem_plugin_register(::gem::Registry* registry) {                                     \
-    ::gem::runPluginRegistrations(gem_plugin_registrations, *registry);                                       \
+#define GEM_PLUGIN(NAME, VERSION)                                                                                              \
+  GEM_PLUGIN_NOTE(GEM_PLUGIN_STRINGIFY(GEM_PLUGIN_ABI_VERSION), GEM_REAL_NAME, GEM_PLUGIN_CUDA_ARCHITECTURES, GEM_COMPILER_ID, \
+                  GEM_COMPILER_VERSION, GEM_VERSION, NAME, VERSION);                                                           \
+  extern "C" {                                                                                                                 \
+  __attribute__((visibility("hidden"))) ::gem::PluginRegistration* gem_plugin_registrations = nullptr;                         \
+  }                                                                                                                            \
+  GEM_PLUGIN_EXPORT const GemPluginDescriptor* gem_plugin_descriptor() {                                                       \
+    static const GemPluginDescriptor descriptor{GEM_PLUGIN_ABI_VERSION,                                                        \
+                                                static_cast<std::uint32_t>(sizeof(::gem::Real)),                               \
+                                                GEM_PLUGIN_CUDA_ARCHITECTURES,                                                 \
+                                                GEM_COMPILER_ID,                                                               \
+                                                GEM_COMPILER_VERSION,                                                          \
+                                                GEM_VERSION,                                                                   \
+                                                NAME,                                                                          \
+                                                VERSION};                                                                      \
+    return &descriptor;                                                                                                        \
+  }                                                                                                                            \
+  GEM_PLUGIN_EXPORT void gem_plugin_register(::gem::Registry* registry) {                                                      \
+    ::gem::runPluginRegistrations(gem_plugin_registrations, *registry);                                                        \
   }

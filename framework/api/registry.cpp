@@ -10,10 +10,14 @@ namespace gem {
 
 const char* eventPhaseName(EventPhase phase) {
   switch (phase) {
-    case EventPhase::Pair: return "two-body";
-    case EventPhase::Solo: return "solo";
-    case EventPhase::Motion: return "motion";
-    case EventPhase::Topology: return "topology";
+    case EventPhase::Pair:
+      return "two-body";
+    case EventPhase::Solo:
+      return "solo";
+    case EventPhase::Motion:
+      return "motion";
+    case EventPhase::Topology:
+      return "topology";
   }
   return "unknown";
 }
@@ -62,13 +66,13 @@ template <class Entry>
 void checkClashes(const char* kind, const std::vector<Entry>& staged, const std::map<std::string, Entry>& table, bool allowOverride) {
   std::map<std::string, const Entry*> seen;
   for (const Entry& e : staged) {
-    if (!seen.emplace(e.name, &e).second)
-      throw InputError(fmt::format("plugin {}: registers {} \"{}\" twice", e.origin, kind, e.name));
+    if (!seen.emplace(e.name, &e).second) throw InputError(fmt::format("plugin {}: registers {} \"{}\" twice", e.origin, kind, e.name));
     auto it = table.find(e.name);
     if (it != table.end() && !allowOverride)
-      throw InputError(fmt::format("plugin {}: {} \"{}\" clashes with the one from {} (to replace it, give the plugin's "
-                                   "[[plugins]] entry override = true)",
-                                   e.origin, kind, e.name, it->second.origin));
+      throw InputError(
+          fmt::format("plugin {}: {} \"{}\" clashes with the one from {} (to replace it, give the plugin's "
+                      "[[plugins]] entry override = true)",
+                      e.origin, kind, e.name, it->second.origin));
   }
 }
 

@@ -62,9 +62,9 @@ struct TopologyData {
   const StepRecords* records;  // the step's rows, in the CPU's order
   Real time;
   // Outputs: what the event did, for the summary and the broadphase.
-  double rubbleMass = 0;   // kg removed as rubble this step
+  double rubbleMass = 0;  // kg removed as rubble this step
   int floesBroken = 0;
-  bool changed = false;    // bodies were added or removed
+  bool changed = false;  // bodies were added or removed
 };
 
 class EventInstance {
@@ -100,8 +100,10 @@ struct EventEntry {
 // The order an event declares (static constexpr int kOrder), else event_order::kDefault.
 template <class Event>
 constexpr int eventOrderOf() {
-  if constexpr (requires { Event::kOrder; }) return Event::kOrder;
-  else return event_order::kDefault;
+  if constexpr (requires { Event::kOrder; })
+    return Event::kOrder;
+  else
+    return event_order::kDefault;
 }
 
 struct BroadphaseEntry {
@@ -114,9 +116,9 @@ struct BroadphaseEntry {
 // event that owns the record type (ship_impact: impacts.csv). countKey and statisticKey, when not
 // empty, add to summary.json the number of rows and the statistics of statisticValue over them.
 struct RecordOutputEntry {
-  std::string stream;  // the stream's name
-  std::string file;    // in the run folder
-  std::string header;  // the CSV header line, without its newline
+  std::string stream;                                      // the stream's name
+  std::string file;                                        // in the run folder
+  std::string header;                                      // the CSV header line, without its newline
   void (*writeRow)(const void* record, std::string& row);  // the row, with its newline
   std::string countKey, statisticKey;
   double (*statisticValue)(const void* record);
@@ -170,7 +172,8 @@ template <class Event>
 class CpuPairDriver final : public EventInstance {
  public:
   using Params = typename Event::Params;
-  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  static_assert(std::is_trivially_copyable_v<Params>,
+                "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
   explicit CpuPairDriver(const Params& p) : m_params(p) {}
   void runPairs(const PairPhaseData& d) override {
     for (int k = 0; k < d.count; ++k)
@@ -186,7 +189,8 @@ template <class Event>
 class CpuSoloDriver final : public EventInstance {
  public:
   using Params = typename Event::Params;
-  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  static_assert(std::is_trivially_copyable_v<Params>,
+                "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
   explicit CpuSoloDriver(const Params& p) : m_params(p) {}
   void runSolo(const SoloPhaseData& d) override {
     for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.changes[i], d.ctx);
@@ -201,7 +205,8 @@ template <class Event>
 class CpuMotionDriver final : public EventInstance {
  public:
   using Params = typename Event::Params;
-  static_assert(std::is_trivially_copyable_v<Params>, "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
+  static_assert(std::is_trivially_copyable_v<Params>,
+                "an event's Params must be trivially copyable: it is copied to the GPU as a kernel argument");
   explicit CpuMotionDriver(const Params& p) : m_params(p) {}
   void runMotion(const MotionPhaseData& d) override {
     for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.ctx);
@@ -220,12 +225,16 @@ class TopologyDriver final : public EventInstance {
   explicit TopologyDriver(const Params& p) : m_params(p) {}
   void runTopology(TopologyData& d) override { Event::apply(m_params, d); }
   std::vector<int> streamsRead() const override {
-    if constexpr (requires { Event::streamsRead(m_params); }) return Event::streamsRead(m_params);
-    else return {};
+    if constexpr (requires { Event::streamsRead(m_params); })
+      return Event::streamsRead(m_params);
+    else
+      return {};
   }
   std::vector<std::int64_t> bodiesRead(const StepRecords& records) const override {
-    if constexpr (requires { Event::bodiesRead(m_params, records); }) return Event::bodiesRead(m_params, records);
-    else return {};
+    if constexpr (requires { Event::bodiesRead(m_params, records); })
+      return Event::bodiesRead(m_params, records);
+    else
+      return {};
   }
   const void* params() const override { return &m_params; }
 
@@ -239,7 +248,7 @@ class TopologyDriver final : public EventInstance {
 // one that loads them, so parsing never reaches up to the code that opens libraries.
 struct PluginLibraryLoader {
   void (*load)(const std::filesystem::path& path, bool allowOverride);  // throws InputError
-  void (*loadEnvironment)();                                           // GEM_PLUGIN_PATH, once
+  void (*loadEnvironment)();                                            // GEM_PLUGIN_PATH, once
 };
 void setPluginLibraryLoader(PluginLibraryLoader loader);
 // Both throw InputError when no loader is installed (a program without the plugin loader).
@@ -263,25 +272,26 @@ struct RegisterNow {
 // list, which the loader runs through gem_plugin_register once the descriptor has been accepted
 // (plugin_api.hpp).
 #if defined(GEM_BUILDING_PLUGIN)
-#define GEM_REGISTRATION(KIND, ADD)                                                              \
+#define GEM_REGISTRATION(KIND, ADD)                                                                      \
   static void GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)(::gem::Registry & registry) { ADD; } \
-  static ::gem::PluginRegistrationNode GEM_CONCAT(GEM_CONCAT(gem_registration_, KIND), __LINE__){         \
-      &GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)}
+  static ::gem::PluginRegistrationNode GEM_CONCAT(GEM_CONCAT(gem_registration_, KIND), __LINE__) {       \
+    &GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)                                               \
+  }
 #else
-#define GEM_REGISTRATION(KIND, ADD)                                                              \
+#define GEM_REGISTRATION(KIND, ADD)                                                                      \
   static void GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)(::gem::Registry & registry) { ADD; } \
-  static const ::gem::RegisterNow GEM_CONCAT(GEM_CONCAT(gem_registration_, KIND), __LINE__){              \
-      &GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)}
+  static const ::gem::RegisterNow GEM_CONCAT(GEM_CONCAT(gem_registration_, KIND), __LINE__) {            \
+    &GEM_CONCAT(GEM_CONCAT(gem_register_, KIND), __LINE__)                                               \
+  }
 #endif
 
 // Registers an event: EVENT is the evaluator struct, PARSE a function EventConfig& -> EVENT::Params.
-#define GEM_REGISTER_EVENT(DRIVER, PHASE, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)                        \
-  GEM_REGISTRATION(event_, registry.addEvent(::gem::EventEntry{                                            \
-      NAME, DESCRIPTION, GEM_ORIGIN, PHASE, ENABLED,                                                        \
-      [](::gem::EventConfig& config) -> std::unique_ptr<::gem::EventInstance> {                            \
-        return std::make_unique<DRIVER<EVENT>>(PARSE(config));                                             \
-      },                                                                                                   \
-      ::gem::eventOrderOf<EVENT>()}))
+#define GEM_REGISTER_EVENT(DRIVER, PHASE, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)                                                      \
+  GEM_REGISTRATION(event_, registry.addEvent(::gem::EventEntry{NAME, DESCRIPTION, GEM_ORIGIN, PHASE, ENABLED,                            \
+                                                               [](::gem::EventConfig& config) -> std::unique_ptr<::gem::EventInstance> { \
+                                                                 return std::make_unique<DRIVER<EVENT>>(PARSE(config));                  \
+                                                               },                                                                        \
+                                                               ::gem::eventOrderOf<EVENT>()}))
 #define GEM_REGISTER_PAIR_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
   GEM_REGISTER_EVENT(::gem::CpuPairDriver, ::gem::EventPhase::Pair, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
 #define GEM_REGISTER_SOLO_EVENT(EVENT, NAME, DESCRIPTION, ENABLED, PARSE) \
@@ -292,18 +302,18 @@ struct RegisterNow {
   GEM_REGISTER_EVENT(::gem::TopologyDriver, ::gem::EventPhase::Topology, EVENT, NAME, DESCRIPTION, ENABLED, PARSE)
 
 // Registers the writer of a record stream to a file of the run folder (RecordOutputEntry).
-#define GEM_REGISTER_RECORD_OUTPUT(STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, STATISTIC_KEY, STATISTIC_VALUE) \
-  GEM_REGISTRATION(record_output_, registry.addRecordOutput(::gem::RecordOutputEntry{                       \
-      STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, STATISTIC_KEY, STATISTIC_VALUE}))
+#define GEM_REGISTER_RECORD_OUTPUT(STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, STATISTIC_KEY, STATISTIC_VALUE)                   \
+  GEM_REGISTRATION(record_output_, registry.addRecordOutput(::gem::RecordOutputEntry{STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, \
+                                                                                     STATISTIC_KEY, STATISTIC_VALUE}))
 
 // Registers a broadphase class constructible from BroadphaseSettings; its kSettings, if any, name
 // the settings it reads.
-#define GEM_REGISTER_BROADPHASE(CLASS, NAME, DESCRIPTION)                                                  \
-  GEM_REGISTRATION(broadphase_, registry.addBroadphase(::gem::BroadphaseEntry{                             \
-      NAME, DESCRIPTION, GEM_ORIGIN,                                                                       \
-      [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::Broadphase> {                      \
-        return std::make_unique<CLASS>(s);                                                                 \
-      },                                                                                                   \
-      ::gem::declaredBroadphaseSettings<CLASS>()}))
+#define GEM_REGISTER_BROADPHASE(CLASS, NAME, DESCRIPTION)                                                                      \
+  GEM_REGISTRATION(                                                                                                            \
+      broadphase_,                                                                                                             \
+      registry.addBroadphase(::gem::BroadphaseEntry{                                                                           \
+          NAME, DESCRIPTION, GEM_ORIGIN,                                                                                       \
+          [](const ::gem::BroadphaseSettings& s) -> std::unique_ptr<::gem::Broadphase> { return std::make_unique<CLASS>(s); }, \
+          ::gem::declaredBroadphaseSettings<CLASS>()}))
 
 }  // namespace gem

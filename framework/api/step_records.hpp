@@ -46,7 +46,9 @@ class StepRecords {
   void reset(const RecordStreams& streams);
   const RecordStreams& streams() const { return *m_streams; }
   int rowCount(int stream) const {
-    return stream < 0 || stream >= static_cast<int>(m_rows.size()) ? 0 : static_cast<int>(m_rows[static_cast<size_t>(stream)].size()) / strideOf(stream);
+    return stream < 0 || stream >= static_cast<int>(m_rows.size())
+               ? 0
+               : static_cast<int>(m_rows[static_cast<size_t>(stream)].size()) / strideOf(stream);
   }
   const RecordTag& tag(int stream, int row) const { return *reinterpret_cast<const RecordTag*>(rowBytes(stream, row)); }
   const void* record(int stream, int row) const { return rowBytes(stream, row) + sizeof(RecordTag); }

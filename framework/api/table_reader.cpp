@@ -37,9 +37,12 @@ void TableReader::failAt(const toml::node& n, const std::string& message) const 
 
 Real TableReader::toReal(const toml::node& n, const std::string& key) const {
   double v;
-  if (auto f = n.value_exact<double>()) v = *f;
-  else if (auto i = n.value_exact<std::int64_t>()) v = static_cast<double>(*i);
-  else failAt(n, fmt::format("{}: expected a number, got {}", keyPath(key), toml::impl::node_type_friendly_names[static_cast<int>(n.type())]));
+  if (auto f = n.value_exact<double>())
+    v = *f;
+  else if (auto i = n.value_exact<std::int64_t>())
+    v = static_cast<double>(*i);
+  else
+    failAt(n, fmt::format("{}: expected a number, got {}", keyPath(key), toml::impl::node_type_friendly_names[static_cast<int>(n.type())]));
   if (!std::isfinite(v)) failAt(n, fmt::format("{}: expected a finite number, got {}", keyPath(key), v));
   return static_cast<Real>(v);
 }
@@ -89,8 +92,7 @@ std::string TableReader::getString(const std::string& key, const std::string& fa
   return *s;
 }
 
-std::string TableReader::getChoice(const std::string& key, const std::string& fallback,
-                                   const std::vector<std::string>& choices) {
+std::string TableReader::getChoice(const std::string& key, const std::string& fallback, const std::vector<std::string>& choices) {
   std::string v = getString(key, fallback);
   for (const auto& c : choices)
     if (c == v) return v;

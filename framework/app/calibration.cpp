@@ -13,7 +13,7 @@ namespace gem {
 
 namespace {
 
-constexpr Real kFloeSide = 10;  // m
+constexpr Real kFloeSide = 10;      // m
 constexpr Real kGap = Real(0.005);  // m between the floe and the hull at placement
 
 struct EdgeFrame {
@@ -40,16 +40,15 @@ std::vector<int> bowEdges(const HullGeometry& hull) {
 
 // docs/model.md 5 written out directly for a vessel with heading 0 and a square floe (isotropic in
 // plane, so its principal frame does not matter): the thesis's spreadsheet.
-void directEvaluation(const Scenario& base, const EdgeFrame& edge, const CalibrationCase& c, Real apexDeg,
-                      CalibrationResult& out) {
+void directEvaluation(const Scenario& base, const EdgeFrame& edge, const CalibrationCase& c, Real apexDeg, CalibrationResult& out) {
   const VesselSpec& v = base.vessel;
   const Real beta = edge.frameAngleDeg * kPi / 180, phi = apexDeg * kPi / 180;
   const Real nx = edge.normal.x * std::cos(beta), ny = edge.normal.y * std::cos(beta), nz = std::sin(beta);
   // Vessel: the contact point is the edge's midpoint, in the ship's (principal) frame.
   const Real xs = edge.midpoint.x, ys = edge.midpoint.y, L = v.length;
   const Real lambdaS = nz * ys, muS = -nz * xs, etaS = ny * xs - nx * ys;
-  const Real coS = nx * nx + ny * ny / 1.5 + nz * nz / 2 + lambdaS * lambdaS / (1.25 * 0.003 * L * L) +
-                   muS * muS / (2 * 0.05 * L * L) + etaS * etaS / (1.6 * 0.06 * L * L);
+  const Real coS = nx * nx + ny * ny / 1.5 + nz * nz / 2 + lambdaS * lambdaS / (1.25 * 0.003 * L * L) + muS * muS / (2 * 0.05 * L * L) +
+                   etaS * etaS / (1.6 * 0.06 * L * L);
   // Floe: the contact point lies on the floe's axis through its centroid along the normal.
   const Real reach = c.corner ? kFloeSide / std::sqrt(Real(2)) : kFloeSide / 2;
   const Real xf = -edge.normal.x * reach, yf = -edge.normal.y * reach;
@@ -76,8 +75,8 @@ std::vector<CalibrationCase> calibrationCases(const Scenario& base) {
     for (bool corner : {true, false})
       for (Real speed : {Real(2), Real(5)})
         for (Real thickness : {Real(0.7), Real(1.2)})
-          cases.push_back({fmt::format("edge{}_{}_{}ms_{}m", edge, corner ? "corner" : "face", speed, thickness), edge,
-                           corner, speed, thickness});
+          cases.push_back(
+              {fmt::format("edge{}_{}_{}ms_{}m", edge, corner ? "corner" : "face", speed, thickness), edge, corner, speed, thickness});
   return cases;
 }
 
@@ -128,21 +127,22 @@ CalibrationResult runCalibrationCase(const Scenario& base, const CalibrationCase
 
 double runCalibration(const std::string& scenarioFile, const std::string& outDir, bool quiet) {
   const Scenario base = loadScenario(scenarioFile);
-  std::string csv = "case,edge,orientation,speed_mps,thickness_m,frame_angle_deg,apex_deg,fn_logged_n,fn_direct_n,relative_difference,flim_logged_n,flim_direct_n,broke\n";
+  std::string csv =
+      "case,edge,orientation,speed_mps,thickness_m,frame_angle_deg,apex_deg,fn_logged_n,fn_direct_n,relative_difference,flim_logged_n,flim_"
+      "direct_n,broke\n";
   double worst = 0;
-  if (!quiet)
-    std::printf("%-28s %6s %6s %14s %14s %9s\n", "case", "beta", "phi", "logged F [kN]", "direct F [kN]", "diff");
+  if (!quiet) std::printf("%-28s %6s %6s %14s %14s %9s\n", "case", "beta", "phi", "logged F [kN]", "direct F [kN]", "diff");
   for (const CalibrationCase& c : calibrationCases(base)) {
     const CalibrationResult r = runCalibrationCase(base, c);
     const double diff = r.logged ? (r.record.force - r.directForce) / r.directForce : 1.0;
     worst = std::max(worst, std::fabs(diff));
     if (!quiet)
       std::printf("%-28s %6.1f %6.1f %14.2f %14.2f %8.2f%%%s\n", c.name.c_str(), static_cast<double>(r.frameAngleDeg),
-                  static_cast<double>(r.logged ? r.record.apexDeg : 0), r.record.force / 1e3, r.directForce / 1e3,
-                  100 * diff, r.logged ? "" : "  (no impact logged)");
+                  static_cast<double>(r.logged ? r.record.apexDeg : 0), r.record.force / 1e3, r.directForce / 1e3, 100 * diff,
+                  r.logged ? "" : "  (no impact logged)");
     csv += fmt::format("{},{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", c.name, c.edge, c.corner ? "corner" : "face",
-                       c.speed, c.thickness, r.frameAngleDeg, r.logged ? r.record.apexDeg : Real(NAN), r.record.force,
-                       r.directForce, diff, r.record.forceLimit, r.directLimit, r.record.broke ? 1 : 0);
+                       c.speed, c.thickness, r.frameAngleDeg, r.logged ? r.record.apexDeg : Real(NAN), r.record.force, r.directForce, diff,
+                       r.record.forceLimit, r.directLimit, r.record.broke ? 1 : 0);
   }
   std::filesystem::create_directories(outDir);
   writeFileAtomically(std::filesystem::path(outDir) / "calibration.csv", csv);

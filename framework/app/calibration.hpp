@@ -24,10 +24,10 @@ struct CalibrationCase {
 
 struct CalibrationResult {
   CalibrationCase input;
-  bool logged = false;     // an impact was logged
-  ImpactRecord record{};   // what GEM logged
-  Real directForce = 0;    // min(F_n, F_lim) evaluated directly, N
-  Real directLimit = 0;    // F_lim evaluated directly, N
+  bool logged = false;    // an impact was logged
+  ImpactRecord record{};  // what GEM logged
+  Real directForce = 0;   // min(F_n, F_lim) evaluated directly, N
+  Real directLimit = 0;   // F_lim evaluated directly, N
   Real apexDeg = 0, frameAngleDeg = 0;
 };
 

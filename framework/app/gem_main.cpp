@@ -60,12 +60,12 @@ int commandRun(const RunArguments& a) {
   options.quiet = a.quiet;
   options.progress = isatty(fileno(stderr));
   if (!a.quiet)
-    std::printf("gem run %s: %ld steps of %.3g s, backend %s, broadphase %s\n", a.scenario.c_str(), s.steps,
-                static_cast<double>(s.dt), resolveBackend(s.backend).c_str(), s.broadphase.c_str());
+    std::printf("gem run %s: %ld steps of %.3g s, backend %s, broadphase %s\n", a.scenario.c_str(), s.steps, static_cast<double>(s.dt),
+                resolveBackend(s.backend).c_str(), s.broadphase.c_str());
   const RunSummary r = runScenario(s, options);
   if (!a.quiet) {
-    std::printf("  floes          %d at start, %d at end (%ld broken, %.4g kg rubble)\n", r.floesInitial, r.floesFinal,
-                r.floesBroken, r.rubbleMass);
+    std::printf("  floes          %d at start, %d at end (%ld broken, %.4g kg rubble)\n", r.floesInitial, r.floesFinal, r.floesBroken,
+                r.rubbleMass);
     // The record streams' totals, under the names their events give them (ship_impact: impacts).
     for (const RecordTotals& t : r.records) {
       if (t.countKey.empty()) continue;
@@ -75,8 +75,8 @@ int commandRun(const RunArguments& a) {
       std::printf("\n");
     }
     if (r.shipSpeed.count)
-      std::printf("  ship speed     mean %.3f m/s (min %.3f, max %.3f); mean net thrust %.1f kN\n", r.shipSpeed.mean,
-                  r.shipSpeed.min, r.shipSpeed.max, r.netThrust.mean / 1e3);
+      std::printf("  ship speed     mean %.3f m/s (min %.3f, max %.3f); mean net thrust %.1f kN\n", r.shipSpeed.mean, r.shipSpeed.min,
+                  r.shipSpeed.max, r.netThrust.mean / 1e3);
     std::printf("  wall time      %.3f s for %.1f s simulated: %.0fx real time (%.0f steps/s)\n", r.wallTime, r.simTime,
                 r.simTime / std::max(r.wallTime, 1e-9), r.steps / std::max(r.wallTime, 1e-9));
     std::printf("  outputs        %s/ (summary.json, timeseries.csv, impacts.csv, state.csv, frames.pvd, frames.ice)\n",
@@ -90,9 +90,9 @@ int commandCheck(const RunArguments& a) {
   resolveBackend(s.backend);
   CpuStepper sim(s);  // builds the field, checks every body and overlap, parses every event
   if (!a.quiet)
-    std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(),
-              sim.world().size(), sim.world().count(BodyKind::Floe), s.vessel.present ? ", a vessel" : "", s.steps,
-              s.broadphase.c_str(), sim.events().size());
+    std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(), sim.world().size(),
+                sim.world().count(BodyKind::Floe), s.vessel.present ? ", a vessel" : "", s.steps, s.broadphase.c_str(),
+                sim.events().size());
   return 0;
 }
 
@@ -157,8 +157,8 @@ int main(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "version, build, devices, registered events and broadphases");
   info->add_option("--plugin", infoPlugins, "load this plugin first (repeatable); GEM_PLUGIN_PATH's are loaded too");
   BenchOptions bench;
-  CLI::App* benchCommand = app.add_subcommand(
-      "bench", "the thesis's Chapter 5 timings as tables, printed and as CSV, each row with its device (--table)");
+  CLI::App* benchCommand =
+      app.add_subcommand("bench", "the thesis's Chapter 5 timings as tables, printed and as CSV, each row with its device (--table)");
   benchCommand->add_option("--table", bench.table,
                            "step: time per step of --cases on --backend (default);\n"
                            "fields: 456 and 824 floes, cpu and cuda, every built-in broadphase;\n"
@@ -199,8 +199,9 @@ int main(int argc, char** argv) {
   sweepCommand->add_option("--out", sweep.outDir, "sweep folder (default runs/NAME)");
   sweepCommand->add_option("--jobs", sweep.jobs, "cases run at once (default: all cores)");
   sweepCommand->add_option("--case-index", sweep.caseIndex, "run only case I (0-based), e.g. in a job array");
-  sweepCommand->add_option("--batch", sweep.batch,
-                           "on a GPU, the most cases run together in one device state (default 0: automatic; 1: one case at a time)")
+  sweepCommand
+      ->add_option("--batch", sweep.batch,
+                   "on a GPU, the most cases run together in one device state (default 0: automatic; 1: one case at a time)")
       ->check(CLI::NonNegativeNumber);
   sweepCommand->add_flag("--quiet", sweep.quiet, "no progress");
 

@@ -9,9 +9,7 @@
 
 namespace gem {
 
-bool launchedByMpi() {
-  return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK");
-}
+bool launchedByMpi() { return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK"); }
 
 bool mpiBuilt() {
 #if defined(GEM_HAVE_MPI)
@@ -42,8 +40,7 @@ MpiWork::MpiWork() {
   MPI_Comm_size(node, &m_localSize);
   MPI_Comm_free(&node);
   m_state = new State;
-  MPI_Win_allocate(m_rank == 0 ? sizeof(long) : 0, sizeof(long), MPI_INFO_NULL, MPI_COMM_WORLD, &m_state->counter,
-                   &m_state->window);
+  MPI_Win_allocate(m_rank == 0 ? sizeof(long) : 0, sizeof(long), MPI_INFO_NULL, MPI_COMM_WORLD, &m_state->counter, &m_state->window);
   if (m_rank == 0) *m_state->counter = 0;
   MPI_Barrier(MPI_COMM_WORLD);
 }

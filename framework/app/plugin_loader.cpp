@@ -65,8 +65,8 @@ GemPluginDescriptor descriptorOf(const PluginNote& note) {
   };
   const std::string real = field("real");
   const std::uint32_t realSize = real == "double" ? 8u : real == "float" ? 4u : 0u;
-  return GemPluginDescriptor{number(field("abi")), realSize, field("cuda"), field("compiler"), field("compiler_version"),
-                             field("gem"), field("name"), field("version")};
+  return GemPluginDescriptor{number(field("abi")),      realSize,     field("cuda"), field("compiler"),
+                             field("compiler_version"), field("gem"), field("name"), field("version")};
 }
 
 const LoadedPlugin& loadLocked(LoaderState& st, const fs::path& given, bool allowOverride) {
@@ -83,9 +83,10 @@ const LoadedPlugin& loadLocked(LoaderState& st, const fs::path& given, bool allo
   const PluginNote note = readPluginNote(path);
   if (note.status == PluginNote::Status::NotElf) throw InputError(fmt::format("plugin {}: cannot be loaded: {}", file, note.problem));
   if (note.status == PluginNote::Status::NoNote)
-    throw InputError(fmt::format("plugin {}: not a GEM plugin (it has no .gem_plugin descriptor note; one source file of a plugin says "
-                                 "GEM_PLUGIN(\"name\", \"version\"), and a plugin built for GEM 0.1 must be rebuilt)",
-                                 file));
+    throw InputError(
+        fmt::format("plugin {}: not a GEM plugin (it has no .gem_plugin descriptor note; one source file of a plugin says "
+                    "GEM_PLUGIN(\"name\", \"version\"), and a plugin built for GEM 0.1 must be rebuilt)",
+                    file));
   const std::vector<std::string> noteMismatches = descriptorMismatches(descriptorOf(note));
   if (!noteMismatches.empty())
     throw InputError(fmt::format("plugin {}: refused, it was built for another GEM: {}", file, fmt::join(noteMismatches, "; ")));
@@ -100,18 +101,20 @@ const LoadedPlugin& loadLocked(LoaderState& st, const fs::path& given, bool allo
   st.libraries.push_back(library);
 
   if (!library.has("gem_plugin_descriptor"))
-    throw InputError(fmt::format("plugin {}: not a GEM plugin (it exports no gem_plugin_descriptor; "
-                                 "one source file of a plugin says GEM_PLUGIN(\"name\", \"version\"))",
-                                 file));
+    throw InputError(
+        fmt::format("plugin {}: not a GEM plugin (it exports no gem_plugin_descriptor; "
+                    "one source file of a plugin says GEM_PLUGIN(\"name\", \"version\"))",
+                    file));
   const GemPluginDescriptor* d = library.get<const GemPluginDescriptor*()>("gem_plugin_descriptor")();
   if (!d) throw InputError(fmt::format("plugin {}: gem_plugin_descriptor returned nothing", file));
   const std::vector<std::string> mismatches = descriptorMismatches(*d);
   if (!mismatches.empty())
     throw InputError(fmt::format("plugin {}: refused, it was built for another GEM: {}", file, fmt::join(mismatches, "; ")));
   if (!library.has("gem_plugin_register"))
-    throw InputError(fmt::format("plugin {}: missing symbol gem_plugin_register (the descriptor is there, the "
-                                 "registration entry point is not)",
-                                 file));
+    throw InputError(
+        fmt::format("plugin {}: missing symbol gem_plugin_register (the descriptor is there, the "
+                    "registration entry point is not)",
+                    file));
   auto registerAll = library.get<void(Registry*)>("gem_plugin_register");
 
   LoadedPlugin plugin{path, text(d->name), text(d->version), ""};
@@ -143,15 +146,15 @@ std::vector<std::string> descriptorMismatches(const GemPluginDescriptor& d) {
   }
   if (d.realSize != sizeof(Real)) {
     auto realName = [](unsigned size) { return size == 8 ? "double" : size == 4 ? "float" : "unknown"; };
-    out.push_back(fmt::format("real type {} ({} bytes; this GEM: {}, {} bytes)", realName(d.realSize), d.realSize,
-                              realName(sizeof(Real)), sizeof(Real)));
+    out.push_back(fmt::format("real type {} ({} bytes; this GEM: {}, {} bytes)", realName(d.realSize), d.realSize, realName(sizeof(Real)),
+                              sizeof(Real)));
   }
   // Same compiler family and major version: the C++ ABI of std::string, std::function and the
   // vtables the plugin shares with GEM.
   const std::string id = text(d.compilerId), version = text(d.compilerVersion);
   if (id != GEM_COMPILER_ID || majorOf(version) != majorOf(GEM_COMPILER_VERSION))
-    out.push_back(fmt::format("compiler {} {} (this GEM: {} {}; the family and major version must match)", id, version,
-                              GEM_COMPILER_ID, GEM_COMPILER_VERSION));
+    out.push_back(fmt::format("compiler {} {} (this GEM: {} {}; the family and major version must match)", id, version, GEM_COMPILER_ID,
+                              GEM_COMPILER_VERSION));
   // Device code must be built for the architectures GEM runs its kernels on.
   const std::string archs = text(d.cudaArchitectures), hostArchs = hostCudaArchitectures();
   if (!archs.empty() && !hostArchs.empty() && archs != hostArchs)

@@ -56,8 +56,8 @@ void writeStateCsv(const std::filesystem::path& file, const World& w) {
     std::string vertices;
     for (int k = 0; k < n; ++k) vertices += fmt::format("{}{:.9g} {:.9g}", k ? " " : "", v[k].x, v[k].y);
     out.stream() << fmt::format("{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},\"{}\"\n", w.id[i],
-                                bodyKindName(w.kind[i]), w.x[i], w.y[i], w.angle[i], w.vx[i], w.vy[i], w.omega[i],
-                                w.area[i], w.thickness[i], w.mass[i], vertices);
+                                bodyKindName(w.kind[i]), w.x[i], w.y[i], w.angle[i], w.vx[i], w.vy[i], w.omega[i], w.area[i],
+                                w.thickness[i], w.mass[i], vertices);
   }
   out.commit();
 }
@@ -83,11 +83,10 @@ std::string summaryJson(const RunSummary& s) {
       "  \"ice_mass_initial_kg\": {},\n  \"ice_mass_final_kg\": {},\n  \"rubble_mass_kg\": {},\n"
       "  \"cases_on_device\": {},\n{}  \"ship_speed\": {},\n  \"net_thrust_n\": {},\n"
       "  \"resistance_mean_n\": {},\n  \"ship_speed_in_ice\": {},\n  \"resistance_in_ice_n\": {}\n}}\n",
-      GEM_VERSION, s.steps, jsonNumber(s.simTime), jsonNumber(s.wallTime),
-      jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY), s.backend, s.broadphase, s.device,
-      s.floesInitial, s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial), jsonNumber(s.iceMassFinal),
-      jsonNumber(s.rubbleMass), s.casesOnDevice, recordTotalsJson(s), jsonStats(s.shipSpeed), jsonStats(s.netThrust),
-      s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null", jsonStats(s.shipSpeedInIce),
+      GEM_VERSION, s.steps, jsonNumber(s.simTime), jsonNumber(s.wallTime), jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY),
+      s.backend, s.broadphase, s.device, s.floesInitial, s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial),
+      jsonNumber(s.iceMassFinal), jsonNumber(s.rubbleMass), s.casesOnDevice, recordTotalsJson(s), jsonStats(s.shipSpeed),
+      jsonStats(s.netThrust), s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null", jsonStats(s.shipSpeedInIce),
       s.netThrustInIce.count ? jsonNumber(s.netThrustInIce.mean) : "null");
 }
 
@@ -143,8 +142,10 @@ class ScenarioRun {
         const void* record = records.record(f.stream, r);
         f.output->writeRow(record, row);
         f.file->stream() << row;
-        if (f.output->statisticValue) f.statistic.add(f.output->statisticValue(record));
-        else ++f.statistic.count;
+        if (f.output->statisticValue)
+          f.statistic.add(f.output->statisticValue(record));
+        else
+          ++f.statistic.count;
       }
     }
     const VesselSample vessel = sim.vessel();
@@ -250,9 +251,8 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
           lastProgress = now;
           const double wall = std::chrono::duration<double>(now - start).count();
           const double rate = (k + 1) / std::max(wall, 1e-9);
-          std::fprintf(stderr, "\r  step %ld/%ld  t = %.1f s  %.0f steps/s  %.0fx real time  ETA %s   ", k + 1,
-                       scenario.steps, static_cast<double>(sim.time()), rate, rate * scenario.dt,
-                       formatDuration((scenario.steps - k - 1) / rate).c_str());
+          std::fprintf(stderr, "\r  step %ld/%ld  t = %.1f s  %.0f steps/s  %.0fx real time  ETA %s   ", k + 1, scenario.steps,
+                       static_cast<double>(sim.time()), rate, rate * scenario.dt, formatDuration((scenario.steps - k - 1) / rate).c_str());
           std::fflush(stderr);
         }
       }
@@ -265,8 +265,7 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   return run.finish(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }
 
-std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>& scenarios,
-                                              std::vector<std::unique_ptr<Stepper>> steppers,
+std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>& scenarios, std::vector<std::unique_ptr<Stepper>> steppers,
                                               const std::function<void(long step, long steps)>& progress) {
   if (scenarios.size() != steppers.size() || scenarios.empty())
     throw std::invalid_argument("runScenariosTogether: one stepper per scenario, one scenario at least");

@@ -53,8 +53,7 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options);
 // number of steps. Returns, per scenario, "" when it completed, else why it failed; a failure of
 // the shared stepping fails every case still running, and each keeps what it wrote.
 // progress(step, steps), when given, is called after each step.
-std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>& scenarios,
-                                              std::vector<std::unique_ptr<Stepper>> steppers,
+std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>& scenarios, std::vector<std::unique_ptr<Stepper>> steppers,
                                               const std::function<void(long step, long steps)>& progress = {});
 
 std::string summaryJson(const RunSummary& s);

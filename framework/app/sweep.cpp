@@ -135,7 +135,8 @@ std::vector<std::vector<size_t>> workUnits(const std::vector<Scenario>& scenario
     size_t parts = (cases.size() + most - 1) / most;
     if (batch <= 0) {
       const BackendEntry* backend = findBackend(id.first);
-      const size_t spread = ranks > 0 ? static_cast<size_t>(ranks) : static_cast<size_t>(backend->deviceCount ? std::max(1, backend->deviceCount()) : 1);
+      const size_t spread =
+          ranks > 0 ? static_cast<size_t>(ranks) : static_cast<size_t>(backend->deviceCount ? std::max(1, backend->deviceCount()) : 1);
       parts = std::max(parts, std::min(cases.size(), spread));
     }
     // Consecutive cases, the parts as equal as can be.
@@ -155,7 +156,7 @@ struct SweepState {
   std::atomic<size_t> next{0};
   size_t finished = 0, running = 0;
   std::vector<std::pair<std::string, std::string>> failures;  // case name, message
-  std::map<size_t, double> together;  // unit -> cases' worth done, for units of cases run together
+  std::map<size_t, double> together;                          // unit -> cases' worth done, for units of cases run together
 };
 
 }  // namespace
@@ -163,8 +164,8 @@ struct SweepState {
 int runSweep(const SweepOptions& options) {
   MpiWork mpi;  // under mpirun: this rank's share of the world; finalised when the sweep returns
   const SweepDefinition sweep = readSweepFile(options.sweepFile);
-  const fs::path outDir = options.outDir.empty() ? sweep.file.parent_path() / "runs" / sweep.name
-                                                 : fs::absolute(options.outDir).lexically_normal();
+  const fs::path outDir =
+      options.outDir.empty() ? sweep.file.parent_path() / "runs" / sweep.name : fs::absolute(options.outDir).lexically_normal();
   const size_t count = sweep.cases.size();
   if (options.caseIndex < -1 || options.caseIndex >= static_cast<long>(count))
     throw InputError(fmt::format("--case-index {}: {} has {} cases (0 to {})", options.caseIndex, sweep.fileName, count, count - 1));
@@ -180,7 +181,8 @@ int runSweep(const SweepOptions& options) {
   }
 
   std::vector<size_t> selected;
-  if (options.caseIndex >= 0) selected.push_back(static_cast<size_t>(options.caseIndex));
+  if (options.caseIndex >= 0)
+    selected.push_back(static_cast<size_t>(options.caseIndex));
   else
     for (size_t i = 0; i < count; ++i) selected.push_back(i);
   if (options.caseIndex >= 0) std::printf("%s\n", sweep.cases[selected[0]].name.c_str());
@@ -212,10 +214,13 @@ int runSweep(const SweepOptions& options) {
   if (!options.quiet && mpi.rank() == 0) {
     std::printf("gem sweep %s: %zu case%s", sweep.name.c_str(), count, count == 1 ? "" : "s");
     if (options.caseIndex >= 0) std::printf(", running case %ld only", options.caseIndex);
-    if (mpi.active()) std::printf("; %zu to run on %d MPI ranks x %zu thread%s", todo.size(), mpi.size(), jobs, jobs == 1 ? "" : "s");
-    else std::printf("; %zu to run on %zu thread%s", todo.size(), jobs, jobs == 1 ? "" : "s");
-    if (together) std::printf(" (%zu of them in %zu device run%s of several cases)", together, units.size() - (todo.size() - together),
-                              units.size() - (todo.size() - together) == 1 ? "" : "s");
+    if (mpi.active())
+      std::printf("; %zu to run on %d MPI ranks x %zu thread%s", todo.size(), mpi.size(), jobs, jobs == 1 ? "" : "s");
+    else
+      std::printf("; %zu to run on %zu thread%s", todo.size(), jobs, jobs == 1 ? "" : "s");
+    if (together)
+      std::printf(" (%zu of them in %zu device run%s of several cases)", together, units.size() - (todo.size() - together),
+                  units.size() - (todo.size() - together) == 1 ? "" : "s");
     if (skipped) std::printf(", %zu already complete", skipped);
     if (stale) std::printf(", %zu complete but changed since (run again)", stale);
     std::printf("\n  folder %s\n", outDir.string().c_str());
@@ -245,8 +250,10 @@ int runSweep(const SweepOptions& options) {
     if (!options.quiet && !terminal) {
       const std::string who = mpi.active() ? fmt::format("rank {} ", mpi.rank()) : std::string();
       const std::string how = with > 1 ? fmt::format(" (with {} cases in one device state)", with) : std::string();
-      if (failure.empty()) std::printf("  %s[%zu/%zu] %s  %.1f s%s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), seconds, how.c_str());
-      else std::printf("  %s[%zu/%zu] %s  FAILED: %s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), failure.c_str());
+      if (failure.empty())
+        std::printf("  %s[%zu/%zu] %s  %.1f s%s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), seconds, how.c_str());
+      else
+        std::printf("  %s[%zu/%zu] %s  FAILED: %s\n", who.c_str(), state.finished, todo.size(), c.name.c_str(), failure.c_str());
       std::fflush(stdout);
     }
     state.changed.notify_all();
@@ -332,9 +339,9 @@ int runSweep(const SweepOptions& options) {
       double done = static_cast<double>(state.finished);
       for (const auto& [unit, worth] : state.together) done += worth;
       const double eta = done > 0 ? elapsed / done * (static_cast<double>(todo.size()) - done) : NAN;
-      std::fprintf(stderr, "\r  cases %zu/%zu done, %zu running%s, elapsed %s, ETA %s   ", state.finished, todo.size(),
-                   state.running, state.failures.empty() ? "" : fmt::format(", {} failed", state.failures.size()).c_str(),
-                   formatDuration(elapsed).c_str(), formatDuration(eta).c_str());
+      std::fprintf(stderr, "\r  cases %zu/%zu done, %zu running%s, elapsed %s, ETA %s   ", state.finished, todo.size(), state.running,
+                   state.failures.empty() ? "" : fmt::format(", {} failed", state.failures.size()).c_str(), formatDuration(elapsed).c_str(),
+                   formatDuration(eta).c_str());
       std::fflush(stderr);
       state.changed.wait_for(lock, std::chrono::milliseconds(500));
     }
@@ -345,8 +352,7 @@ int runSweep(const SweepOptions& options) {
 
   // Under MPI every rank waits for all; rank 0 alone gathers the table.
   const long failures = mpi.sumOverRanks(static_cast<long>(state.failures.size()));
-  for (const auto& [name, message] : state.failures)
-    std::fprintf(stderr, "gem sweep: case %s failed: %s\n", name.c_str(), message.c_str());
+  for (const auto& [name, message] : state.failures) std::fprintf(stderr, "gem sweep: case %s failed: %s\n", name.c_str(), message.c_str());
   if (mpi.rank() != 0) return failures == 0 ? 0 : 1;
   const fs::path csv = outDir / "summary.csv";
   const int rows = writeSweepSummary(sweep, csv, dirs);

@@ -74,10 +74,10 @@ namespace gem {
 
 struct SweepOptions {
   std::string sweepFile;
-  std::string outDir;      // default: beside the sweep file, "runs/<sweep name>"
-  int jobs = 0;            // parallel cases; 0 = the number of cores
-  long caseIndex = -1;     // run only this case (job arrays); -1 = all
-  int batch = 0;           // on a GPU, the most cases run together in one device state; 0 = automatic, 1 = none
+  std::string outDir;   // default: beside the sweep file, "runs/<sweep name>"
+  int jobs = 0;         // parallel cases; 0 = the number of cores
+  long caseIndex = -1;  // run only this case (job arrays); -1 = all
+  int batch = 0;        // on a GPU, the most cases run together in one device state; 0 = automatic, 1 = none
   bool quiet = false;
 };
 

@@ -59,7 +59,7 @@ __global__ void partnerRowsKernel(GridView g, int* count, const int* offset, int
     if (!Write && lane == 0) count[i] = 0;  // the scan's last element gives the total
     return;
   }
-  if (g.isLarge[i]) return;  // largeRow*Kernel
+  if (g.isLarge[i]) return;                         // largeRow*Kernel
   if (Write && offset[i + 1] > g.capacity) return;  // overflow: the step is redone with more room
   const int begin = Write ? offset[i] : 0;
   int end = begin;
@@ -126,14 +126,27 @@ static int rowLanes(int n) {
 }
 
 template <bool Write>
-static void launchRows(int lanes, int blocks, int block, cudaStream_t s, const GridView& g, int* count, const int* offset, int* candA, int* candB) {
+static void launchRows(int lanes, int blocks, int block, cudaStream_t s, const GridView& g, int* count, const int* offset, int* candA,
+                       int* candB) {
   switch (lanes) {
-    case 1: partnerRowsKernel<Write, 1><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
-    case 2: partnerRowsKernel<Write, 2><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
-    case 4: partnerRowsKernel<Write, 4><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
-    case 8: partnerRowsKernel<Write, 8><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
-    case 16: partnerRowsKernel<Write, 16><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
-    default: partnerRowsKernel<Write, 32><<<blocks, block, 0, s>>>(g, count, offset, candA, candB); break;
+    case 1:
+      partnerRowsKernel<Write, 1><<<blocks, block, 0, s>>>(g, count, offset, candA, candB);
+      break;
+    case 2:
+      partnerRowsKernel<Write, 2><<<blocks, block, 0, s>>>(g, count, offset, candA, candB);
+      break;
+    case 4:
+      partnerRowsKernel<Write, 4><<<blocks, block, 0, s>>>(g, count, offset, candA, candB);
+      break;
+    case 8:
+      partnerRowsKernel<Write, 8><<<blocks, block, 0, s>>>(g, count, offset, candA, candB);
+      break;
+    case 16:
+      partnerRowsKernel<Write, 16><<<blocks, block, 0, s>>>(g, count, offset, candA, candB);
+      break;
+    default:
+      partnerRowsKernel<Write, 32><<<blocks, block, 0, s>>>(g, count, offset, candA, candB);
+      break;
   }
   GEM_CUDA_CHECK_LAUNCH();
 }
@@ -214,8 +227,16 @@ const int* enqueueBroadphase(DeviceState& d, CubCalls& cubCalls, unsigned largeK
   if (d.broadphase) {
     int* count = d.candCount.get();
     GEM_CUDA_CHECK(cudaMemsetAsync(count, 0, sizeof(int), s));
-    const BroadphaseBodies bodies{n, d.x.get(), d.y.get(), d.angle.get(), d.radius.get(), d.boxes.get(), d.invMass.get(),
-                                  d.kind.get(), d.worldVertices.get(), d.vertexCount.get()};
+    const BroadphaseBodies bodies{n,
+                                  d.x.get(),
+                                  d.y.get(),
+                                  d.angle.get(),
+                                  d.radius.get(),
+                                  d.boxes.get(),
+                                  d.invMass.get(),
+                                  d.kind.get(),
+                                  d.worldVertices.get(),
+                                  d.vertexCount.get()};
     d.broadphase->enqueue(bodies, CandidateSink{d.candKey.get(), capacity, count, d.slotBits}, s);
     padCandidateKeysKernel<<<blocksFor(capacity), kBlock, 0, s>>>(capacity, count, d.candKey.get(), (1ull << (2 * d.slotBits)) - 1);
     GEM_CUDA_CHECK_LAUNCH();
@@ -231,8 +252,9 @@ const int* enqueueBroadphase(DeviceState& d, CubCalls& cubCalls, unsigned largeK
     GEM_CUDA_CHECK(cudaMemsetAsync(d.cellStart.get(), 0xff, d.tableSize * sizeof(int), s));
     cellRangeKernel<<<blocksFor(n, block), block, 0, s>>>(d.cellKeySorted.get(), n, largeKey, d.cellStart.get(), d.cellEnd.get());
     GEM_CUDA_CHECK_LAUNCH();
-    const GridView g{d.world.get(), d.boxes.get(), d.invMass.get(), d.isLarge.get(), d.large.get(), d.largeCount, d.cellStart.get(),
-                     d.cellEnd.get(), d.slotSorted.get(), d.cell, d.tableSize - 1, n, capacity};
+    const GridView g{d.world.get(),     d.boxes.get(),   d.invMass.get(),    d.isLarge.get(), d.large.get(),   d.largeCount,
+                     d.cellStart.get(), d.cellEnd.get(), d.slotSorted.get(), d.cell,          d.tableSize - 1, n,
+                     capacity};
     const int lanes = rowLanes(n);
     const int rowBlocks = (lanes * (n + 1) + block - 1) / block;  // a tile per body, one more for count[n]
     launchRows<false>(lanes, rowBlocks, block, s, g, d.partnerCount.get(), nullptr, nullptr, nullptr);

@@ -55,8 +55,10 @@ __device__ inline bool sortedContains(const unsigned long long* keys, int n, uns
   int lo = 0, hi = n;
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
-    if (keys[mid] < key) lo = mid + 1;
-    else hi = mid;
+    if (keys[mid] < key)
+      lo = mid + 1;
+    else
+      hi = mid;
   }
   return lo < n && keys[lo] == key;
 }
@@ -135,15 +137,33 @@ void enqueueContacts(DeviceState& d, CubCalls& cubCalls, const int* candidatesNe
   // computeContact is a long serial chain per pair with a 2.3 KB local-memory frame: while the
   // pairs are few, blocks of one warp spread them over every multiprocessor's L1.
   const int narrowBlock = capacity + 1 < 64 * 1024 ? 32 : block;
-  narrowphaseKernel<<<(capacity + narrowBlock) / narrowBlock, narrowBlock, 0, s>>>(capacity, candidatesNeeded, d.candA.get(), d.candB.get(),
-                                                                d.worldVertices.get(), d.vertexCount.get(), d.x.get(), d.y.get(),
-                                                                d.boxes.get(), d.invMass.get(), d.world.get(), d.candContact.get(), d.flag.get(), stats);
+  narrowphaseKernel<<<(capacity + narrowBlock) / narrowBlock, narrowBlock, 0, s>>>(
+      capacity, candidatesNeeded, d.candA.get(), d.candB.get(), d.worldVertices.get(), d.vertexCount.get(), d.x.get(), d.y.get(),
+      d.boxes.get(), d.invMass.get(), d.world.get(), d.candContact.get(), d.flag.get(), stats);
   GEM_CUDA_CHECK_LAUNCH();
   cubCalls.scanFlags(capacity);
   const unsigned long long padKey = d.idBits >= 32 ? ~0ull : (1ull << (2 * d.idBits)) - 1;
-  const CompactArgs c{capacity, n, d.idBits, padKey, d.candA.get(), d.candB.get(), d.candContact.get(), d.flag.get(),
-                      d.flagOffset.get(), d.id.get(), d.world.get(), d.worldStats.get(), d.previousKeys.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(),
-                      d.slots.get(), d.contactKey.get(), d.bKey.get(), d.bIndex.get(), stats};
+  const CompactArgs c{capacity,
+                      n,
+                      d.idBits,
+                      padKey,
+                      d.candA.get(),
+                      d.candB.get(),
+                      d.candContact.get(),
+                      d.flag.get(),
+                      d.flagOffset.get(),
+                      d.id.get(),
+                      d.world.get(),
+                      d.worldStats.get(),
+                      d.previousKeys.get(),
+                      d.contactA.get(),
+                      d.contactB.get(),
+                      d.contacts.get(),
+                      d.slots.get(),
+                      d.contactKey.get(),
+                      d.bKey.get(),
+                      d.bIndex.get(),
+                      stats};
   compactContactsKernel<<<blocksFor(capacity, block), block, 0, s>>>(c);
   GEM_CUDA_CHECK_LAUNCH();
   cubCalls.sortKeys(capacity, std::min(64, 2 * d.idBits));

@@ -45,8 +45,8 @@ std::unique_ptr<cuda::CudaBroadphase> deviceBroadphase(const Scenario& scenario)
   const std::vector<std::string> honoured = cuda::cudaBroadphaseSettings(name, origin);
   for (const std::string& key : scenario.broadphaseSettings.given)
     if (std::find(honoured.begin(), honoured.end(), key) == honoured.end())
-      throw BackendUnsupported("broadphase \"" + name + "\": its CUDA part does not honour the setting " + key +
-                               " ([broadphase." + name + "] or [simulation]); leave it out, or run with --backend cpu");
+      throw BackendUnsupported("broadphase \"" + name + "\": its CUDA part does not honour the setting " + key + " ([broadphase." + name +
+                               "] or [simulation]); leave it out, or run with --backend cpu");
   return (*factory)(scenario.broadphaseSettings);
 }
 
@@ -60,10 +60,10 @@ void appendRows(World& to, const World& from, int first, std::int64_t idOffset) 
   to.vertexCount.insert(to.vertexCount.end(), from.vertexCount.begin() + first, from.vertexCount.end());
   to.localVertices.insert(to.localVertices.end(), from.localVertices.begin() + static_cast<std::ptrdiff_t>(f * kMaxVertices),
                           from.localVertices.end());
-  std::vector<Real> World::*reals[] = {&World::x, &World::y, &World::angle, &World::vx, &World::vy, &World::omega,
-                                       &World::area, &World::thickness, &World::mass, &World::invMass, &World::invInertia,
-                                       &World::gyration2, &World::gyrationX2, &World::gyrationY2, &World::principalAngle,
-                                       &World::radius};
+  std::vector<Real> World::*reals[] = {&World::x,          &World::y,          &World::angle,          &World::vx,
+                                       &World::vy,         &World::omega,      &World::area,           &World::thickness,
+                                       &World::mass,       &World::invMass,    &World::invInertia,     &World::gyration2,
+                                       &World::gyrationX2, &World::gyrationY2, &World::principalAngle, &World::radius};
   for (auto r : reals) (to.*r).insert((to.*r).end(), (from.*r).begin() + first, (from.*r).end());
 }
 
@@ -103,9 +103,12 @@ CudaBatch::CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal)
     std::vector<const void*> params;
     for (const CudaStepper* m : m_members) params.push_back(m->m_cpu->events()[e].instance->params());
     auto driver = (*factory)(params.data(), worlds());
-    if (event.phase == EventPhase::Pair) m_device->addPairEvent(std::move(driver));
-    else if (event.phase == EventPhase::Solo) m_device->addSoloEvent(std::move(driver));
-    else m_device->addMotionEvent(std::move(driver));
+    if (event.phase == EventPhase::Pair)
+      m_device->addPairEvent(std::move(driver));
+    else if (event.phase == EventPhase::Solo)
+      m_device->addSoloEvent(std::move(driver));
+    else
+      m_device->addMotionEvent(std::move(driver));
   }
   if (worlds() > 1) {
     // Room for each world's ids, new floes from breaks included: a power of two past 4x the most.
@@ -114,7 +117,8 @@ CudaBatch::CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal)
     m_idStride = 1024;
     while (m_idStride < 4 * most) m_idStride *= 2;
     if (static_cast<std::int64_t>(worlds()) * m_idStride > (std::int64_t(1) << 31))
-      throw BackendUnsupported(fmt::format("{} cases of up to {} bodies are too many for one device state; run fewer together", worlds(), most));
+      throw BackendUnsupported(
+          fmt::format("{} cases of up to {} bodies are too many for one device state; run fewer together", worlds(), most));
   }
   m_device->setBroadphase(deviceBroadphase(s));
   m_device->setGridCell(s.broadphase == "uniform_grid" ? s.broadphaseSettings.cellSize : 0);
@@ -123,7 +127,8 @@ CudaBatch::CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal)
   // them in the same order); a row of a stream that a topology event reads ends the batch.
   const RecordStreams& streams = first.m_cpu->recordStreams();
   for (const CudaStepper* m : m_members)
-    if (m->m_cpu->recordStreams().count() != streams.count()) throw BackendUnsupported("cases run together on one device must open the same record streams");
+    if (m->m_cpu->recordStreams().count() != streams.count())
+      throw BackendUnsupported("cases run together on one device must open the same record streams");
   std::vector<int> strides;
   for (int q = 0; q < streams.count(); ++q) strides.push_back(streams.info(q).stride);
   unsigned halt = 0;
@@ -165,7 +170,8 @@ const std::vector<int>& CudaBatch::slotsOfWorld(int world) {
   if (m_slotsOfWorld.empty()) {
     m_slotsOfWorld.assign(static_cast<size_t>(worlds()), {});
     const std::vector<int>& worldOf = m_device->worldOfSlots();
-    for (int k = 0; k < static_cast<int>(worldOf.size()); ++k) m_slotsOfWorld[static_cast<size_t>(worldOf[static_cast<size_t>(k)])].push_back(k);
+    for (int k = 0; k < static_cast<int>(worldOf.size()); ++k)
+      m_slotsOfWorld[static_cast<size_t>(worldOf[static_cast<size_t>(k)])].push_back(k);
   }
   return m_slotsOfWorld[static_cast<size_t>(world)];
 }
@@ -232,7 +238,8 @@ void CudaBatch::addEdit(int world, const std::vector<int>& removedLocal, const W
   m_addedWorlds.insert(m_addedWorlds.end(), static_cast<size_t>(mirror.size() - firstAdded), world);
   m_added.nextId = worlds() == 1 ? mirror.nextId : static_cast<std::int64_t>(worlds()) * m_idStride;
   if (worlds() > 1 && mirror.nextId > m_idStride)
-    throw std::runtime_error(fmt::format("CUDA backend: a case made more than {} bodies, the room for its ids in a shared device state", m_idStride));
+    throw std::runtime_error(
+        fmt::format("CUDA backend: a case made more than {} bodies, the room for its ids in a shared device state", m_idStride));
   m_edited = true;
 }
 

@@ -52,9 +52,7 @@ class CudaBatch {
   std::int64_t idOffset(int world) const { return static_cast<std::int64_t>(world) * m_idStride; }
   int worldOfId(std::int64_t id) const { return static_cast<int>(id / m_idStride); }
   // World w's device slot `local` in the shared state.
-  int sharedSlot(int world, int local) {
-    return worlds() == 1 ? local : slotsOfWorld(world)[static_cast<size_t>(local)];
-  }
+  int sharedSlot(int world, int local) { return worlds() == 1 ? local : slotsOfWorld(world)[static_cast<size_t>(local)]; }
   const std::vector<int>& slotsOfWorld(int world);
 
   // The host mirrors to the device (set-up; a strategy that could not follow a re-sort).
@@ -84,8 +82,8 @@ class CudaBatch {
   std::unique_ptr<cuda::DeviceBatchResult> m_result;
   long m_resultFirst = 0;
   std::int64_t m_idStride = std::int64_t(1) << 62;  // one world: the ids as they are
-  std::vector<std::vector<int>> m_slotsOfWorld;      // empty: stale
-  int m_finished = 0;                                // cases done with the current step
+  std::vector<std::vector<int>> m_slotsOfWorld;     // empty: stale
+  int m_finished = 0;                               // cases done with the current step
   long m_stepsDone = 0;
   // The step's edits, applied together: shared slots, and the new bodies with their worlds.
   std::vector<int> m_removed;

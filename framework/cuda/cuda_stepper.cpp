@@ -27,7 +27,6 @@
 
 namespace gem {
 
-
 bool cudaAvailable() {
   static const bool available = [] {
     int count = 0;
@@ -63,7 +62,6 @@ void useCudaDeviceForWorker(int worker) {
   t_workerDevice = count > 0 ? worker % count : -1;
 }
 
-
 int CudaStepper::bindThreadToDevice() {
   int device = 0;
   if (t_workerDevice >= 0) GEM_CUDA_CHECK(cudaSetDevice(t_workerDevice));
@@ -74,18 +72,15 @@ int CudaStepper::bindThreadToDevice() {
 World& CudaStepper::world() { return m_cpu->world(); }
 const Scenario& CudaStepper::scenario() const { return m_cpu->scenario(); }
 
-
-
-
 std::string CudaStepper::batchKey(const Scenario& s) {
   if (s.broadphase != "uniform_grid") return "";
-  std::string key = fmt::format("dt={} steps={} copy_back_every={} block={} morton={} frames={} vessel_dof={} cell={}", s.dt, s.steps,
-                                s.copyBackEvery, s.cudaBlockSize, s.mortonSort, s.output.frameEvery, s.vessel.dof, s.broadphaseSettings.cellSize);
+  std::string key =
+      fmt::format("dt={} steps={} copy_back_every={} block={} morton={} frames={} vessel_dof={} cell={}", s.dt, s.steps, s.copyBackEvery,
+                  s.cudaBlockSize, s.mortonSort, s.output.frameEvery, s.vessel.dof, s.broadphaseSettings.cellSize);
   for (const auto& [name, setting] : s.events) key += fmt::format(" {}={}", name, setting.enabled);
   for (const PluginSpec& p : s.plugins) key += fmt::format(" plugin={}{}", p.path.string(), p.override ? "!" : "");
   return key;
 }
-
 
 long CudaStepper::broadphaseRebuilds() const {
   const cuda::CudaBroadphase* b = m_batch->device().broadphase();
@@ -112,9 +107,10 @@ std::vector<std::unique_ptr<CudaStepper>> CudaStepper::together(const std::vecto
   for (const Scenario* s : scenarios) {
     const std::string own = batchKey(*s);
     if (own.empty() || own != key)
-      throw BackendUnsupported(own.empty() ? "scenario " + s->file.string() + " cannot share a device state (its broadphase is not uniform_grid)"
-                                           : "scenarios " + scenarios.front()->file.string() + " and " + s->file.string() +
-                                                 " differ in what cases run together must share: " + key + " | " + own);
+      throw BackendUnsupported(own.empty()
+                                   ? "scenario " + s->file.string() + " cannot share a device state (its broadphase is not uniform_grid)"
+                                   : "scenarios " + scenarios.front()->file.string() + " and " + s->file.string() +
+                                         " differ in what cases run together must share: " + key + " | " + own);
   }
   // The cases' set-up (parsing, field generation: CPU work, tens of ms each for the load study's
   // fields) on the host's cores, every thread on this thread's device.
@@ -234,7 +230,8 @@ void CudaStepper::runTopology() {
     }
   }
   if (survivor != firstAdded)
-    throw std::logic_error("CUDA backend: a topology event reordered the bodies (only World::removeBodies and World::addBody may change them)");
+    throw std::logic_error(
+        "CUDA backend: a topology event reordered the bodies (only World::removeBodies and World::addBody may change them)");
   std::sort(removedDevice.begin(), removedDevice.end());
   batch.times.bookkeeping += clock.lap();
   batch.addEdit(m_world, removedDevice, w, firstAdded);
@@ -251,8 +248,8 @@ void CudaStepper::runTopology() {
         continue;
       }
       const int mirrorOld = m_pendingOrder[static_cast<size_t>(old)];
-      composed.push_back(mirrorOld - static_cast<int>(std::lower_bound(removedMirror.begin(), removedMirror.end(), mirrorOld) -
-                                                      removedMirror.begin()));
+      composed.push_back(mirrorOld -
+                         static_cast<int>(std::lower_bound(removedMirror.begin(), removedMirror.end(), mirrorOld) - removedMirror.begin()));
     }
     for (int k = firstAdded; k < w.size(); ++k) composed.push_back(k);
     m_pendingOrder.swap(composed);
@@ -284,9 +281,7 @@ void CudaStepper::downloadState() {
   m_hostCurrent = true;
 }
 
-bool CudaStepper::deviceAhead() const {
-  return m_taken < m_batch->resultFirst() + static_cast<long>(m_batch->result().steps.size());
-}
+bool CudaStepper::deviceAhead() const { return m_taken < m_batch->resultFirst() + static_cast<long>(m_batch->result().steps.size()); }
 
 const World& CudaStepper::hostWorld() {
   // Batches end where the runner needs the state (frames, the last step): downloadState refuses a
@@ -380,16 +375,15 @@ void CudaStepper::followReorder(const std::vector<int>& order) {
 
 // The backend's entry: listed by `gem info`, chosen by --backend cuda and by backend = "auto".
 static const bool kRegistered = [] {
-  registerBackend(BackendEntry{
-      "cuda", [] { return cudaAvailable(); }, [] { return cudaDeviceName(); },
-      [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CudaStepper>(s); }, useCudaDeviceForWorker,
-      CudaStepper::batchKey,
-      [](const std::vector<const Scenario*>& scenarios) {
-        std::vector<std::unique_ptr<Stepper>> steppers;
-        for (auto& s : CudaStepper::together(scenarios)) steppers.push_back(std::move(s));
-        return steppers;
-      },
-      deviceCount});
+  registerBackend(BackendEntry{"cuda", [] { return cudaAvailable(); }, [] { return cudaDeviceName(); },
+                               [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CudaStepper>(s); },
+                               useCudaDeviceForWorker, CudaStepper::batchKey,
+                               [](const std::vector<const Scenario*>& scenarios) {
+                                 std::vector<std::unique_ptr<Stepper>> steppers;
+                                 for (auto& s : CudaStepper::together(scenarios)) steppers.push_back(std::move(s));
+                                 return steppers;
+                               },
+                               deviceCount});
   return true;
 }();
 

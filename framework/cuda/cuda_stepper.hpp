@@ -59,7 +59,7 @@ class CudaStepper final : public Stepper {
   std::string device() const override { return m_deviceName; }
   std::string backend() const override { return "cuda"; }
   int candidateCount() const { return m_candidateCount; }  // over the whole device state
-  int casesOnDevice() const;  // 1 alone, the batch's size when run together
+  int casesOnDevice() const;                               // 1 alone, the batch's size when run together
   // Rebuilds of the device broadphase's kept list (0 for one that keeps none): reads the device.
   long broadphaseRebuilds() const;
   // Tests, alone only: run the topology phase through a whole-world round trip (download, edit,
@@ -71,21 +71,21 @@ class CudaStepper final : public Stepper {
   struct Member {};
   CudaStepper(const Scenario& scenario, Member);  // a case of a batch; the batch attaches itself
 
-  void downloadState();      // device kinematics -> host mirror
-  bool deviceAhead() const;  // the device has run steps that step() has not handed out yet
-  void runTopology();        // phase 6 on the mirror, replayed on the device (CudaBatch::addEdit)
+  void downloadState();                               // device kinematics -> host mirror
+  bool deviceAhead() const;                           // the device has run steps that step() has not handed out yet
+  void runTopology();                                 // phase 6 on the mirror, replayed on the device (CudaBatch::addEdit)
   void followReorder(const std::vector<int>& order);  // a device re-sort of this world's bodies
-  void flushPendingOrder();  // the mirror into the device's order
-  void locateVessel();       // m_vesselSlot from the mirror (in the device's order)
-  int mirrorSlot(int deviceSlot) const;  // the host mirror's row of a device slot
+  void flushPendingOrder();                           // the mirror into the device's order
+  void locateVessel();                                // m_vesselSlot from the mirror (in the device's order)
+  int mirrorSlot(int deviceSlot) const;               // the host mirror's row of a device slot
   const std::vector<int>& slotOfId();
 
-  World& world();                     // the host mirror (the CPU simulation's world, never stepped there)
+  World& world();  // the host mirror (the CPU simulation's world, never stepped there)
   const Scenario& scenario() const;
 
-  static int bindThreadToDevice();  // the worker's device (useCudaDeviceForWorker), before any CUDA call
-  int m_deviceOrdinal;               // first: every member after it lives on this device
-  std::unique_ptr<CpuStepper> m_cpu;  // parses the events (and runs the topology ones) and holds the host world
+  static int bindThreadToDevice();     // the worker's device (useCudaDeviceForWorker), before any CUDA call
+  int m_deviceOrdinal;                 // first: every member after it lives on this device
+  std::unique_ptr<CpuStepper> m_cpu;   // parses the events (and runs the topology ones) and holds the host world
   std::shared_ptr<CudaBatch> m_batch;  // the device state, alone or shared
   int m_world = 0;                     // this case's world in it
   bool m_hostCurrent = true;

@@ -31,7 +31,8 @@ void DeviceStep::setGridCell(Real cellSize) {
 void DeviceStep::setRecordStreams(const std::vector<int>& strides, unsigned haltStreams) {
   DeviceState& d = *m_state;
   d.dropGraph();
-  if (strides.size() > static_cast<size_t>(kMaxRecordStreams)) throw std::invalid_argument("DeviceStep::setRecordStreams: too many streams");
+  if (strides.size() > static_cast<size_t>(kMaxRecordStreams))
+    throw std::invalid_argument("DeviceStep::setRecordStreams: too many streams");
   d.recordStreams = static_cast<int>(strides.size());
   for (int s = 0; s < kMaxRecordStreams; ++s) d.recordStride[s] = s < d.recordStreams ? strides[static_cast<size_t>(s)] : 0;
   d.haltStreams = haltStreams;
@@ -87,7 +88,7 @@ const std::vector<int>& DeviceStep::worldOfSlots() const { return m_state->world
 void uploadVessels(DeviceState& d) { d.vessel.upload(d.vesselHost.data(), d.vesselHost.size()); }
 
 void DeviceStep::upload(const World& w, const std::vector<int>& worldOf, const std::vector<int>& vesselSlots,
-                         const std::vector<int>& vesselDofs) {
+                        const std::vector<int>& vesselDofs) {
   DeviceState& d = *m_state;
   const int n = w.size(), worlds = static_cast<int>(vesselSlots.size());
   if (worlds < 1 || vesselDofs.size() != vesselSlots.size() || (!worldOf.empty() && worldOf.size() != static_cast<size_t>(n)))

@@ -29,7 +29,7 @@ using ReorderScratch = DeviceArray<unsigned char, DeviceArrayUse::Scratch>;
 struct BatchControl {
   long firstStep;  // index of the batch's first step
   Real dt;
-  int steps;       // steps to run, at most the ring's length
+  int steps;  // steps to run, at most the ring's length
 };
 
 // Why the batch's loop stopped (StepStats::halt).
@@ -40,11 +40,11 @@ enum : int { kRunning = 0, kHaltDone = 1, kHaltBreak = 2, kHaltOverflow = 3 };
 struct StepStats {
   int recordCount[kMaxRecordStreams];  // RecordSink's counters, over the whole batch
   int recordBegin[kMaxRecordStreams];  // at the start of the step: a step that fails rewinds to them
-  int candidatesNeeded;         // the broadphase's pair count, even past the capacity
-  int candidates;               // min(needed, capacity)
+  int candidatesNeeded;                // the broadphase's pair count, even past the capacity
+  int candidates;                      // min(needed, capacity)
   int contacts, previousContacts;
-  int overflow;                 // 1: candidates or records past their capacity: the step left the state alone
-  int stepsDone, halt;          // completed steps of the batch, and why it stopped
+  int overflow;         // 1: candidates or records past their capacity: the step left the state alone
+  int stepsDone, halt;  // completed steps of the batch, and why it stopped
 };
 
 struct DeviceState {
@@ -53,8 +53,8 @@ struct DeviceState {
   GraphArray<BodyKind> kind;
   GraphArray<int> vertexCount, dof;
   GraphArray<Vec2> local;
-  GraphArray<Real> x, y, angle, vx, vy, omega, area, thickness, mass, invMass, invInertia, gyration2, gyrationX2,
-      gyrationY2, principalAngle;
+  GraphArray<Real> x, y, angle, vx, vy, omega, area, thickness, mass, invMass, invInertia, gyration2, gyrationX2, gyrationY2,
+      principalAngle;
   GraphArray<Real> radius;  // bounding radius: what a device broadphase tests (docs/model.md 9)
   GraphArray<unsigned char> isLarge;
   GraphArray<int> large;
@@ -102,21 +102,21 @@ struct DeviceState {
   GraphArray<unsigned char> records[kMaxRecordStreams];
   int recordStride[kMaxRecordStreams] = {};
   int recordStreams = 0;
-  unsigned haltStreams = 0;       // streams whose rows end the batch (topology follows)
-  int recordCapacity = 0;         // rows of each record buffer (grows when a single step needs more)
+  unsigned haltStreams = 0;                       // streams whose rows end the batch (topology follows)
+  int recordCapacity = 0;                         // rows of each record buffer (grows when a single step needs more)
   std::int64_t idStride = std::int64_t(1) << 62;  // several worlds: ids are world x idStride + own id
   GraphArray<StepStats> stats;
   GraphArray<StepContext> ctx;  // written on the device at the start of each step
   GraphArray<BatchControl> control;
-  GraphArray<StepRecord> ring;  // one record per step of the batch
-  GraphArray<WorldStepRecord> worldRing;  // ringSize x worlds
-  int ringSize = 16;              // simulation.copy_back_every
-  int block = kBlock;             // simulation.cuda_block_size
-  StepStats* h_stats = nullptr;       // pinned
-  BatchControl* h_control = nullptr;  // pinned: the graph's first node copies it to control
-  StepRecord* h_ring = nullptr;       // pinned, ringSize records
+  GraphArray<StepRecord> ring;             // one record per step of the batch
+  GraphArray<WorldStepRecord> worldRing;   // ringSize x worlds
+  int ringSize = 16;                       // simulation.copy_back_every
+  int block = kBlock;                      // simulation.cuda_block_size
+  StepStats* h_stats = nullptr;            // pinned
+  BatchControl* h_control = nullptr;       // pinned: the graph's first node copies it to control
+  StepRecord* h_ring = nullptr;            // pinned, ringSize records
   WorldStepRecord* h_worldRing = nullptr;  // pinned, ringSize x worlds records
-  GraphArray<unsigned char> temp;  // CUB scratch, sized before capture
+  GraphArray<unsigned char> temp;          // CUB scratch, sized before capture
   // Topology edits and the rows they fetch: kept here, because a cudaFree waits for the whole
   // device, every other simulation's stream included (a sweep runs many at once).
   GraphArray<int> editRemoved, editOrder, fetchSlots;
@@ -129,7 +129,7 @@ struct DeviceState {
   int capacity = 0;  // candidate (and contact) capacity the graph was captured for
   cudaStream_t stream = nullptr;
   cudaGraphExec_t graph = nullptr;
-  long captures = 0;           // step graphs captured and instantiated (GEM_CUDA_TIMING)
+  long captures = 0;  // step graphs captured and instantiated (GEM_CUDA_TIMING)
   double captureSeconds = 0;
   std::vector<std::unique_ptr<CudaEventDriver>> pairEvents, soloEvents, motionEvents;
 

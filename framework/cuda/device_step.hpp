@@ -27,8 +27,8 @@ struct StepRecord {
 // several when a sweep batches its cases (upload's worldOf); bodies of two worlds never touch.
 struct WorldStepRecord {
   int contacts;
-  Vec2 vesselImpulse;                    // N s, this step's contact impulses on the world's vessel
-  Vec2 vesselPosition, vesselVelocity;   // after the step (zero in a world without a vessel)
+  Vec2 vesselImpulse;                   // N s, this step's contact impulses on the world's vessel
+  Vec2 vesselPosition, vesselVelocity;  // after the step (zero in a world without a vessel)
   Real vesselAngle;
 };
 
@@ -38,7 +38,7 @@ struct WorldStepRecord {
 struct DeviceBatchResult {
   int worlds = 1;
   std::vector<StepRecord> steps;
-  std::vector<WorldStepRecord> worldSteps;  // steps.size() x worlds: step s's world w at s * worlds + w
+  std::vector<WorldStepRecord> worldSteps;                // steps.size() x worlds: step s's world w at s * worlds + w
   std::vector<unsigned char> records[kMaxRecordStreams];  // rows (RecordTag + record) of each stream
 };
 

@@ -87,8 +87,10 @@ __global__ void keptOrderKernel(int n, const int* removed, int removedCount, int
   int lo = 0, hi = removedCount;  // removed slots below `slot`
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
-    if (removed[mid] < slot) lo = mid + 1;
-    else hi = mid;
+    if (removed[mid] < slot)
+      lo = mid + 1;
+    else
+      hi = mid;
   }
   if (lo < removedCount && removed[lo] == slot) return;
   order[slot - lo] = slot;
@@ -135,17 +137,19 @@ std::vector<int> DeviceStep::reorderAlongCurve(bool* broadphaseFollowed) {
   GEM_CUDA_CHECK_LAUNCH();
   const int keyBits = 32 + (d.worlds > 1 ? bitsFor(static_cast<unsigned long long>(d.worlds - 1)) : 0);
   size_t bytes = 0;
-  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, keyBits, s));
+  GEM_CUDA_CHECK(
+      cub::DeviceRadixSort::SortPairs(nullptr, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, keyBits, s));
   sortScratch.ensure(bytes);
   void* temp = sortScratch.get();
-  GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, keyBits, s));
+  GEM_CUDA_CHECK(
+      cub::DeviceRadixSort::SortPairs(temp, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, keyBits, s));
   const int* o = sortedSlots.get();
   permuteOnDevice(d.id, n, 1, o, scratch, s), permuteOnDevice(d.kind, n, 1, o, scratch, s);
   permuteOnDevice(d.world, n, 1, o, scratch, s);
   permuteOnDevice(d.vertexCount, n, 1, o, scratch, s), permuteOnDevice(d.dof, n, 1, o, scratch, s);
   permuteOnDevice(d.local, n, kMaxVertices, o, scratch, s), permuteOnDevice(d.isLarge, n, 1, o, scratch, s);
   for (GraphArray<Real>* r : {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.radius, &d.area, &d.thickness, &d.mass, &d.invMass,
-                                &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle})
+                              &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle})
     permuteOnDevice(*r, n, 1, o, scratch, s);
   if (d.broadphase) *broadphaseFollowed = d.broadphase->reorder(o, n, s);
   sortedSlots.download(order.data(), static_cast<size_t>(n));
@@ -190,7 +194,7 @@ void DeviceStep::downloadKinematics(const std::vector<int>& deviceSlots, const s
 }
 
 bool DeviceStep::editBodies(const std::vector<int>& removedSlots, const World& from, int firstAdded, const std::vector<int>& addedWorlds,
-                             const std::vector<int>& vesselDofs) {
+                            const std::vector<int>& vesselDofs) {
   DeviceState& d = *m_state;
   const int before = d.n, removedCount = static_cast<int>(removedSlots.size());
   const int kept = before - removedCount, added = from.size() - firstAdded, n = kept + added;
@@ -213,8 +217,9 @@ bool DeviceStep::editBodies(const std::vector<int>& removedSlots, const World& f
   permuteOnDevice(d.vertexCount, kept, 1, o, scratch, s, before, n), permuteOnDevice(d.dof, kept, 1, o, scratch, s, before, n);
   permuteOnDevice(d.local, kept, kMaxVertices, o, scratch, s, before, n), permuteOnDevice(d.isLarge, kept, 1, o, scratch, s, before, n);
   permuteOnDevice(d.world, kept, 1, o, scratch, s, before, n);
-  GraphArray<Real>* reals[] = {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.radius, &d.area, &d.thickness, &d.mass, &d.invMass,
-                                 &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle};
+  GraphArray<Real>* reals[] = {
+      &d.x,         &d.y,    &d.angle,   &d.vx,         &d.vy,        &d.omega,      &d.radius,     &d.area,
+      &d.thickness, &d.mass, &d.invMass, &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle};
   for (GraphArray<Real>* r : reals) permuteOnDevice(*r, kept, 1, o, scratch, s, before, n);
 
   // The new bodies' rows, as World::addBody made them on the host (a few per step): rows
@@ -224,9 +229,10 @@ bool DeviceStep::editBodies(const std::vector<int>& removedSlots, const World& f
   d.kind.uploadAt(at, from.kind.data() + first, count);
   d.vertexCount.uploadAt(at, from.vertexCount.data() + first, count);
   d.local.uploadAt(at * kMaxVertices, from.localVertices.data() + first * kMaxVertices, count * kMaxVertices);
-  const std::vector<Real>* hostReals[] = {&from.x, &from.y, &from.angle, &from.vx, &from.vy, &from.omega, &from.radius, &from.area,
-                                          &from.thickness, &from.mass, &from.invMass, &from.invInertia, &from.gyration2,
-                                          &from.gyrationX2, &from.gyrationY2, &from.principalAngle};
+  const std::vector<Real>* hostReals[] = {&from.x,         &from.y,          &from.angle,      &from.vx,
+                                          &from.vy,        &from.omega,      &from.radius,     &from.area,
+                                          &from.thickness, &from.mass,       &from.invMass,    &from.invInertia,
+                                          &from.gyration2, &from.gyrationX2, &from.gyrationY2, &from.principalAngle};
   for (size_t k = 0; k < std::size(reals); ++k) reals[k]->uploadAt(at, hostReals[k]->data() + first, count);
   std::vector<int> dof(count), worlds(count, 0);
   std::vector<unsigned char> isLarge(count);

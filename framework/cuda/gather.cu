@@ -12,8 +12,10 @@ __device__ inline int lowerBound(const int* v, int n, int x) {
   int lo = 0, hi = n;
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
-    if (v[mid] < x) lo = mid + 1;
-    else hi = mid;
+    if (v[mid] < x)
+      lo = mid + 1;
+    else
+      hi = mid;
   }
   return lo;
 }
@@ -23,8 +25,8 @@ __device__ inline int lowerBound(const int* v, int n, int x) {
 // contactA and bKeySorted are sorted with the padding (slot n) last, so searching the whole
 // capacity finds only real contacts.
 __global__ void gatherKernel(int n, const int* world, const int* vesselSlot, const PairBody* bodies, const VelocityChange* changes,
-                             int capacity, const int* contactA, const int* bKeySorted, const int* bIndexSorted,
-                             const PairContact* contacts, const PairSlot* slots, MotionBody* motion, WorldStepRecord* worldStats) {
+                             int capacity, const int* contactA, const int* bKeySorted, const int* bIndexSorted, const PairContact* contacts,
+                             const PairSlot* slots, MotionBody* motion, WorldStepRecord* worldStats) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   const int vessel = vesselSlot[world[i]];

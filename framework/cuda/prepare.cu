@@ -17,8 +17,8 @@ struct PrepareArgs {
   const BodyKind* kind;
   const int *vertexCount, *dof;
   const Vec2* local;
-  const Real *x, *y, *angle, *vx, *vy, *omega, *area, *thickness, *mass, *invMass, *invInertia, *gyration2, *gyrationX2,
-      *gyrationY2, *principalAngle;
+  const Real *x, *y, *angle, *vx, *vy, *omega, *area, *thickness, *mass, *invMass, *invInertia, *gyration2, *gyrationX2, *gyrationY2,
+      *principalAngle;
   const unsigned char* isLarge;
   const int* world;
   std::int64_t idStride;  // the events see each case's own ids (PairBody::id)
@@ -131,13 +131,44 @@ void enqueuePrepare(DeviceState& d, unsigned largeKey) {
   cudaStream_t s = d.stream;
   const int n = d.n, block = d.block;
   // 1. World vertices, boxes, views, cell keys.
-  PrepareArgs a{n, d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.local.get(), d.x.get(), d.y.get(),
-                d.angle.get(), d.vx.get(), d.vy.get(), d.omega.get(), d.area.get(), d.thickness.get(), d.mass.get(),
-                d.invMass.get(), d.invInertia.get(), d.gyration2.get(), d.gyrationX2.get(), d.gyrationY2.get(),
-                d.principalAngle.get(), d.isLarge.get(), d.world.get(), d.idStride, d.cell, d.tableSize - 1, largeKey, d.worldVertices.get(), d.boxes.get(),
-                d.pairBodies.get(), d.soloBodies.get(), d.changes.get(), d.cellKey.get(), d.slot.get()};
-  if (stagedPrepare(n)) prepareStagedKernel<<<blocksFor(n, kPrepareBlock), kPrepareBlock, 0, s>>>(a);  // a fixed block
-  else prepareDirectKernel<<<blocksFor(n, block), block, 0, s>>>(a);
+  PrepareArgs a{n,
+                d.id.get(),
+                d.kind.get(),
+                d.vertexCount.get(),
+                d.dof.get(),
+                d.local.get(),
+                d.x.get(),
+                d.y.get(),
+                d.angle.get(),
+                d.vx.get(),
+                d.vy.get(),
+                d.omega.get(),
+                d.area.get(),
+                d.thickness.get(),
+                d.mass.get(),
+                d.invMass.get(),
+                d.invInertia.get(),
+                d.gyration2.get(),
+                d.gyrationX2.get(),
+                d.gyrationY2.get(),
+                d.principalAngle.get(),
+                d.isLarge.get(),
+                d.world.get(),
+                d.idStride,
+                d.cell,
+                d.tableSize - 1,
+                largeKey,
+                d.worldVertices.get(),
+                d.boxes.get(),
+                d.pairBodies.get(),
+                d.soloBodies.get(),
+                d.changes.get(),
+                d.cellKey.get(),
+                d.slot.get()};
+  if (stagedPrepare(n))
+    prepareStagedKernel<<<blocksFor(n, kPrepareBlock), kPrepareBlock, 0, s>>>(a);  // a fixed block
+  else
+    prepareDirectKernel<<<blocksFor(n, block), block, 0, s>>>(a);
   GEM_CUDA_CHECK_LAUNCH();
 }
 

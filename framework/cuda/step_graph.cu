@@ -32,13 +32,14 @@ void CubCalls::check(cudaError_t status, const size_t& need, const char* what) {
 }
 void CubCalls::cellSort(int n, int bits) {
   size_t need = sizing ? 0 : bytes;
-  check(cub::DeviceRadixSort::SortPairs(temp, need, d.cellKey.get(), d.cellKeySorted.get(), d.slot.get(), d.slotSorted.get(), n, 0,
-                                        bits, d.stream),
+  check(cub::DeviceRadixSort::SortPairs(temp, need, d.cellKey.get(), d.cellKeySorted.get(), d.slot.get(), d.slotSorted.get(), n, 0, bits,
+                                        d.stream),
         need, "cub SortPairs (cells)");
 }
 void CubCalls::scanPartners(int n) {
   size_t need = sizing ? 0 : bytes;
-  check(cub::DeviceScan::ExclusiveSum(temp, need, d.partnerCount.get(), d.partnerOffset.get(), n + 1, d.stream), need, "cub ExclusiveSum (partners)");
+  check(cub::DeviceScan::ExclusiveSum(temp, need, d.partnerCount.get(), d.partnerOffset.get(), n + 1, d.stream), need,
+        "cub ExclusiveSum (partners)");
 }
 void CubCalls::sortCandidates(int capacity, int bits) {
   size_t need = sizing ? 0 : bytes;
@@ -47,11 +48,13 @@ void CubCalls::sortCandidates(int capacity, int bits) {
 }
 void CubCalls::scanFlags(int capacity) {
   size_t need = sizing ? 0 : bytes;
-  check(cub::DeviceScan::ExclusiveSum(temp, need, d.flag.get(), d.flagOffset.get(), capacity + 1, d.stream), need, "cub ExclusiveSum (flags)");
+  check(cub::DeviceScan::ExclusiveSum(temp, need, d.flag.get(), d.flagOffset.get(), capacity + 1, d.stream), need,
+        "cub ExclusiveSum (flags)");
 }
 void CubCalls::sortKeys(int capacity, int bits) {
   size_t need = sizing ? 0 : bytes;
-  check(cub::DeviceRadixSort::SortKeys(temp, need, d.contactKey.get(), d.sortedKeys.get(), capacity, 0, bits, d.stream), need, "cub SortKeys (contact ids)");
+  check(cub::DeviceRadixSort::SortKeys(temp, need, d.contactKey.get(), d.sortedKeys.get(), capacity, 0, bits, d.stream), need,
+        "cub SortKeys (contact ids)");
 }
 void CubCalls::sortB(int capacity, int bits) {
   size_t need = sizing ? 0 : bytes;
@@ -116,8 +119,10 @@ __global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, con
     }
     ring[s->stepsDone] = r;
     ++s->stepsDone;
-    if (topology) s->halt = kHaltBreak;
-    else if (s->stepsDone >= c->steps) s->halt = kHaltDone;
+    if (topology)
+      s->halt = kHaltBreak;
+    else if (s->stepsDone >= c->steps)
+      s->halt = kHaltDone;
   }
   if (inGraph) cudaGraphSetConditional(loop, s->halt == kRunning ? 1u : 0u);
 }
@@ -149,9 +154,20 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   // 4. Two-body events write into each contact's slot; solo events from the start-of-step state.
   const int records = d.recordCapacity;
   RecordSink sink{};
-  for (int q = 0; q < d.recordStreams; ++q) sink.streams[q] = RecordBuffer{d.records[q].get(), d.recordStride[q], records, &stats->recordCount[q]};
-  DevicePairData pairData{d.pairBodies.get(), d.world.get(), d.contactA.get(), d.contactB.get(), d.contacts.get(), d.slots.get(),
-                          capacity, block, &stats->contacts, d.ctx.get(), sink, 0};
+  for (int q = 0; q < d.recordStreams; ++q)
+    sink.streams[q] = RecordBuffer{d.records[q].get(), d.recordStride[q], records, &stats->recordCount[q]};
+  DevicePairData pairData{d.pairBodies.get(),
+                          d.world.get(),
+                          d.contactA.get(),
+                          d.contactB.get(),
+                          d.contacts.get(),
+                          d.slots.get(),
+                          capacity,
+                          block,
+                          &stats->contacts,
+                          d.ctx.get(),
+                          sink,
+                          0};
   for (auto& e : d.pairEvents) {
     e->launchPairs(pairData, s);
     ++pairData.event;
@@ -167,8 +183,8 @@ void enqueueStep(DeviceState& d, cudaGraphConditionalHandle loop, bool inGraph) 
   for (auto& e : d.motionEvents) e->launchMotion(motionData, s);
   enqueueWriteBack(d);
   enqueueCommitContacts(d);
-  endStepKernel<<<1, stepEdgeThreads(d.worlds), 0, s>>>(loop, inGraph, d.control.get(), stats, d.ring.get(), d.worlds,
-                                                       d.worldStats.get(), d.worldRing.get(), d.haltStreams);
+  endStepKernel<<<1, stepEdgeThreads(d.worlds), 0, s>>>(loop, inGraph, d.control.get(), stats, d.ring.get(), d.worlds, d.worldStats.get(),
+                                                        d.worldRing.get(), d.haltStreams);
   GEM_CUDA_CHECK_LAUNCH();
 }
 
@@ -221,8 +237,8 @@ void captureStep(DeviceState& d) {
     ~Owned() { cudaGraphDestroy(g); }
   } owned{graph};
   cudaGraphNode_t controlIn, begin, loop, ringOut, worldRingOut, statsOut;
-  GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&controlIn, graph, nullptr, 0, d.control.get(), d.h_control, sizeof(BatchControl),
-                                          cudaMemcpyHostToDevice));
+  GEM_CUDA_CHECK(
+      cudaGraphAddMemcpyNode1D(&controlIn, graph, nullptr, 0, d.control.get(), d.h_control, sizeof(BatchControl), cudaMemcpyHostToDevice));
   StepStats* stats = d.stats.get();
   void* beginArgs[] = {&stats};
   cudaKernelNodeParams beginParams{};
@@ -270,10 +286,11 @@ void runBatchUncaptured(DeviceState& d) {
     GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_stats, d.stats.get(), sizeof(StepStats), cudaMemcpyDeviceToHost, d.stream));
     GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));
   } while (d.h_stats->halt == kRunning);
-  GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_ring, d.ring.get(), sizeof(StepRecord) * static_cast<size_t>(d.ringSize), cudaMemcpyDeviceToHost, d.stream));
+  GEM_CUDA_CHECK(
+      cudaMemcpyAsync(d.h_ring, d.ring.get(), sizeof(StepRecord) * static_cast<size_t>(d.ringSize), cudaMemcpyDeviceToHost, d.stream));
   GEM_CUDA_CHECK(cudaMemcpyAsync(d.h_worldRing, d.worldRing.get(),
-                                 sizeof(WorldStepRecord) * static_cast<size_t>(d.ringSize) * static_cast<size_t>(d.worlds), cudaMemcpyDeviceToHost,
-                                 d.stream));
+                                 sizeof(WorldStepRecord) * static_cast<size_t>(d.ringSize) * static_cast<size_t>(d.worlds),
+                                 cudaMemcpyDeviceToHost, d.stream));
 }
 
 }  // namespace
@@ -337,7 +354,8 @@ void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& resu
       for (int q = 0; q < kMaxRecordStreams; ++q) r.recordEnd[q] += base[q];
       result.steps.push_back(r);
     }
-    result.worldSteps.insert(result.worldSteps.end(), d.h_worldRing, d.h_worldRing + static_cast<size_t>(done) * static_cast<size_t>(d.worlds));
+    result.worldSteps.insert(result.worldSteps.end(), d.h_worldRing,
+                             d.h_worldRing + static_cast<size_t>(done) * static_cast<size_t>(d.worlds));
     next += done;
     remaining -= done;
     if (stats.halt == kHaltBreak) break;

@@ -34,19 +34,19 @@ struct RandomFieldSpec {
   // Largest length / width (sqrt of the principal second moments' ratio): longer cells are cut
   // back. Natural floes are seldom longer than 2 to 3 times their width.
   Real maxAspect = Real(2.5);
-  Real thickness = Real(0.7);      // m, when groups is empty
+  Real thickness = Real(0.7);          // m, when groups is empty
   std::vector<ThicknessGroup> groups;  // coverages sum to concentration; each floe in one group
-  Real minGap = Real(0.05);        // m, smallest distance between floes, and to the domain edge
+  Real minGap = Real(0.05);            // m, smallest distance between floes, and to the domain edge
   std::uint64_t seed = 1;
 };
 
 struct HexagonFieldSpec {
   Domain domain;
   Real concentration = Real(0.46);
-  Real size = Real(10.1);            // sqrt(area) of every hexagon, m (thesis 6.2.1.1.1)
-  Real rotationJitterDeg = 3;        // each hexagon rotated uniformly in +-jitter (breaks interlocking)
+  Real size = Real(10.1);      // sqrt(area) of every hexagon, m (thesis 6.2.1.1.1)
+  Real rotationJitterDeg = 3;  // each hexagon rotated uniformly in +-jitter (breaks interlocking)
   Real thickness = Real(0.7);
-  Real minGap = Real(0.05);          // m, as in RandomFieldSpec
+  Real minGap = Real(0.05);  // m, as in RandomFieldSpec
   std::uint64_t seed = 1;
 };
 

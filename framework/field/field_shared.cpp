@@ -18,8 +18,7 @@ void checkDomain(const Domain& d) {
 }
 
 void checkCommon(Real concentration, Real thickness, Real minGap, bool thicknessUsed) {
-  if (!(concentration > 0 && concentration < Real(0.9)))
-    fail("field.concentration: expected a fraction in (0, 0.9), got ", concentration);
+  if (!(concentration > 0 && concentration < Real(0.9))) fail("field.concentration: expected a fraction in (0, 0.9), got ", concentration);
   if (thicknessUsed && !(thickness > 0 && std::isfinite(thickness)))
     fail("field.thickness: expected a positive thickness in m, got ", thickness);
   if (!(minGap >= 0 && std::isfinite(minGap))) fail("field.min_gap: expected >= 0 m, got ", minGap);

@@ -45,10 +45,10 @@ class Random {
   double uniform() { return static_cast<double>(m_engine() >> 11) * 0x1.0p-53; }  // [0, 1)
   double uniform(double a, double b) { return a + (b - a) * uniform(); }
   std::uint64_t below(std::uint64_t n) {  // [0, n), unbiased by rejection
-    const std::uint64_t limit = std::numeric_limits<std::uint64_t>::max() -
-                                std::numeric_limits<std::uint64_t>::max() % n;
+    const std::uint64_t limit = std::numeric_limits<std::uint64_t>::max() - std::numeric_limits<std::uint64_t>::max() % n;
     std::uint64_t r;
-    do r = m_engine(); while (r >= limit);
+    do r = m_engine();
+    while (r >= limit);
     return r % n;
   }
   template <class T>

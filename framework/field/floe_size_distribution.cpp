@@ -18,20 +18,18 @@ double normalCdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
 // Inverse of normalCdf: Acklam's rational approximation, polished by one Halley step (|error|
 // about 1e-15).
 double normalQuantile(double p) {
-  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
-                             1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
-  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
-                             6.680131188771972e+01, -1.328068155288572e+01};
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,  -2.759285104469687e+02,
+                             1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02, 6.680131188771972e+01,
+                             -1.328068155288572e+01};
   static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
-                             -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
-  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
-                             3.754408661907416e+00};
+                             -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00, 3.754408661907416e+00};
   p = std::clamp(p, 1e-300, 1 - 1e-16);
   double x;
   if (p < 0.02425 || p > 1 - 0.02425) {
     const double q = std::sqrt(-2 * std::log(p < 0.5 ? p : 1 - p));
-    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
+    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) / ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
     if (p > 0.5) x = -x;
   } else {
     const double q = p - 0.5, r = q * q;
@@ -45,9 +43,7 @@ double normalQuantile(double p) {
 
 // Probability mass of the standard normal between z1 < z2, from the nearer tail so that ranges
 // far out in one tail keep their precision.
-double normalMass(double z1, double z2) {
-  return z1 >= 0 ? normalCdf(-z1) - normalCdf(-z2) : normalCdf(z2) - normalCdf(z1);
-}
+double normalMass(double z1, double z2) { return z1 >= 0 ? normalCdf(-z1) - normalCdf(-z2) : normalCdf(z2) - normalCdf(z1); }
 
 }  // namespace
 

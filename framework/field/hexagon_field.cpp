@@ -99,8 +99,8 @@ std::vector<BodySpec> generateHexagonField(const HexagonFieldSpec& spec) {
         for (int k = 0; k < 6; ++k) {
           const double angle = kPiD / 6 + k * kPiD / 3 + turn;
           hex[k] = centre + circumradius * P2{std::cos(angle), std::sin(angle)};
-          inside = inside && hex[k].x >= d.x0 + margin && hex[k].x <= d.x1 - margin &&
-                   hex[k].y >= d.y0 + margin && hex[k].y <= d.y1 - margin;
+          inside =
+              inside && hex[k].x >= d.x0 + margin && hex[k].x <= d.x1 - margin && hex[k].y >= d.y0 + margin && hex[k].y <= d.y1 - margin;
         }
       }
     if (!inside) continue;
@@ -115,8 +115,7 @@ std::vector<BodySpec> generateHexagonField(const HexagonFieldSpec& spec) {
     for (int r = 0; r < ny && separated; ++r)
       for (int i = 0; i < nx && separated; ++i) {
         const int left = r % 2 == 0 ? i - 1 : i;  // the lower of the two neighbours in the next row
-        separated = apart(r, i, r, i + 1) && apart(r, i, r + 1, left) && apart(r, i, r + 1, left + 1) &&
-                    apart(r, i, r + 2, i);
+        separated = apart(r, i, r, i + 1) && apart(r, i, r + 1, left) && apart(r, i, r + 1, left + 1) && apart(r, i, r + 2, i);
       }
     if (!separated) continue;
     std::vector<BodySpec> floes;
@@ -129,8 +128,8 @@ std::vector<BodySpec> generateHexagonField(const HexagonFieldSpec& spec) {
     sortAlongX(floes, centre);
     return floes;
   }
-  fail("field.concentration: ", spec.concentration, " cannot be reached within 0.01 by hexagons of field.size = ",
-       spec.size, " m in this domain, at least field.min_gap = ", spec.minGap, " m apart");
+  fail("field.concentration: ", spec.concentration, " cannot be reached within 0.01 by hexagons of field.size = ", spec.size,
+       " m in this domain, at least field.min_gap = ", spec.minGap, " m apart");
 }
 
 }  // namespace gem

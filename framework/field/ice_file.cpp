@@ -84,8 +84,7 @@ Real parseReal(std::string_view token, const SourceMap& src, std::ptrdiff_t offs
   Real value = 0;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
   if (ec == std::errc::result_out_of_range && end == t.data() + t.size())
-    throw src.error(offset, what() + " " + quoted(trim(token)) + " is out of range for a " +
-                                (sizeof(Real) == 8 ? "double" : "float"));
+    throw src.error(offset, what() + " " + quoted(trim(token)) + " is out of range for a " + (sizeof(Real) == 8 ? "double" : "float"));
   if (t.empty() || ec != std::errc() || end != t.data() + t.size())
     throw src.error(offset, what() + " " + quoted(trim(token)) + " is not a number");
   if (!std::isfinite(value)) throw src.error(offset, what() + " " + quoted(trim(token)) + " is not a finite number");
@@ -130,17 +129,15 @@ std::vector<Vec2> parseCoordinates(pugi::xml_node element, const SourceMap& src,
     numbers.push_back(parseReal(value.substr(start, k - start), src, offset, describe));
   }
   if (numbers.size() % 2 != 0)
-    throw src.error(element, what + ": odd number of coordinate values (" + std::to_string(numbers.size()) +
-                                 "); expected x y pairs");
+    throw src.error(element, what + ": odd number of coordinate values (" + std::to_string(numbers.size()) + "); expected x y pairs");
   std::vector<Vec2> points(numbers.size() / 2);
   for (size_t p = 0; p < points.size(); ++p) points[p] = {numbers[2 * p], numbers[2 * p + 1]};
   // A ring closed by repeating its first vertex is the same polygon; the repeat would be a
   // zero-length edge that convexity checks refuse.
-  if (points.size() > 3 && points.front().x == points.back().x && points.front().y == points.back().y)
-    points.pop_back();
+  if (points.size() > 3 && points.front().x == points.back().x && points.front().y == points.back().y) points.pop_back();
   if (points.size() < 3 || points.size() > static_cast<size_t>(kMaxVertices))
-    throw src.error(element, what + ": " + std::to_string(points.size()) + " vertices; a polygon needs 3 to " +
-                                 std::to_string(kMaxVertices));
+    throw src.error(element,
+                    what + ": " + std::to_string(points.size()) + " vertices; a polygon needs 3 to " + std::to_string(kMaxVertices));
   return points;
 }
 
@@ -177,8 +174,7 @@ IceObject parseObject(pugi::xml_node node, bool firstFrame, const SourceMap& src
     const pugi::xml_text text = t.text();
     const std::ptrdiff_t offset = text ? text.data().offset_debug() : t.offset_debug() - 1;
     object.thickness = parseReal(text ? text.get() : "", src, offset, [&] { return what + ": thickness"; });
-    if (!(object.thickness > 0))
-      throw src.error(offset, what + ": thickness " + quoted(trim(text.get())) + " must be positive");
+    if (!(object.thickness > 0)) throw src.error(offset, what + ": thickness " + quoted(trim(text.get())) + " must be positive");
     object.hasThickness = true;
   } else if (firstFrame) {
     throw src.error(node, what + " in frame 0 has no <thickness>");
@@ -227,16 +223,14 @@ std::vector<IceFrame> parseIceFile(const std::filesystem::path& path, bool frame
   std::string lower = rootName;
   std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
   if (lower != "icefloesim")
-    throw src.error(root, "expected the root element <iceFloeSim>, found " +
-                              (root ? "<" + rootName + ">" : std::string("no element")));
+    throw src.error(root, "expected the root element <iceFloeSim>, found " + (root ? "<" + rootName + ">" : std::string("no element")));
 
   std::vector<IceFrame> frames;
   std::unordered_set<std::int64_t> seenFrames;
   bool haveFrameZero = false;
   for (const pugi::xml_node f : root.children("frame")) {
     const std::int64_t index = parseIndex(f, "index", src, "frame");
-    if (index > std::numeric_limits<int>::max())
-      throw src.error(f, "frame index " + std::to_string(index) + " is too large");
+    if (index > std::numeric_limits<int>::max()) throw src.error(f, "frame index " + std::to_string(index) + " is too large");
     if (!seenFrames.insert(index).second) throw src.error(f, "duplicate frame index " + std::to_string(index));
     const bool firstFrame = index == 0;
     haveFrameZero = haveFrameZero || firstFrame;
@@ -253,8 +247,7 @@ std::vector<IceFrame> parseIceFile(const std::filesystem::path& path, bool frame
     for (const pugi::xml_node o : f.children("object")) {
       IceObject object = parseObject(o, firstFrame, src);
       if (!ids.insert(object.index).second)
-        throw src.error(o, "duplicate object index " + std::to_string(object.index) + " in frame " +
-                               std::to_string(index));
+        throw src.error(o, "duplicate object index " + std::to_string(object.index) + " in frame " + std::to_string(index));
       frame.objects.push_back(std::move(object));
     }
     frames.push_back(std::move(frame));
@@ -267,8 +260,8 @@ std::vector<IceFrame> parseIceFile(const std::filesystem::path& path, bool frame
     if (t.empty() || ec != std::errc() || end != t.data() + t.size() || declared < 0)
       throw src.error(root, "numFrames=" + quoted(n.value()) + " is not a non-negative integer");
     if (declared != std::ssize(seenFrames))
-      throw src.error(root, "numFrames=" + std::to_string(declared) + " but the file holds " +
-                                std::to_string(seenFrames.size()) + " frames");
+      throw src.error(root,
+                      "numFrames=" + std::to_string(declared) + " but the file holds " + std::to_string(seenFrames.size()) + " frames");
   }
   if (!haveFrameZero) throw src.error(root, "no frame with index 0 (the initial frame holding every object)");
   return frames;

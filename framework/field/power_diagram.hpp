@@ -27,10 +27,7 @@ struct Grid {
 // rectangle cut by the power bisector of every site that can reach it, nearest first.
 class PowerDiagram {
  public:
-  PowerDiagram(const std::vector<P2>& site, const Domain& d, const Grid& grid)
-      : m_site(site), m_domain(d), m_grid(grid) {
-    rebuild();
-  }
+  PowerDiagram(const std::vector<P2>& site, const Domain& d, const Grid& grid) : m_site(site), m_domain(d), m_grid(grid) { rebuild(); }
 
   // Sites bucketed by grid cell (counting sort: deterministic order within a cell); again after
   // the sites moved.

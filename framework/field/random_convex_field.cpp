@@ -79,8 +79,7 @@ class WeightedChoice {
 // metres) make the power weights of step 3 grow with the domain, and the diagram slow. A disk that
 // finds no place in kAttempts tries is shrunk by 10 % and tried again; at a packing fraction of
 // 0.45 that is rare.
-std::vector<P2> placeDisks(std::vector<double>& radius, const std::vector<double>& share, const Domain& d,
-                           const Grid& grid, Random& rng) {
+std::vector<P2> placeDisks(std::vector<double>& radius, const std::vector<double>& share, const Domain& d, const Grid& grid, Random& rng) {
   constexpr int kAttempts = 64;
   constexpr double kFloesPerBlock = 50;
   const size_t n = radius.size();
@@ -161,8 +160,8 @@ std::vector<double> fitAreas(const std::vector<double>& a, const std::vector<dou
 // floe to a group drawn with probability proportional to what the group still lacks (so every
 // group spreads over the whole domain), the last tenth largest first to the neediest group (so
 // the error ends near the size of a small floe).
-std::vector<int> assignGroups(const std::vector<double>& floeArea, const std::vector<ThicknessGroup>& groups,
-                              double domainArea, Random& rng) {
+std::vector<int> assignGroups(const std::vector<double>& floeArea, const std::vector<ThicknessGroup>& groups, double domainArea,
+                              Random& rng) {
   const size_t n = floeArea.size();
   std::vector<double> lack(groups.size());
   for (size_t g = 0; g < groups.size(); ++g) lack[g] = groups[g].coverage * domainArea;
@@ -172,7 +171,8 @@ std::vector<int> assignGroups(const std::vector<double>& floeArea, const std::ve
   const size_t randomPart = n - n / 10;
   std::sort(order.begin() + static_cast<std::ptrdiff_t>(randomPart), order.end(), [&](int a, int b) {
     return floeArea[static_cast<size_t>(a)] != floeArea[static_cast<size_t>(b)]
-               ? floeArea[static_cast<size_t>(a)] > floeArea[static_cast<size_t>(b)] : a < b;
+               ? floeArea[static_cast<size_t>(a)] > floeArea[static_cast<size_t>(b)]
+               : a < b;
   });
   for (size_t k = 0; k < n; ++k) {
     const size_t i = static_cast<size_t>(order[k]);
@@ -202,19 +202,17 @@ std::vector<BodySpec> generateRandomConvexField(const RandomFieldSpec& spec) {
   checkDomain(spec.domain);
   checkCommon(spec.concentration, spec.thickness, spec.minGap, spec.groups.empty());
   if (spec.count < 0) fail("field.count: expected a floe count >= 0 (0: from the size distribution), got ", spec.count);
-  if (!(spec.sizeMin > 0 && std::isfinite(spec.sizeMin)))
-    fail("field.size_min: expected a positive size in m, got ", spec.sizeMin);
+  if (!(spec.sizeMin > 0 && std::isfinite(spec.sizeMin))) fail("field.size_min: expected a positive size in m, got ", spec.sizeMin);
   if (!(spec.sizeMax >= spec.sizeMin && std::isfinite(spec.sizeMax)))
     fail("field.size_max: expected >= field.size_min = ", spec.sizeMin, " m, got ", spec.sizeMax);
   if (!(spec.sizeMean >= spec.sizeMin && spec.sizeMean <= spec.sizeMax))
-    fail("field.size_mean: expected within [field.size_min, field.size_max] = [", spec.sizeMin, ", ",
-         spec.sizeMax, "] m, got ", spec.sizeMean);
+    fail("field.size_mean: expected within [field.size_min, field.size_max] = [", spec.sizeMin, ", ", spec.sizeMax, "] m, got ",
+         spec.sizeMean);
   if (!(spec.sizeSd >= 0 && std::isfinite(spec.sizeSd))) fail("field.size_sd: expected >= 0 m, got ", spec.sizeSd);
   if (spec.minSides < 3 || spec.minSides > kMaxFloeVertices)
     fail("field.min_sides: expected 3 to ", kMaxFloeVertices, ", got ", spec.minSides);
   if (spec.maxSides < spec.minSides || spec.maxSides > kMaxFloeVertices)
-    fail("field.max_sides: expected field.min_sides = ", spec.minSides, " to ", kMaxFloeVertices, ", got ",
-         spec.maxSides);
+    fail("field.max_sides: expected field.min_sides = ", spec.minSides, " to ", kMaxFloeVertices, ", got ", spec.maxSides);
   if (!(spec.maxAspect >= Real(1.2))) fail("field.max_aspect: expected at least 1.2, got ", spec.maxAspect);
   double coverageSum = 0;
   for (size_t g = 0; g < spec.groups.size(); ++g) {
@@ -285,8 +283,7 @@ std::vector<BodySpec> generateRandomConvexField(const RandomFieldSpec& spec) {
     double sumS = 0;
     for (double a : target) sumS += std::sqrt(a);
     const double pad = 2 * insetBy, qa = iceArea, qb = 2 * pad * sumS, qc = pad * pad * nd - domainArea;
-    if (!(qc < 0))
-      fail("field.min_gap: ", spec.minGap, " m between ", n, " floes leaves no room for ice in this domain");
+    if (!(qc < 0)) fail("field.min_gap: ", spec.minGap, " m between ", n, " floes leaves no room for ice in this domain");
     const double beta = (-qb + std::sqrt(qb * qb - 4 * qa * qc)) / (2 * qa);
     for (size_t i = 0; i < n; ++i) {
       const double size = beta * std::sqrt(target[i]) + pad;
@@ -370,8 +367,7 @@ std::vector<BodySpec> generateRandomConvexField(const RandomFieldSpec& spec) {
     inset(cell, insetBy, shrunk);
     // The floe is this container shrunk by at least sqrt(a_i / room): its features are kept
     // above the rounding tolerance after that shrinking.
-    const double minFeature = std::max(1e-4 * std::sqrt(target[i]),
-                                       roundingTol * std::sqrt(std::max(1.0, area(shrunk) / target[i])));
+    const double minFeature = std::max(1e-4 * std::sqrt(target[i]), roundingTol * std::sqrt(std::max(1.0, area(shrunk) / target[i])));
     // Cutting corners can lengthen a polygon and trimming adds corners: twice each settles both.
     // Half the many-sided cells are cut to one corner fewer than allowed, so that the largest
     // floes (the cells with most neighbours) are not all maxSides-gons.

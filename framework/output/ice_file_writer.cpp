@@ -41,8 +41,7 @@ IceFileWriter::IceFileWriter(std::filesystem::path path) : m_path(std::move(path
   m_framesPath += ".frames.tmp-" + std::to_string(::getpid());
   errno = 0;
   m_frames.open(m_framesPath, std::ios::out | std::ios::trunc | std::ios::binary);
-  if (!m_frames)
-    throw std::runtime_error("cannot open " + m_framesPath.string() + " for writing: " + std::strerror(errno));
+  if (!m_frames) throw std::runtime_error("cannot open " + m_framesPath.string() + " for writing: " + std::strerror(errno));
 }
 
 IceFileWriter::~IceFileWriter() {
@@ -74,8 +73,7 @@ void IceFileWriter::addFrame(const World& world, double time) {
     bool coordinatesChanged = isNew || static_cast<size_t>(n) != w.coordinates.size();
     for (int k = 0; k < n && !coordinatesChanged; ++k)
       coordinatesChanged = differs(vertices[k].x, w.coordinates[k].x) || differs(vertices[k].y, w.coordinates[k].y);
-    const bool velocityChanged =
-        isNew || differs(world.vx[i], w.vx) || differs(world.vy[i], w.vy) || differs(world.omega[i], w.omega);
+    const bool velocityChanged = isNew || differs(world.vx[i], w.vx) || differs(world.vy[i], w.vy) || differs(world.omega[i], w.omega);
     const bool thicknessChanged = isNew || differs(world.thickness[i], w.thickness);
     const bool kindChanged = !isNew && world.kind[i] != w.kind;
     if (!coordinatesChanged && !velocityChanged && !thicknessChanged && !kindChanged) continue;

@@ -37,8 +37,7 @@ void applyOverride(toml::table& root, const std::string& assignment) {
   for (size_t i = 0; i + 1 < parts.size(); ++i) {
     toml::node* next = table->get(parts[i]);
     if (!next) next = &table->insert_or_assign(parts[i], toml::table{}).first->second;
-    if (!next->is_table())
-      throw InputError(fmt::format("--set {}: {} is not a table", assignment, parts[i]));
+    if (!next->is_table()) throw InputError(fmt::format("--set {}: {} is not a table", assignment, parts[i]));
     table = next->as_table();
   }
   table->insert_or_assign(parts.back(), *parsed.get("value"));
@@ -264,7 +263,6 @@ void readBroadphaseTables(const toml::table& tables, TableReader& top, Scenario&
 }
 
 }  // namespace
-
 
 const toml::table* Scenario::eventTable(const std::string& name) const {
   const toml::table* events = root["events"].as_table();

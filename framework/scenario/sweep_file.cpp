@@ -26,8 +26,10 @@ struct Leaf {
 void flatten(const toml::table& table, const std::string& prefix, std::vector<Leaf>& out) {
   for (const auto& [k, v] : table) {
     const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
-    if (const toml::table* sub = v.as_table()) flatten(*sub, key, out);
-    else out.push_back({key, &v});
+    if (const toml::table* sub = v.as_table())
+      flatten(*sub, key, out);
+    else
+      out.push_back({key, &v});
   }
 }
 
@@ -93,8 +95,8 @@ bool validName(const std::string& name) {
 
 SweepOverride makeOverride(const Leaf& leaf, bool varied) {
   const auto& src = leaf.node->source().begin;
-  return SweepOverride{leaf.key, tomlText(*leaf.node), plainText(*leaf.node), varied, static_cast<int>(src.line),
-                       static_cast<int>(src.column)};
+  return SweepOverride{leaf.key, tomlText(*leaf.node),       plainText(*leaf.node),
+                       varied,   static_cast<int>(src.line), static_cast<int>(src.column)};
 }
 
 fs::path resolveBase(TableReader& reader, const std::string& key, const std::string& text, const fs::path& folder) {
@@ -249,9 +251,9 @@ SweepDefinition readSweepFile(const fs::path& file) {
       sc.overrides.insert(sc.overrides.end(), e.set.begin(), e.set.end());
       sc.overrides.insert(sc.overrides.end(), c.overrides.begin(), c.overrides.end());
       if (auto [it, inserted] = seen.emplace(sc.name, def.cases.size()); !inserted)
-        throw InputError(def.fileName, sc.line, sc.column,
-                         fmt::format("two cases are named \"{}\" (cases {} and {}): case names must differ", sc.name, it->second,
-                                     def.cases.size()));
+        throw InputError(
+            def.fileName, sc.line, sc.column,
+            fmt::format("two cases are named \"{}\" (cases {} and {}): case names must differ", sc.name, it->second, def.cases.size()));
       def.cases.push_back(std::move(sc));
     }
   }

@@ -8,25 +8,25 @@ namespace gem {
 
 // One scenario key set by a sweep: becomes loadScenario's "key=toml" override.
 struct SweepOverride {
-  std::string key;      // dotted scenario key
-  std::string toml;     // the value in TOML syntax
-  std::string text;     // the value for names and summary.csv: shortest numbers, bare strings
-  bool varied = false;  // a column of summary.csv (from a case's set or [parameters], not sweep.set)
+  std::string key;           // dotted scenario key
+  std::string toml;          // the value in TOML syntax
+  std::string text;          // the value for names and summary.csv: shortest numbers, bare strings
+  bool varied = false;       // a column of summary.csv (from a case's set or [parameters], not sweep.set)
   int line = 0, column = 0;  // where the sweep file gives it
 };
 
 struct SweepCase {
   std::string name;
-  std::filesystem::path base;              // absolute
-  std::vector<SweepOverride> overrides;    // in the order they apply
-  int line = 0, column = 0;                // its [[cases]] entry, else [parameters]
+  std::filesystem::path base;            // absolute
+  std::vector<SweepOverride> overrides;  // in the order they apply
+  int line = 0, column = 0;              // its [[cases]] entry, else [parameters]
 };
 
 struct SweepDefinition {
-  std::filesystem::path file;            // absolute
-  std::string fileName;                  // as given, for messages
+  std::filesystem::path file;  // absolute
+  std::string fileName;        // as given, for messages
   std::string name;
-  std::vector<std::string> columns;      // the varied keys, [parameters] first, then the cases' set keys
+  std::vector<std::string> columns;  // the varied keys, [parameters] first, then the cases' set keys
   std::vector<SweepCase> cases;
 };
 

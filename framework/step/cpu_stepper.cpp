@@ -28,7 +28,8 @@ void validateBodySpec(BodySpec& spec, int maxVertices) {
     throw InputError(fmt::format("{}: thickness must be a positive number, got {}", spec.origin, spec.thickness));
   if (signedArea(spec.vertices.data(), n) < 0) reverseOrder(spec.vertices.data(), n);  // docs/model.md 1
   if (!isStrictlyConvexCCW(spec.vertices.data(), n, Real(1e-9)))
-    throw InputError(fmt::format("{}: the polygon is not convex (or is self-intersecting or has repeated or collinear vertices)", spec.origin));
+    throw InputError(
+        fmt::format("{}: the polygon is not convex (or is self-intersecting or has repeated or collinear vertices)", spec.origin));
 }
 
 // Static walls along the long sides of the domain (docs/scenario.md [domain] walls): the channel. They
@@ -44,7 +45,8 @@ static void addWalls(const Scenario& s, std::vector<BodySpec>& bodies) {
     wall.kind = BodyKind::Wall;
     wall.thickness = 10;
     wall.origin = side == 0 ? "domain wall (y0)" : "domain wall (y1)";
-    wall.vertices = {{x0, std::min(inner, outer)}, {x1, std::min(inner, outer)}, {x1, std::max(inner, outer)}, {x0, std::max(inner, outer)}};
+    wall.vertices = {
+        {x0, std::min(inner, outer)}, {x1, std::min(inner, outer)}, {x1, std::max(inner, outer)}, {x0, std::max(inner, outer)}};
     bodies.push_back(wall);
   }
 }
@@ -105,17 +107,15 @@ World buildWorld(const Scenario& s) {
     const int n = world.worldVertices(pair.a, p), m = world.worldVertices(pair.b, q);
     const Contact c = computeContact(p, n, world.position(pair.a), q, m, world.position(pair.b));
     if (c.touching)
-      throw InputError(fmt::format("{}: bodies overlap at the start: {} (id {}) and {} (id {}), overlap area {:.4g} m^2",
-                                   s.fileName, origins[pair.a], world.id[pair.a], origins[pair.b], world.id[pair.b], c.area));
+      throw InputError(fmt::format("{}: bodies overlap at the start: {} (id {}) and {} (id {}), overlap area {:.4g} m^2", s.fileName,
+                                   origins[pair.a], world.id[pair.a], origins[pair.b], world.id[pair.b], c.area));
   }
   return world;
 }
 
 CpuStepper::CpuStepper(const Scenario& scenario) : CpuStepper(scenario, buildWorld(scenario)) {}
 
-CpuStepper::CpuStepper(const Scenario& scenario, World world) : m_scenario(scenario), m_world(std::move(world)) {
-  setUp();
-}
+CpuStepper::CpuStepper(const Scenario& scenario, World world) : m_scenario(scenario), m_world(std::move(world)) { setUp(); }
 
 void CpuStepper::setUp() {
   m_broadphase = Registry::global().broadphase(m_scenario.broadphase).make(m_scenario.broadphaseSettings);
@@ -189,9 +189,8 @@ void CpuStepper::narrowphase() {
     // is exactly "not among the last step's contacts".)
     const bool touchedBefore = std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
     if (!m_moved[a] && !m_moved[b] && !touchedBefore) continue;
-    const Contact c = computeContact(&m_worldVertices[static_cast<size_t>(a) * kMaxVertices], m_world.vertexCount[a],
-                                     m_world.position(a), &m_worldVertices[static_cast<size_t>(b) * kMaxVertices],
-                                     m_world.vertexCount[b], m_world.position(b));
+    const Contact c = computeContact(&m_worldVertices[static_cast<size_t>(a) * kMaxVertices], m_world.vertexCount[a], m_world.position(a),
+                                     &m_worldVertices[static_cast<size_t>(b) * kMaxVertices], m_world.vertexCount[b], m_world.position(b));
     if (!c.touching) continue;
     const bool onset = !touchedBefore;
     m_contactA.push_back(a);
@@ -215,8 +214,8 @@ void CpuStepper::step() {
   // 3. Two-body events write into each contact's slot.
   m_pairBodies.resize(n);
   for (int i = 0; i < n; ++i)
-    m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof), &m_worldVertices[static_cast<size_t>(i) * kMaxVertices],
-                                 m_world.vertexCount[i]);
+    m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof),
+                                 &m_worldVertices[static_cast<size_t>(i) * kMaxVertices], m_world.vertexCount[i]);
   const int contacts = static_cast<int>(m_contacts.size());
   m_slots.assign(contacts, PairSlot{{0, 0}});
   // Records: each stream has room for one row per contact at first; an event may push more (a
@@ -233,9 +232,11 @@ void CpuStepper::step() {
       room = std::max(room, contacts);
       m_recordRows[static_cast<size_t>(s)].resize(static_cast<size_t>(room) * static_cast<size_t>(m_streams.info(s).stride));
       counts[static_cast<size_t>(s)] = 0;
-      sink.streams[s] = RecordBuffer{m_recordRows[static_cast<size_t>(s)].data(), m_streams.info(s).stride, room, &counts[static_cast<size_t>(s)]};
+      sink.streams[s] =
+          RecordBuffer{m_recordRows[static_cast<size_t>(s)].data(), m_streams.info(s).stride, room, &counts[static_cast<size_t>(s)]};
     }
-    PairPhaseData pairData{m_pairBodies.data(), m_contactA.data(), m_contactB.data(), m_contacts.data(), m_slots.data(), contacts, ctx, sink, 0};
+    PairPhaseData pairData{
+        m_pairBodies.data(), m_contactA.data(), m_contactB.data(), m_contacts.data(), m_slots.data(), contacts, ctx, sink, 0};
     for (auto& e : m_events)
       if (e.phase == EventPhase::Pair) {
         e.instance->runPairs(pairData);

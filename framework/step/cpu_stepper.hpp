@@ -54,7 +54,7 @@ class CpuStepper final : public Stepper {
   int contactCount() const override { return static_cast<int>(m_contacts.size()); }
   int candidateCount() const { return static_cast<int>(m_pairs.size()); }
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
-  int vesselSlot() const;                                   // -1 without a vessel
+  int vesselSlot() const;                                            // -1 without a vessel
 
   // Totals since the start.
   double rubbleMass() const override { return m_rubbleMass; }
@@ -76,7 +76,7 @@ class CpuStepper final : public Stepper {
 
   // Per-step buffers, kept to avoid allocation.
   std::vector<Vec2> m_worldVertices;  // kMaxVertices per body
-  std::vector<Box> m_boxes;  // world-aligned bounding box of each body, this step
+  std::vector<Box> m_boxes;           // world-aligned bounding box of each body, this step
   struct Pose {
     std::int64_t id;
     Real x, y, angle;
@@ -93,8 +93,8 @@ class CpuStepper final : public Stepper {
   std::vector<VelocityChange> m_changes;
   std::vector<MotionBody> m_motionBodies;
   std::vector<std::pair<std::int64_t, std::int64_t>> m_previousContacts, m_currentContacts;
-  RecordStreams m_streams;  // opened by the events as their Params are parsed
-  StepRecords m_records;    // the last step's rows
+  RecordStreams m_streams;                               // opened by the events as their Params are parsed
+  StepRecords m_records;                                 // the last step's rows
   std::vector<std::vector<unsigned char>> m_recordRows;  // per stream: the pair phase's buffer
   std::vector<int> m_recordRoom;                         // per stream: rows the buffer holds
   Vec2 m_vesselIceForce{0, 0};

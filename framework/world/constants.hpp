@@ -4,8 +4,8 @@
 #include "geometry/config.hpp"
 
 namespace gem {
-constexpr Real kRhoIce = 900;     // kg/m^3
-constexpr Real kRhoWater = 1025;  // kg/m^3
-constexpr Real kRhoAir = Real(1.3);  // kg/m^3
+constexpr Real kRhoIce = 900;          // kg/m^3
+constexpr Real kRhoWater = 1025;       // kg/m^3
+constexpr Real kRhoAir = Real(1.3);    // kg/m^3
 constexpr Real kGravity = Real(9.81);  // m/s^2
 }  // namespace gem

@@ -13,9 +13,8 @@ namespace gem {
 //   sides and the transom 0. The sloped bow is what lets floes fail in bending (F_lim finite).
 void defaultHull(Real length, Real beam, std::vector<Vec2>& vertices, std::vector<Real>& frameAnglesDeg) {
   const Real l = length, b = beam;
-  vertices = {{-0.5 * l, -0.5 * b}, {0.2 * l, -0.5 * b},   {0.35 * l, -0.4 * b}, {0.45 * l, -0.25 * b},
-              {0.5 * l, -0.075 * b}, {0.5 * l, 0.075 * b}, {0.45 * l, 0.25 * b},  {0.35 * l, 0.4 * b},
-              {0.2 * l, 0.5 * b},   {-0.5 * l, 0.5 * b}};
+  vertices = {{-0.5 * l, -0.5 * b}, {0.2 * l, -0.5 * b},  {0.35 * l, -0.4 * b}, {0.45 * l, -0.25 * b}, {0.5 * l, -0.075 * b},
+              {0.5 * l, 0.075 * b}, {0.45 * l, 0.25 * b}, {0.35 * l, 0.4 * b},  {0.2 * l, 0.5 * b},    {-0.5 * l, 0.5 * b}};
   frameAnglesDeg = {0, 30, 45, 55, 60, 55, 45, 30, 0, 0};
 }
 

@@ -25,7 +25,6 @@ struct VesselSpec {
 // The default hull: 100 m x 20 m with a sloped bow (see vessel.cpp for the numbers).
 void defaultHull(Real length, Real beam, std::vector<Vec2>& vertices, std::vector<Real>& frameAnglesDeg);
 
-
 // The hull in the ship's body frame about its area centroid, counter-clockwise, x forward.
 struct HullGeometry {
   std::vector<Vec2> vertices;

@@ -10,9 +10,12 @@ namespace gem {
 
 const char* bodyKindName(BodyKind kind) {
   switch (kind) {
-    case BodyKind::Floe: return "floe";
-    case BodyKind::Vessel: return "vessel";
-    case BodyKind::Wall: return "wall";
+    case BodyKind::Floe:
+      return "floe";
+    case BodyKind::Vessel:
+      return "vessel";
+    case BodyKind::Wall:
+      return "wall";
   }
   return "unknown";
 }
@@ -75,8 +78,8 @@ void World::removeBodies(const std::vector<char>& remove) {
   if (f == remove.size()) return;
   std::vector<std::function<void()>> small = {[&] { keepIf(id, remove, f); }, [&] { keepIf(kind, remove, f); },
                                               [&] { keepIf(vertexCount, remove, f); }};
-  for (std::vector<Real>* v : {&x, &y, &angle, &vx, &vy, &omega, &area, &thickness, &mass, &invMass, &invInertia, &gyration2,
-                               &gyrationX2, &gyrationY2, &principalAngle, &radius})
+  for (std::vector<Real>* v : {&x, &y, &angle, &vx, &vy, &omega, &area, &thickness, &mass, &invMass, &invInertia, &gyration2, &gyrationX2,
+                               &gyrationY2, &principalAngle, &radius})
     small.push_back([v, &remove, f] { keepIf(*v, remove, f); });
   // A break in a world of 10^5 floes or more: the vertices (60 % of the bytes) are compacted while
   // helper threads do the other arrays (at 10^6 floes one thread took 84 ms a break).
@@ -102,14 +105,26 @@ static void applyOrder(std::vector<T>& v, const std::vector<int>& order, size_t 
 }
 
 void World::permute(const std::vector<int>& order) {
-  applyOrder(id, order); applyOrder(kind, order); applyOrder(vertexCount, order);
+  applyOrder(id, order);
+  applyOrder(kind, order);
+  applyOrder(vertexCount, order);
   applyOrder(localVertices, order, kMaxVertices);
-  applyOrder(x, order); applyOrder(y, order); applyOrder(angle, order);
-  applyOrder(vx, order); applyOrder(vy, order); applyOrder(omega, order);
-  applyOrder(area, order); applyOrder(thickness, order); applyOrder(mass, order);
-  applyOrder(invMass, order); applyOrder(invInertia, order);
-  applyOrder(gyration2, order); applyOrder(gyrationX2, order); applyOrder(gyrationY2, order);
-  applyOrder(principalAngle, order); applyOrder(radius, order);
+  applyOrder(x, order);
+  applyOrder(y, order);
+  applyOrder(angle, order);
+  applyOrder(vx, order);
+  applyOrder(vy, order);
+  applyOrder(omega, order);
+  applyOrder(area, order);
+  applyOrder(thickness, order);
+  applyOrder(mass, order);
+  applyOrder(invMass, order);
+  applyOrder(invInertia, order);
+  applyOrder(gyration2, order);
+  applyOrder(gyrationX2, order);
+  applyOrder(gyrationY2, order);
+  applyOrder(principalAngle, order);
+  applyOrder(radius, order);
 }
 
 std::vector<int> World::curveOrder() const {

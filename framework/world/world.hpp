@@ -12,10 +12,7 @@
 
 namespace gem {
 
-
-
 const char* bodyKindName(BodyKind kind);
-
 
 // One body as given by a scenario, a field generator or a .ice file: world coordinates.
 struct BodySpec {
@@ -39,10 +36,10 @@ struct World {
   // Mass properties. invMass and invInertia are 0 for walls (immovable); the vessel's
   // constrained degrees of freedom are handled by its dof (see Vessel).
   std::vector<Real> area, thickness, mass, invMass, invInertia;
-  std::vector<Real> gyration2;       // r_z^2 = I_zz / A (floes), m^2: the 2D impulse's r^2
+  std::vector<Real> gyration2;               // r_z^2 = I_zz / A (floes), m^2: the 2D impulse's r^2
   std::vector<Real> gyrationX2, gyrationY2;  // principal r_x^2, r_y^2 (the 2.5D impact, A.80 to A.82)
-  std::vector<Real> principalAngle;  // body-frame angle of the principal x axis, rad
-  std::vector<Real> radius;          // bounding radius about the centroid, m
+  std::vector<Real> principalAngle;          // body-frame angle of the principal x axis, rad
+  std::vector<Real> radius;                  // bounding radius about the centroid, m
   std::int64_t nextId = 0;
 
   int size() const { return static_cast<int>(id.size()); }

@@ -52,7 +52,8 @@ static RaftingOnset::Params parseRaftingOnset(EventConfig& config) {
   return p;
 }
 
-GEM_REGISTER_PAIR_EVENT(RaftingOnset, "rafting_onset", "records floe-floe contact onsets of thin ice closing fast (rafting onset) to rafting.csv",
-                        false, parseRaftingOnset);
+GEM_REGISTER_PAIR_EVENT(RaftingOnset, "rafting_onset",
+                        "records floe-floe contact onsets of thin ice closing fast (rafting onset) to rafting.csv", false,
+                        parseRaftingOnset);
 
 }  // namespace gem

@@ -24,8 +24,8 @@ struct RaftingOnset {
     int logChannel;        // where onsets go: this run's rafting.csv
   };
 
-  GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact,
-                           PairSlot&, const StepContext& ctx, const RecordSink& sink) {
+  GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact, PairSlot&,
+                           const StepContext& ctx, const RecordSink& sink) {
     if (!contact.onset || a.kind != BodyKind::Floe || b.kind != BodyKind::Floe) return;
     const Real closing = closingSpeed(a, b, contact);
     const Real thinner = a.thickness < b.thickness ? a.thickness : b.thickness;

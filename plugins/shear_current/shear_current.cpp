@@ -21,7 +21,7 @@ static ShearCurrent::Params parseShearCurrent(EventConfig& config) {
 }
 
 // Off unless the scenario gives [events.shear_current]: loading a plugin changes nothing by itself.
-GEM_REGISTER_SOLO_EVENT(ShearCurrent, "shear_current", "current U(y) = u0 + shear (y - y_ref) along x, bulk stress rho_w C_w |U - v| (U - v)",
-                        false, parseShearCurrent);
+GEM_REGISTER_SOLO_EVENT(ShearCurrent, "shear_current",
+                        "current U(y) = u0 + shear (y - y_ref) along x, bulk stress rho_w C_w |U - v| (U - v)", false, parseShearCurrent);
 
 }  // namespace gem

@@ -58,9 +58,8 @@ class SweepAndPrune final : public Broadphase {
         pairs.push_back({std::min(a, b), std::max(a, b)});
       }
     }
-    std::sort(pairs.begin(), pairs.end(), [](const CandidatePair& p, const CandidatePair& q) {
-      return p.a != q.a ? p.a < q.a : p.b < q.b;
-    });
+    std::sort(pairs.begin(), pairs.end(),
+              [](const CandidatePair& p, const CandidatePair& q) { return p.a != q.a ? p.a < q.a : p.b < q.b; });
   }
 
  private:

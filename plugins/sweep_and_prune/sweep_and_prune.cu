@@ -47,8 +47,8 @@ class DeviceSweepAndPrune final : public cuda::CudaBroadphase {
     const size_t n = static_cast<size_t>(std::max(m_n, 1));
     m_start.ensure(n), m_sortedStart.ensure(n), m_slot.ensure(n), m_sortedSlot.ensure(n);
     size_t bytes = 0;  // CUB's scratch, sized here: nothing may be allocated inside the step's graph
-    GEM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, m_start.get(), m_sortedStart.get(), m_slot.get(),
-                                                   m_sortedSlot.get(), m_n));
+    GEM_CUDA_CHECK(
+        cub::DeviceRadixSort::SortPairs(nullptr, bytes, m_start.get(), m_sortedStart.get(), m_slot.get(), m_sortedSlot.get(), m_n));
     m_temp.ensure(std::max<size_t>(bytes, 1));
     m_tempBytes = bytes;
   }

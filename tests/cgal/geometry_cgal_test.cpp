@@ -85,8 +85,7 @@ Poly randomConvex(Rng& rng, Vec2 centre, double scale) {
     if (hull.size() < 3 || hull.size() > 19) continue;
     Poly p;
     for (auto& h : hull) p.push_back({Real(h.x()), Real(h.y())});
-    if (isStrictlyConvexCCW(p.data(), int(p.size())) && signedArea(p.data(), int(p.size())) > 1e-3 * scale * scale)
-      return p;
+    if (isStrictlyConvexCCW(p.data(), int(p.size())) && signedArea(p.data(), int(p.size())) > 1e-3 * scale * scale) return p;
   }
 }
 
@@ -340,8 +339,8 @@ void checkContact(const Poly& p, const Poly& q, double exactArea, bool borderlin
   }
   if (ex.size() == 2) {
     ++st.twoCrossings;
-    bool same = norm(c.cross0 - ex[0]) <= tol ? norm(c.cross1 - ex[1]) <= tol
-                                              : norm(c.cross0 - ex[1]) <= tol && norm(c.cross1 - ex[0]) <= tol;
+    bool same =
+        norm(c.cross0 - ex[0]) <= tol ? norm(c.cross1 - ex[1]) <= tol : norm(c.cross0 - ex[1]) <= tol && norm(c.cross1 - ex[0]) <= tol;
     EXPECT_TRUE(same);
     // n points from P into Q: P's vertices inside Q lie on the +n side of the line, Q's inside P on
     // the -n side (exact inside tests).
@@ -396,8 +395,8 @@ void runPairs(unsigned long long seed, int count) {
   EXPECT_GT(st.contained, count / 50);
   EXPECT_GT(st.twoCrossings, count / 5);
   EXPECT_GT(st.manyCrossings, 0);
-  std::printf("pairs %d overlapping %d contained %d two-crossing %d many-crossing %d borderline %d\n", st.pairs,
-              st.overlapping, st.contained, st.twoCrossings, st.manyCrossings, st.borderline);
+  std::printf("pairs %d overlapping %d contained %d two-crossing %d many-crossing %d borderline %d\n", st.pairs, st.overlapping,
+              st.contained, st.twoCrossings, st.manyCrossings, st.borderline);
 }
 
 }  // namespace
@@ -591,8 +590,8 @@ TEST(GeometryCgal, SplitByLine) {
     double area = toDouble(toPolygon(p).area());
     double tol = kRel * s + kMag * magnitudeOf(p);
     // A line through a random point near the polygon (it misses sometimes) or through a vertex.
-    Vec2 at = it % 10 == 0 ? p[size_t(rng.integer(0, n - 1))]
-                           : origin + Vec2{Real(rng.uniform(-1.1, 1.1) * s), Real(rng.uniform(-1.1, 1.1) * s)};
+    Vec2 at =
+        it % 10 == 0 ? p[size_t(rng.integer(0, n - 1))] : origin + Vec2{Real(rng.uniform(-1.1, 1.1) * s), Real(rng.uniform(-1.1, 1.1) * s)};
     double a = rng.uniform(0, 2 * kPi);
     Vec2 dir{Real(std::cos(a)), Real(std::sin(a))};
     int nl, nr;

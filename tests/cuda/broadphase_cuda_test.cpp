@@ -49,8 +49,7 @@ Trajectory runOnDevice(const Scenario& s, int steps) {
   return t;
 }
 
-Scenario withBroadphase(const TempDir& dir, const std::string& scene, const std::string& broadphase,
-                        std::vector<std::string> more = {}) {
+Scenario withBroadphase(const TempDir& dir, const std::string& scene, const std::string& broadphase, std::vector<std::string> more = {}) {
   more.push_back("simulation.broadphase=\"" + broadphase + "\"");
   return test::scenarioFromToml(dir, scene, more);
 }
@@ -109,8 +108,8 @@ TEST(CudaBroadphase, KeptListsRebuildByTheDisplacementRule) {
     for (int k = 0; k < 12; ++k) {
       const double x0 = row == 0 ? 0.0 : 9.0, y0 = 6.0 * k;
       scene += "[[floes]]\nvertices = [[" + std::to_string(x0) + ", " + std::to_string(y0) + "], [" + std::to_string(x0 + 4) + ", " +
-               std::to_string(y0) + "], [" + std::to_string(x0 + 4) + ", " + std::to_string(y0 + 4) + "], [" + std::to_string(x0) +
-               ", " + std::to_string(y0 + 4) + "]]\nthickness = 0.5\nvelocity = [" + (row == 0 ? "1.0" : "-1.0") + ", 0.1]\n";
+               std::to_string(y0) + "], [" + std::to_string(x0 + 4) + ", " + std::to_string(y0 + 4) + "], [" + std::to_string(x0) + ", " +
+               std::to_string(y0 + 4) + "]]\nthickness = 0.5\nvelocity = [" + (row == 0 ? "1.0" : "-1.0") + ", 0.1]\n";
     }
   TempDir dir;
   const std::vector<std::string> smallSkin{"simulation.skin=0.3"};
@@ -182,11 +181,12 @@ TEST(CudaBroadphase, PluginBroadphaseWithoutADevicePartIsRefusedByCudaAndRunsOnT
   for (const BroadphaseEntry* e : Registry::global().broadphases())
     if (e->name == "cpu_only_plugin_broadphase") known = e;
   if (!known)
-    Registry::global().addBroadphase(BroadphaseEntry{"cpu_only_plugin_broadphase", "test", "libpairs.so (pairs 1.0)",
-                                                     [](const BroadphaseSettings& s) -> std::unique_ptr<Broadphase> {
-                                                       return std::make_unique<PairsFromPlugin>(s);
-                                                     },
-                                                     {}});
+    Registry::global().addBroadphase(
+        BroadphaseEntry{"cpu_only_plugin_broadphase",
+                        "test",
+                        "libpairs.so (pairs 1.0)",
+                        [](const BroadphaseSettings& s) -> std::unique_ptr<Broadphase> { return std::make_unique<PairsFromPlugin>(s); },
+                        {}});
   TempDir dir;
   const std::string scene =
       "[simulation]\nsteps = 5\nbroadphase = \"cpu_only_plugin_broadphase\"\n"
@@ -214,7 +214,8 @@ TEST(CudaBroadphase, UniformGridHonoursCellSizeOnTheDevice) {
   const int steps = 150;
   const Trajectory grid = runOnDevice(test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"uniform_grid\""}), steps);
   for (const char* cell : {"1.5", "40.0"}) {
-    const Scenario s = test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"uniform_grid\"", std::string("simulation.cell_size=") + cell});
+    const Scenario s =
+        test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"uniform_grid\"", std::string("simulation.cell_size=") + cell});
     EXPECT_EQ(s.broadphaseSettings.cellSize, std::stod(cell));
     expectIdentical(grid, runOnDevice(s, steps), std::string("cell_size ") + cell);
   }
@@ -248,18 +249,18 @@ TEST(CudaBroadphase, ASettingTheDevicePartDoesNotHonourIsRefused) {
   bool known = false;
   for (const BroadphaseEntry* e : Registry::global().broadphases()) known = known || e->name == "skin_only_on_the_cpu";
   if (!known) {
-    Registry::global().addBroadphase(BroadphaseEntry{"skin_only_on_the_cpu", "test", "built-in",
-                                                     [](const BroadphaseSettings& s) -> std::unique_ptr<Broadphase> {
-                                                       return std::make_unique<SkinOnlyOnTheCpu>(s);
-                                                     },
-                                                     declaredBroadphaseSettings<SkinOnlyOnTheCpu>()});
+    Registry::global().addBroadphase(
+        BroadphaseEntry{"skin_only_on_the_cpu", "test", "built-in",
+                        [](const BroadphaseSettings& s) -> std::unique_ptr<Broadphase> { return std::make_unique<SkinOnlyOnTheCpu>(s); },
+                        declaredBroadphaseSettings<SkinOnlyOnTheCpu>()});
     cuda::addCudaBroadphase("skin_only_on_the_cpu", [](const BroadphaseSettings& s) -> std::unique_ptr<cuda::CudaBroadphase> {
       return std::make_unique<NoSettingsOnTheDevice>(s);
     });
   }
   TempDir dir;
-  const std::string scene = "[simulation]\nsteps = 5\nbroadphase = \"skin_only_on_the_cpu\"\n[broadphase.skin_only_on_the_cpu]\nskin = 1.0\n"
-                            "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
+  const std::string scene =
+      "[simulation]\nsteps = 5\nbroadphase = \"skin_only_on_the_cpu\"\n[broadphase.skin_only_on_the_cpu]\nskin = 1.0\n"
+      "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
   try {
     makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"cuda\""}));
     ADD_FAILURE() << "a setting the device part does not honour was accepted on cuda";
@@ -268,6 +269,7 @@ TEST(CudaBroadphase, ASettingTheDevicePartDoesNotHonourIsRefused) {
   }
   EXPECT_EQ(makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"auto\""}))->backend(), "cpu");
   // Without the setting it runs on the device.
-  const std::string plain = "[simulation]\nsteps = 5\nbroadphase = \"skin_only_on_the_cpu\"\n[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
+  const std::string plain =
+      "[simulation]\nsteps = 5\nbroadphase = \"skin_only_on_the_cpu\"\n[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
   EXPECT_EQ(makeStepper(test::scenarioFromToml(dir, plain, {"simulation.backend=\"cuda\""}))->backend(), "cuda");
 }

@@ -135,7 +135,8 @@ TEST(CudaBackend, BusyChannelMatchesTheCpuAfter50Steps) {
     ASSERT_EQ(::gem::test::impactsOf(cpu).size(), ::gem::test::impactsOf(gpu).size()) << "step " << k;
     for (size_t r = 0; r < ::gem::test::impactsOf(cpu).size(); ++r) {
       EXPECT_EQ(::gem::test::impactsOf(cpu)[r].floeId, ::gem::test::impactsOf(gpu)[r].floeId);
-      EXPECT_NEAR(::gem::test::impactsOf(cpu)[r].force, ::gem::test::impactsOf(gpu)[r].force, 1e-9 * std::fabs(::gem::test::impactsOf(cpu)[r].force) + 1e-9);
+      EXPECT_NEAR(::gem::test::impactsOf(cpu)[r].force, ::gem::test::impactsOf(gpu)[r].force,
+                  1e-9 * std::fabs(::gem::test::impactsOf(cpu)[r].force) + 1e-9);
     }
     cpuImpacts += static_cast<long>(::gem::test::impactsOf(cpu).size());
     gpuImpacts += static_cast<long>(::gem::test::impactsOf(gpu).size());
@@ -155,8 +156,8 @@ TEST(CudaBackend, BusyChannelSummaryMatchesTheCpuOver300Steps) {
   CpuStepper cpu(s);
   CudaStepper gpu(s);
   const State a = run(cpu, 300), b = run(gpu, 300);
-  std::printf("busy channel, 300 steps: impacts cpu %ld cuda %ld, broken cpu %ld cuda %ld, mean floe speed cpu %.6g cuda %.6g\n",
-              a.impacts, b.impacts, a.broken, b.broken, a.meanSpeed, b.meanSpeed);
+  std::printf("busy channel, 300 steps: impacts cpu %ld cuda %ld, broken cpu %ld cuda %ld, mean floe speed cpu %.6g cuda %.6g\n", a.impacts,
+              b.impacts, a.broken, b.broken, a.meanSpeed, b.meanSpeed);
   EXPECT_NEAR(static_cast<double>(b.impacts), static_cast<double>(a.impacts), 0.1 * a.impacts + 1);
   EXPECT_NEAR(static_cast<double>(b.broken), static_cast<double>(a.broken), 2.0);
   EXPECT_NEAR(b.meanSpeed, a.meanSpeed, 0.05 * a.meanSpeed);
@@ -195,7 +196,8 @@ TEST(CudaBackend, BreaksOnTheDeviceMatchTheWholeWorldRoundTrip) {
     long impactsA = 0, impactsB = 0;
     for (int k = 0; k < 200; ++k) {
       onDevice.step(), roundTrip.step();
-      impactsA += static_cast<long>(::gem::test::impactsOf(onDevice).size()), impactsB += static_cast<long>(::gem::test::impactsOf(roundTrip).size());
+      impactsA += static_cast<long>(::gem::test::impactsOf(onDevice).size()),
+          impactsB += static_cast<long>(::gem::test::impactsOf(roundTrip).size());
     }
     // No hostWorld() here: the mirror stays in the order before the device's re-sort at step 200.
     const long brokenBefore = onDevice.floesBroken();
@@ -461,7 +463,8 @@ TEST(CudaBackend, PluginEventsRunOnTheCpuUnderAutoAndAreRefusedByCuda) {
                                              return std::make_unique<CpuSoloDriver<NudgeFromPlugin>>(NudgeFromPlugin::Params{0.1});
                                            }});
   TempDir dir;
-  const std::string scene = "[simulation]\nsteps = 5\n[events.nudge_from_plugin]\n[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
+  const std::string scene =
+      "[simulation]\nsteps = 5\n[events.nudge_from_plugin]\n[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
   Scenario cuda = test::scenarioFromToml(dir, scene, {"simulation.backend=\"cuda\""});
   EXPECT_THROW(makeStepper(cuda), BackendUnsupported);
   Scenario automatic = test::scenarioFromToml(dir, scene, {"simulation.backend=\"auto\""});
@@ -645,7 +648,8 @@ set = { "simulation.steps" = 300, "simulation.backend" = "cuda", "simulation.bro
       << test::readFile(dir.path() / "log1.txt");
   ASSERT_EQ(0, test::runGem("sweep " + sweep.string() + " --batch 1 --out " + single.string(), dir.path() / "log2.txt"))
       << test::readFile(dir.path() / "log2.txt");
-  EXPECT_NE(test::readFile(dir.path() / "log1.txt").find("4 of them in 1 device run"), std::string::npos) << test::readFile(dir.path() / "log1.txt");
+  EXPECT_NE(test::readFile(dir.path() / "log1.txt").find("4 of them in 1 device run"), std::string::npos)
+      << test::readFile(dir.path() / "log1.txt");
   auto withoutTiming = [](std::string json) {
     for (const char* key : {"\"wall_time_s\"", "\"real_time_factor\"", "\"cases_on_device\""}) {
       const size_t at = json.find(key);

@@ -34,7 +34,8 @@ std::string shearScene(const std::string& plugin, int steps) {
          "[[floes]]\nvertices = [[5.5, -3.0], [15.5, -3.0], [15.5, 7.0], [5.5, 7.0]]\nthickness = 0.4\nvelocity = [-1.0, 0.0]\n"
          "[[floes]]\nvertices = [[-5.0, 35.0], [5.0, 35.0], [5.0, 45.0], [-5.0, 45.0]]\nthickness = 0.5\n"
          "[events.shear_current]\nu0 = 0.2\nshear = 0.01\n"
-         "[[plugins]]\npath = \"" + plugin + "\"\n";
+         "[[plugins]]\npath = \"" +
+         plugin + "\"\n";
 }
 
 std::vector<Real> state(Stepper& sim) {
@@ -69,7 +70,7 @@ TEST(CudaPlugin, RegistersItsDeviceDriverUnderItsOwnOrigin) {
   EXPECT_EQ(entry->origin, p.origin);
   EXPECT_NE(cuda::findCudaEvent("shear_current", p.origin), nullptr);
   EXPECT_EQ(cuda::findCudaEvent("shear_current"), nullptr);  // not a built-in's
-  EXPECT_NE(cuda::findCudaEvent("drag"), nullptr);            // the built-ins are untouched
+  EXPECT_NE(cuda::findCudaEvent("drag"), nullptr);           // the built-ins are untouched
 }
 
 TEST(CudaPlugin, ShearCurrentOnCudaMatchesTheCpu) {
@@ -88,8 +89,8 @@ TEST(CudaPlugin, ShearCurrentOnCudaMatchesTheCpu) {
   const std::vector<Real> a = state(cpu), b = state(gpu);
   ASSERT_EQ(a.size(), b.size());
   const double diff = relativeDifference(a, b);
-  std::printf("shear_current plugin, 20 steps: %zu bodies, %d contacts, max relative difference CUDA vs CPU %.3g\n",
-              a.size() / 6, contacts, diff);
+  std::printf("shear_current plugin, 20 steps: %zu bodies, %d contacts, max relative difference CUDA vs CPU %.3g\n", a.size() / 6, contacts,
+              diff);
   EXPECT_LT(diff, 1e-12);
   EXPECT_GT(contacts, 0);
   // The plugin's event really ran on the device: the floe at y = -40 drifts back (U < 0), the one
@@ -124,13 +125,14 @@ TEST(CudaPlugin, RaftingOnsetLogsTheSameRowsOnCudaAsOnTheCpu) {
   GEM_SKIP_WITHOUT_CUDA();
   const std::string plugin = test::cudaTestPlugin("librafting_onset.so");
   TempDir dir;
-  const std::filesystem::path scene = dir.write(
-      "rafting.toml",
-      "[simulation]\ndt = 0.1\nsteps = 60\nseed = 3\n[domain]\nx = [0.0, 120.0]\ny = [-40.0, 40.0]\nwalls = true\n"
-      "[field]\nkind = \"random_convex\"\nconcentration = 0.45\nsize_mean = 5.0\nsize_sd = 2.0\nsize_min = 2.0\nsize_max = 12.0\n"
-      "thickness = 0.4\n[vessel]\nposition = [-56.0, 0.0]\nbollard_thrust = 740e3\nopen_water_speed = 6.5\n"
-      "[events.rafting_onset]\nmin_closing_speed = 0.0\nmax_thickness = 1.0\n"
-      "[output]\nframe_every = 0\n[[plugins]]\npath = \"" + plugin + "\"\n");
+  const std::filesystem::path scene =
+      dir.write("rafting.toml",
+                "[simulation]\ndt = 0.1\nsteps = 60\nseed = 3\n[domain]\nx = [0.0, 120.0]\ny = [-40.0, 40.0]\nwalls = true\n"
+                "[field]\nkind = \"random_convex\"\nconcentration = 0.45\nsize_mean = 5.0\nsize_sd = 2.0\nsize_min = 2.0\nsize_max = 12.0\n"
+                "thickness = 0.4\n[vessel]\nposition = [-56.0, 0.0]\nbollard_thrust = 740e3\nopen_water_speed = 6.5\n"
+                "[events.rafting_onset]\nmin_closing_speed = 0.0\nmax_thickness = 1.0\n"
+                "[output]\nframe_every = 0\n[[plugins]]\npath = \"" +
+                    plugin + "\"\n");
   auto rows = [&](const std::string& backend) {
     const std::filesystem::path out = dir.path() / backend, log = dir.path() / (backend + ".log");
     EXPECT_EQ(0, test::runGem("run " + scene.string() + " --backend " + backend + " --quiet --out " + out.string(), log))

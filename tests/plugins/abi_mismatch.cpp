@@ -7,8 +7,8 @@
 GEM_PLUGIN_NOTE("999", GEM_REAL_NAME, "", GEM_COMPILER_ID, GEM_COMPILER_VERSION, GEM_VERSION, "abi_mismatch", "0.0.1");
 
 GEM_PLUGIN_EXPORT const GemPluginDescriptor* gem_plugin_descriptor() {
-  static const GemPluginDescriptor d{999, sizeof(gem::Real), "", GEM_COMPILER_ID, GEM_COMPILER_VERSION, GEM_VERSION,
-                                     "abi_mismatch", "0.0.1"};
+  static const GemPluginDescriptor d{999,         sizeof(gem::Real), "",     GEM_COMPILER_ID, GEM_COMPILER_VERSION,
+                                     GEM_VERSION, "abi_mismatch",    "0.0.1"};
   return &d;
 }
 GEM_PLUGIN_EXPORT void gem_plugin_register(gem::Registry*) { std::abort(); }

@@ -40,7 +40,7 @@ static void writeContactArea(const void* record, std::string& row) {
 
 GEM_REGISTER_RECORD_OUTPUT("contact_areas", "contact_areas.csv", "t,id_a,id_b,area_m2", writeContactArea, "contact_rows", "contact_area_m2",
                            [](const void* record) { return static_cast<double>(static_cast<const ContactArea*>(record)->area); });
-GEM_REGISTER_PAIR_EVENT(ContactAreaLog, "contact_area_log", "test plugin: the overlap area of floe-floe contacts, to contact_areas.csv", false,
-                        parseContactAreaLog);
+GEM_REGISTER_PAIR_EVENT(ContactAreaLog, "contact_area_log", "test plugin: the overlap area of floe-floe contacts, to contact_areas.csv",
+                        false, parseContactAreaLog);
 
 }  // namespace gem
