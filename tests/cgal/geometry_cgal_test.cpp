@@ -1,3 +1,4 @@
+// Over 500 lines on purpose: one file, so that CGAL (slow to compile) is compiled once, in one binary.
 // Property tests of the geometry headers against CGAL's exact kernel (docs/architecture.md "Tests"): random
 // convex polygons (random points -> convex hull, 3 to 19 vertices, 0.5 to 20 m), the second placed
 // near the first so that most pairs overlap. Every check runs in both argument orders. The inputs

@@ -1,3 +1,4 @@
+// Over 500 lines on purpose: the CUDA-vs-CPU cases share its trajectory helpers and tolerances.
 // CUDA vs CPU on small scenes, CUDA determinism, and `gem run --backend cuda` end to end.
 // Every test skips, visibly, where no CUDA device exists (CI), so the suite stays green there.
 //
