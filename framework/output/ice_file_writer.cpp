@@ -15,18 +15,10 @@
 
 #include "framework/api/errors.hpp"
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/number_text.hpp"
 
 namespace gem {
 namespace {
-
-// Shortest text that reads back to the identical value: exact round trips at no more length than
-// needed (0.7 stays "0.7"), for float and double builds alike.
-template <class T>
-void appendNumber(std::string& out, T value) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
-  out.append(buf, ec == std::errc() ? end : buf);
-}
 
 // Changed by more than 1e-9 relative (absolute below magnitude 1); NaN always counts as changed.
 bool differs(Real now, Real written) {

@@ -6,18 +6,11 @@
 #include <system_error>
 
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/number_text.hpp"
 
 namespace gem {
 
 namespace {
-
-// Shortest text that reads back to the same value (float and double builds alike).
-template <class T>
-void appendNumber(std::string& out, T value) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
-  out.append(buf, ec == std::errc() ? end : buf);
-}
 
 // VTK's name for the engine's floating-point type: a float build writes Float32 arrays.
 constexpr const char* kRealType = sizeof(Real) == 8 ? "Float64" : "Float32";
