@@ -62,6 +62,23 @@ std::vector<BadCase> badCases() {
       {"field_without_domain", kSim + "[field]\nconcentration = 0.3\n", {"[domain]"}},
       {"bad_concentration", kSim + kDomain + "[field]\nconcentration = 0.95\n", {"field.concentration"}},
       {"plugin_missing_file", kSim + "[[plugins]]\npath = \"libx.so\"\n", {"plugins.path", "libx.so", "no such file", ":5:"}},
+      // Hostile but fair (issue "Trust"): classes of input that crashed a parser or ran as nothing.
+      {"empty_file", "", {"empty"}},
+      {"only_comments", "# nothing but a comment\n", {"nothing in it"}},
+      {"dotted_key_50000_parts",
+       "[simulation]\n" +
+           [] {
+             std::string key = "a";
+             for (int k = 0; k < 50000; ++k) key += ".a";
+             return key + " = 1\n";
+           }(),
+       {"dotted key of more than 64 parts", ":2:"}},
+      {"arrays_50000_deep",
+       "[simulation]\nx = " + std::string(50000, '[') + std::string(50000, ']') + "\n",
+       {"nested more than 64 deep", ":2:"}},
+      {"tiny_dt_overflows_steps", "[simulation]\ndt = 1e-300\n", {"simulation.duration", "more than the 2e9"}},
+      {"huge_duration", "[simulation]\nduration = 1e300\n", {"simulation.duration", "more than the 2e9"}},
+      {"duration_below_one_step", "[simulation]\ndt = 0.1\nduration = 0.01\n", {"simulation.duration", "shorter than one step"}},
   };
 }
 
@@ -92,6 +109,38 @@ TEST_P(BadInput, ExitsWithStatus2AndAClearMessageAndWritesNoSummary) {
 
 INSTANTIATE_TEST_SUITE_P(Cases, BadInput, ::testing::ValuesIn(badCases()),
                          [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
+
+// Things that are not scenario files, numbers on the command line that would be ignored or overflow,
+// and a token too long to echo: exit 2, one short message naming the file or the option.
+TEST(BadInputCli, NotAScenarioFileAndBadNumbersOnTheCommandLine) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  const auto good = dir.write("good.toml", kSim);
+  std::filesystem::create_directories(dir.path() / "folder.toml");
+  const struct {
+    std::string arguments, expected;
+  } cases[] = {
+      {"run " + (dir.path() / "folder.toml").string(), "a folder, not a scenario file"},
+      {"run /dev/zero", "not a regular file"},
+      {"run " + good.string() + " --steps -5", "--steps -5"},
+      {"run " + good.string() + " --steps 0", "--steps 0"},
+      {"run " + good.string() + " --duration nan", "--duration nan"},
+      {"run " + good.string() + " --duration 1e300", "a run takes 1 to 2e9 steps"},
+      {"sweep " + (dir.path() / "folder.toml").string(), "a folder, not a sweep file"},
+      {"sweep " + dir.write("empty_sweep.toml", "").string(), "empty"},
+  };
+  for (const auto& c : cases) {
+    EXPECT_EQ(gem::test::runGem(c.arguments + " --quiet --out " + (dir.path() / "out").string(), log), 2) << c.arguments;
+    const std::string text = gem::test::readFile(log);
+    EXPECT_NE(text.find(c.expected), std::string::npos) << c.arguments << ": " << text;
+    EXPECT_LE(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "summary.json")) << c.arguments;
+  }
+  // A 5 MB token in an unknown key is not echoed whole.
+  const auto huge = dir.write("huge.toml", kSim + "[simulation.extra]\n" + std::string(5000000, 'k') + " = 1\n");
+  EXPECT_EQ(gem::test::runGem("check " + huge.string(), log), 2);
+  EXPECT_LT(std::filesystem::file_size(log), 2000u) << "the message echoes the whole token";
+}
 
 TEST(BadInputCli, MissingScenarioFileAndUnknownOptionExit2) {
   TempDir dir;

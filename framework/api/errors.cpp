@@ -4,6 +4,13 @@
 
 namespace gem {
 
+std::string InputError::shorten(const std::string& message) {
+  if (message.size() <= kMaxMessage) return message;
+  const size_t head = kMaxMessage * 2 / 3, tail = kMaxMessage / 4;
+  return message.substr(0, head) + fmt::format(" [... {} characters left out ...] ", message.size() - head - tail) +
+         message.substr(message.size() - tail);
+}
+
 std::string InputError::format(const std::string& file, int line, int column, const std::string& message) {
   if (file.empty()) return message;
   if (line > 0 && column > 0) return fmt::format("{}:{}:{}: {}", file, line, column, message);

@@ -8,10 +8,14 @@ namespace gem {
 
 class InputError : public std::runtime_error {
  public:
-  explicit InputError(const std::string& message) : std::runtime_error(message) {}
+  // A message longer than kMaxMessage is cut in its middle (a 200 MB token must not be echoed whole).
+  explicit InputError(const std::string& message) : std::runtime_error(shorten(message)) {}
   // "FILE:LINE:COL: message" (line/column 0 are left out).
   InputError(const std::string& file, int line, int column, const std::string& message)
-      : std::runtime_error(format(file, line, column, message)) {}
+      : std::runtime_error(shorten(format(file, line, column, message))) {}
+
+  static constexpr size_t kMaxMessage = 1000;
+  static std::string shorten(const std::string& message);
 
  private:
   static std::string format(const std::string& file, int line, int column, const std::string& message);

@@ -33,6 +33,7 @@ struct RunArguments {
   std::string scenario, out, backend, broadphase;
   double duration = 0;
   long steps = 0;
+  bool durationGiven = false, stepsGiven = false;  // set from the command line's counts
   std::vector<std::string> set;
   bool quiet = false;
 };
@@ -42,10 +43,18 @@ Scenario load(const RunArguments& a) {
   if (!a.backend.empty()) overrides.push_back("simulation.backend=\"" + a.backend + "\"");
   if (!a.broadphase.empty()) overrides.push_back("simulation.broadphase=\"" + a.broadphase + "\"");
   Scenario s = loadScenario(a.scenario, overrides);
-  if (a.duration > 0) {
+  // --duration and --steps, when given, must make a run of 1 to 2e9 steps: never silently ignored.
+  if (a.durationGiven) {
+    const double count = a.duration / static_cast<double>(s.dt);
+    if (!(a.duration > 0) || !std::isfinite(a.duration))
+      throw InputError(fmt::format("--duration {}: expected a positive number of seconds", a.duration));
+    if (!(count >= 0.5 && count <= 2e9))
+      throw InputError(fmt::format("--duration {}: {:.3g} steps of dt = {} s; a run takes 1 to 2e9 steps", a.duration, count, s.dt));
     s.duration = static_cast<Real>(a.duration);
-    s.steps = std::lround(a.duration / s.dt);
+    s.steps = std::lround(count);
   }
+  if (a.stepsGiven && !(a.steps >= 1 && a.steps <= 2000000000))
+    throw InputError(fmt::format("--steps {}: expected a whole number from 1 to 2e9", a.steps));
   if (a.steps > 0) {
     s.steps = a.steps;
     s.duration = static_cast<Real>(a.steps) * s.dt;
@@ -142,8 +151,9 @@ int main(int argc, char** argv) {
     c->add_option("scenario", args.scenario, "scenario file (TOML)")->required();
     c->add_option("--backend", args.backend, "auto, cpu or cuda");
     c->add_option("--broadphase", args.broadphase, "broadphase strategy by name (see gem info)");
-    auto* duration = c->add_option("--duration", args.duration, "simulated time, s");
-    c->add_option("--steps", args.steps, "number of steps")->excludes(duration);
+    auto* duration =
+        c->add_option("--duration", args.duration, "simulated time, s")->each([&](const std::string&) { args.durationGiven = true; });
+    c->add_option("--steps", args.steps, "number of steps")->excludes(duration)->each([&](const std::string&) { args.stepsGiven = true; });
     c->add_option("--set", args.set, "override a scenario key: --set simulation.dt=0.05")->take_all();
   };
   CLI::App* run = app.add_subcommand("run", "run a scenario and write its outputs");

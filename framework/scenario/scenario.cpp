@@ -10,6 +10,7 @@
 #include "framework/api/errors.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/api/table_reader.hpp"
+#include "framework/scenario/toml_limits.hpp"
 
 namespace fs = std::filesystem;
 
@@ -23,6 +24,7 @@ void applyOverride(toml::table& root, const std::string& assignment) {
   if (eq == std::string::npos || eq == 0)
     throw InputError(fmt::format("--set {}: expected KEY=VALUE, e.g. simulation.dt=0.05", assignment));
   const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  checkTomlLimits(assignment, "--set");
   toml::table parsed;
   try {
     parsed = toml::parse("value = " + text);
@@ -272,15 +274,17 @@ const toml::table* Scenario::eventTable(const std::string& name) const {
 Scenario loadScenario(const fs::path& file, const std::vector<std::string>& overrides) {
   Scenario s;
   s.fileName = file.string();
-  if (!fs::exists(file)) throw InputError(fmt::format("{}: no such scenario file", s.fileName));
+  const std::string text = readTomlFile(s.fileName, "scenario");  // bounded before the parser sees it
   s.file = fs::absolute(file);
   try {
-    s.root = toml::parse_file(s.file.string());
+    s.root = toml::parse(text, s.file.string());
   } catch (const toml::parse_error& e) {
     throw InputError(s.fileName, static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
                      std::string(e.description()));
   }
   for (const std::string& o : overrides) applyOverride(s.root, o);
+  if (s.root.empty())
+    throw InputError(fmt::format("{}: nothing in it: a scenario needs at least a [simulation] table or bodies", s.fileName));
 
   TableReader top(&s.root, "", s.fileName);
   // Plugins first: their events and broadphases are valid names in the sections below.
@@ -293,6 +297,13 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
     s.duration = t.getPositive("duration", s.duration);
     const std::int64_t steps = t.getInt("steps", 0, 1, 2000000000);
     if (hasSteps && t.has("duration")) t.fail("steps", "give either duration or steps, not both");
+    if (!hasSteps) {
+      // duration / dt is checked as a double before it becomes a count: 1e300 s, or dt = 1e-300 s,
+      // would overflow it (docs/scenario.md: at most 2e9 steps).
+      const double count = static_cast<double>(s.duration) / static_cast<double>(s.dt);
+      if (!(count >= 0.5)) t.fail("duration", fmt::format("shorter than one step of dt = {} s", s.dt));
+      if (!(count <= 2e9)) t.fail("duration", fmt::format("duration / dt = {:.3g} steps, more than the 2e9 a run may take", count));
+    }
     s.steps = hasSteps ? static_cast<long>(steps) : static_cast<long>(std::llround(s.duration / s.dt));
     if (hasSteps) s.duration = static_cast<Real>(s.steps) * s.dt;
     s.backend = t.getChoice("backend", "auto", {"auto", "cpu", "cuda"});

@@ -10,6 +10,7 @@
 
 #include "framework/api/errors.hpp"
 #include "framework/api/table_reader.hpp"
+#include "framework/scenario/toml_limits.hpp"
 
 namespace fs = std::filesystem;
 
@@ -158,12 +159,12 @@ std::string sweepCell(const SweepCase& c, const std::string& key) {
 SweepDefinition readSweepFile(const fs::path& file) {
   SweepDefinition def;
   def.fileName = file.string();
-  if (!fs::is_regular_file(file)) throw InputError(fmt::format("{}: no such sweep file", def.fileName));
+  const std::string text = readTomlFile(def.fileName, "sweep");  // bounded before the parser sees it
   def.file = fs::absolute(file).lexically_normal();
   const fs::path folder = def.file.parent_path();
   toml::table root;
   try {
-    root = toml::parse_file(def.file.string());
+    root = toml::parse(text, def.file.string());
   } catch (const toml::parse_error& e) {
     throw InputError(def.fileName, static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
                      std::string(e.description()));
