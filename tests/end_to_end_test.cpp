@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <set>
+#include <sstream>
+#include <string>
 
 #include "framework/field/ice_file.hpp"
 #include "framework/api/registry.hpp"
@@ -142,4 +145,29 @@ TEST(GemCheck, ValidatesEveryThesisScenario) {
     const std::string file = std::string(GEM_SOURCE_DIR) + "/scenarios/thesis/" + name + ".toml";
     EXPECT_EQ(test::runGem("check " + file, dir.path() / "log.txt"), 0) << test::readFile(dir.path() / "log.txt");
   }
+}
+
+// A .ice field (object indices 0, 1) with the domain's walls: the floes keep their ids, the walls
+// get ids after them, and gem check and gem run agree (run used to fail on duplicate ids).
+TEST(GemRun, AnIceFieldWithWallsHasUniqueIds) {
+  test::TempDir dir;
+  dir.write("pack.ice",
+            "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\" time=\"0\">\n"
+            "<object index=\"0\"><coordinates>10 0 20 0 20 10 10 10</coordinates><thickness>1</thickness></object>\n"
+            "<object index=\"1\"><coordinates>30 0 40 0 40 10 30 10</coordinates><thickness>1</thickness></object>\n"
+            "</frame>\n</iceFloeSim>\n");
+  const auto scenario = dir.write("walls.toml",
+                                  "[simulation]\ndt = 0.1\nsteps = 5\n[domain]\nx = [0.0, 100.0]\ny = [-20.0, 30.0]\nwalls = true\n"
+                                  "[field]\nkind = \"file\"\nfile = \"pack.ice\"\n");
+  EXPECT_EQ(test::runGem("check " + scenario.string() + " --quiet", dir.path() / "log"), 0) << test::readFile(dir.path() / "log");
+  ASSERT_EQ(test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / "out").string(), dir.path() / "log"), 0)
+      << test::readFile(dir.path() / "log");
+  std::istringstream rows(test::readFile(dir.path() / "out" / "state.csv"));
+  std::string row;
+  std::getline(rows, row);  // header
+  std::set<long> ids;
+  int count = 0;
+  while (std::getline(rows, row)) ++count, ids.insert(std::stol(row.substr(0, row.find(','))));
+  EXPECT_EQ(count, 4);
+  EXPECT_EQ(ids, (std::set<long>{0, 1, 2, 3}));  // the floes 0 and 1 as in the file, then the walls
 }

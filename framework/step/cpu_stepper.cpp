@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -75,7 +76,17 @@ World buildWorld(const Scenario& s) {
   }
   bodies.insert(bodies.end(), s.floes.begin(), s.floes.end());
 
+  // Ids are unique: bodies given with ids (a .ice field's object indices) keep them, and the ones
+  // without (walls, generated floes, the vessel) are numbered after the largest given id, whatever
+  // their order. Two bodies given the same id are refused, naming both.
   World world;
+  std::map<std::int64_t, const std::string*> given;
+  for (const BodySpec& spec : bodies) {
+    if (spec.id < 0 || spec.kind == BodyKind::Vessel) continue;
+    const auto [it, fresh] = given.emplace(spec.id, &spec.origin);
+    if (!fresh) throw InputError(fmt::format("{}: two bodies have the id {}: {} and {}", s.fileName, spec.id, *it->second, spec.origin));
+    world.nextId = std::max(world.nextId, spec.id + 1);
+  }
   std::vector<std::string> origins;
   for (BodySpec& spec : bodies) {
     if (spec.kind == BodyKind::Vessel) continue;  // a vessel comes from [vessel]
