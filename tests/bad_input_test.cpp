@@ -78,6 +78,10 @@ std::vector<BadCase> badCases() {
        {"nested more than 64 deep", ":2:"}},
       {"tiny_dt_overflows_steps", "[simulation]\ndt = 1e-300\n", {"simulation.duration", "more than the 2e9"}},
       {"huge_duration", "[simulation]\nduration = 1e300\n", {"simulation.duration", "more than the 2e9"}},
+      {"non_convex_hull",
+       kSim + "[vessel]\nvertices = [[-50.0, -10.0], [50.0, -10.0], [0.0, 0.0], [50.0, 10.0], [-50.0, 10.0]]\n"
+              "frame_angle_deg = [80.0, 30.0, 30.0, 80.0, 80.0]\n",
+       {"vessel.vertices", "not convex"}},
       {"duration_below_one_step", "[simulation]\ndt = 0.1\nduration = 0.01\n", {"simulation.duration", "shorter than one step"}},
   };
 }

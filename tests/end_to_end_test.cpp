@@ -171,3 +171,23 @@ TEST(GemRun, AnIceFieldWithWallsHasUniqueIds) {
   EXPECT_EQ(count, 4);
   EXPECT_EQ(ids, (std::set<long>{0, 1, 2, 3}));  // the floes 0 and 1 as in the file, then the walls
 }
+
+// A state that is no longer finite stops the run: exit 1, the body and the step named, what was
+// written kept whole (no NaN in any file), and no summary.json.
+TEST(GemRun, ANonFiniteStateStopsTheRunNamingTheBodyAndStep) {
+  test::TempDir dir;
+  const auto scenario = dir.write("fast.toml",
+                                  "[simulation]\ndt = 0.1\nsteps = 50\n[[floes]]\n"
+                                  "vertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\nvelocity = [1e300, 0.0]\n");
+  const auto out = dir.path() / "out";
+  EXPECT_EQ(test::runGem("run " + scenario.string() + " --quiet --out " + out.string(), dir.path() / "log"), 1);
+  const std::string log = test::readFile(dir.path() / "log");
+  EXPECT_NE(log.find("body 0 (floe)"), std::string::npos) << log;
+  EXPECT_NE(log.find("no longer finite"), std::string::npos) << log;
+  EXPECT_NE(log.find("step "), std::string::npos) << log;
+  EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
+  const std::string series = test::readFile(out / "timeseries.csv");
+  EXPECT_EQ(series.rfind("t,", 0), 0u) << series;
+  EXPECT_EQ(series.find("nan"), std::string::npos) << series;
+  EXPECT_EQ(series.find("inf"), std::string::npos) << series;
+}

@@ -26,6 +26,9 @@ struct GoldenScene {
   std::vector<std::string> overrides;
 };
 
+// gtest names a parameter by this (not by its bytes) in ctest's listing.
+inline void PrintTo(const GoldenScene& scene, std::ostream* os) { *os << scene.name; }
+
 // At most this many steps of each scene: long enough for the vessel to meet the ice, re-sort
 // three or more times and break floes; short enough for a test of a few seconds.
 inline constexpr long kGoldenSteps = 1000;

@@ -71,6 +71,7 @@ TEST(PluginErrors, EachExitsWithStatus2NamingTheFileAndTheCause) {
       {plugin("real_mismatch"), "real type"},
       {plugin("compiler_mismatch"), "compiler TurboC 3.0.0"},
       {dir.write("text.so", "not a library\n").string(), "cannot be loaded"},
+      {plugin("throws_int"), "not a std::exception"},
   };
   for (const auto& c : cases) {
     EXPECT_EQ(gem::test::runGem("info --plugin " + c.file, log), 2) << c.file;

@@ -316,6 +316,16 @@ TEST(SweepSummary, ReadsGemJson) {
   EXPECT_EQ(s.at("ship_speed.mean"), "");
   EXPECT_EQ(s.at("ok"), "true");
   EXPECT_THROW(readSummaryJson(dir.write("bad.json", "{\"a\": }")), std::runtime_error);
+  // Nested 50,000 deep (a damaged file in a sweep being resumed): refused, not a stack overflow.
+  std::string deep = "{\"a\": ";
+  for (int k = 0; k < 50000; ++k) deep += "{\"a\": ";
+  deep += "1" + std::string(50001, '}');
+  try {
+    readSummaryJson(dir.write("deep.json", deep));
+    ADD_FAILURE() << "a summary nested 50,000 deep was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nested more than 64 deep"), std::string::npos) << e.what();
+  }
 }
 
 // Bad sweep files: exit 2 through the real binary, naming the sweep file's line and column.

@@ -72,9 +72,14 @@ class JsonReader {
     ++m_pos;
     return s;
   }
-  void value(const std::string& key, std::map<std::string, std::string>& out) {
+  // Nesting is bounded: a summary.json nested 50,000 deep (a damaged or hostile file) must not
+  // overflow the stack of this recursive reader; GEM's own are 2 deep.
+  static constexpr int kMaxDepth = 64;
+
+  void value(const std::string& key, std::map<std::string, std::string>& out, int depth = 0) {
     skipSpace();
     if (m_pos >= m_text.size()) fail("unexpected end");
+    if (depth > kMaxDepth) fail(fmt::format("nested more than {} deep", kMaxDepth));
     const char c = m_text[m_pos];
     if (c == '{') {
       ++m_pos;
@@ -83,14 +88,14 @@ class JsonReader {
         skipSpace();
         const std::string name = string();
         expect(':');
-        value(key.empty() ? name : key + "." + name, out);
+        value(key.empty() ? name : key + "." + name, out, depth + 1);
       } while (take(','));
       expect('}');
     } else if (c == '[') {
       ++m_pos;
       std::map<std::string, std::string> ignored;
       if (take(']')) return;
-      do value(key, ignored);
+      do value(key, ignored, depth + 1);
       while (take(','));
       expect(']');
     } else if (c == '"') {

@@ -130,6 +130,9 @@ const LoadedPlugin& loadLocked(LoaderState& st, const fs::path& given, bool allo
   } catch (const std::exception& e) {
     registry.abortPlugin();
     throw InputError(fmt::format("plugin {}: its registration failed: {}", file, e.what()));
+  } catch (...) {  // a plugin may throw anything: never let it end the process
+    registry.abortPlugin();
+    throw InputError(fmt::format("plugin {}: its registration failed with an exception that is not a std::exception", file));
   }
   st.plugins.push_back(plugin);
   return st.plugins.back();

@@ -98,7 +98,7 @@ World buildWorld(const Scenario& s) {
     HullGeometry hull = hullGeometry(s.vessel);
     BodySpec check;
     check.kind = BodyKind::Vessel;
-    check.origin = "vessel hull";
+    check.origin = s.fileName + ": vessel.vertices (the hull)";
     check.vertices = hull.vertices;
     check.thickness = s.vessel.draft;
     validateBodySpec(check, kMaxVertices);
