@@ -1,6 +1,10 @@
 // End to end: whole scenarios through the scheduler and the gem binary.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <cstring>
 #include <set>
 #include <sstream>
@@ -190,4 +194,48 @@ TEST(GemRun, ANonFiniteStateStopsTheRunNamingTheBodyAndStep) {
   EXPECT_EQ(series.rfind("t,", 0), 0u) << series;
   EXPECT_EQ(series.find("nan"), std::string::npos) << series;
   EXPECT_EQ(series.find("inf"), std::string::npos) << series;
+}
+
+// One run writes into a run folder at a time: while another process holds the folder's lock, gem
+// run is refused (exit 2, naming the folder); once it is free the run goes ahead and leaves no lock.
+TEST(GemRun, ARunFolderInUseIsRefused) {
+  test::TempDir dir;
+  const auto scenario = dir.write("busy.toml", test::kBusyScene);
+  const auto out = dir.path() / "out";
+  std::filesystem::create_directories(out);
+  const int fd = ::open((out / ".gem-run.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  EXPECT_EQ(test::runGem("run " + scenario.string() + " --quiet --steps 5 --out " + out.string(), dir.path() / "log"), 2);
+  const std::string log = test::readFile(dir.path() / "log");
+  EXPECT_NE(log.find("another gem run is writing into this run folder"), std::string::npos) << log;
+  EXPECT_FALSE(std::filesystem::exists(out / "timeseries.csv"));
+  ::close(fd);
+  EXPECT_EQ(test::runGem("run " + scenario.string() + " --quiet --steps 5 --out " + out.string(), dir.path() / "log"), 0)
+      << test::readFile(dir.path() / "log");
+  EXPECT_FALSE(std::filesystem::exists(out / ".gem-run.lock"));
+}
+
+// SIGTERM (as Ctrl-C) stops a run between two steps: exit 128 + 15, a message, the CSVs whole under
+// their final names, no temporary left behind, no summary.json.
+TEST(GemRun, SigtermKeepsTheFilesWholeAndSaysSo) {
+  test::TempDir dir;
+  const auto scenario = dir.write("busy.toml", test::kBusyScene);
+  const auto out = dir.path() / "out";
+  const std::string gem = std::string(std::getenv("GEM_BINARY_DIR") ? std::getenv("GEM_BINARY_DIR") : GEM_BINARY_DIR) + "/gem";
+  const std::string command = "bash -c '" + gem + " run " + scenario.string() +
+                              " --quiet --steps 2000000 --set output.frame_every=0 --out " + out.string() + " > " +
+                              (dir.path() / "log").string() + " 2>&1 & p=$!; sleep 1; kill -TERM $p; wait $p; exit $?'";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 128 + 15) << test::readFile(dir.path() / "log");
+  const std::string log = test::readFile(dir.path() / "log");
+  EXPECT_NE(log.find("interrupted (SIGTERM)"), std::string::npos) << log;
+  const std::string series = test::readFile(out / "timeseries.csv");
+  EXPECT_EQ(series.rfind("t,", 0), 0u);
+  EXPECT_EQ(series.back(), '\n');  // whole rows
+  EXPECT_TRUE(std::filesystem::exists(out / "impacts.csv"));
+  EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
+  for (const auto& entry : std::filesystem::directory_iterator(out))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
 }

@@ -15,6 +15,7 @@
 #include "bench/bench.hpp"
 #include "framework/app/calibration.hpp"
 #include "framework/api/errors.hpp"
+#include "framework/app/interrupt.hpp"
 #include "framework/app/plugin_loader.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/app/runner.hpp"
@@ -225,6 +226,7 @@ int main(int argc, char** argv) {
     // GEM_PLUGIN_PATH's plugins, for every command: a scenario, gem bench --broadphase or gem info
     // may name what they add.
     loadEnvironmentPlugins();
+    catchInterrupts();  // Ctrl-C and SIGTERM stop a run between two steps, its files kept whole
     if (*run) return commandRun(args);
     if (*check) return commandCheck(args);
     if (*benchCommand) return runBench(bench);
@@ -235,6 +237,10 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::fprintf(stderr, "gem: error: %s\n", e.what());
     return 2;
+  } catch (const Interrupted& e) {
+    if (!args.quiet) std::fprintf(stderr, "\n");  // past the progress line
+    std::fprintf(stderr, "gem: %s\n", e.what());
+    return 128 + e.signal();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gem: failed: %s\n", e.what());
     return 1;

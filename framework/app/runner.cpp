@@ -13,10 +13,12 @@
 
 #include "events/propulsion.hpp"
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/run_folder_lock.hpp"
 #include "framework/api/errors.hpp"
 #include "framework/field/ice_file.hpp"
 #include "framework/output/ice_file_writer.hpp"
 #include "framework/api/registry.hpp"
+#include "framework/app/interrupt.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/output/vtk_writer.hpp"
 
@@ -99,10 +101,7 @@ class ScenarioRun {
   // The stepper outlives the run (a case run together with others is stepped to the end even
   // when its outputs fail).
   ScenarioRun(const Scenario& scenario, Stepper& stepper)
-      : m_scenario(scenario),
-        m_stepper(&stepper),
-        m_dir(scenario.output.dir),
-        m_timeseries((std::filesystem::create_directories(m_dir), m_dir / "timeseries.csv")) {
+      : m_scenario(scenario), m_stepper(&stepper), m_dir(scenario.output.dir), m_lock(m_dir), m_timeseries(m_dir / "timeseries.csv") {
     Stepper& sim = *m_stepper;
     m_summary.backend = sim.backend();  // "auto" may have fallen back to the cpu
     m_summary.broadphase = scenario.broadphase;
@@ -244,6 +243,7 @@ class ScenarioRun {
   bool m_frames = false;
   std::unique_ptr<VtkSeriesWriter> m_vtk;
   std::unique_ptr<IceFileWriter> m_ice;
+  RunFolderLock m_lock;  // before any file of the folder is opened
   AtomicFile m_timeseries;
   struct RecordFile {
     const RecordOutputEntry* output;
@@ -266,6 +266,7 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   auto lastProgress = start;
   try {
     for (long k = 0; k < scenario.steps; ++k) {
+      stopIfInterrupted(k);
       sim.step();
       run.record(k);
       if (options.progress && !options.quiet) {
