@@ -82,6 +82,9 @@ std::vector<BadCase> badCases() {
        kSim + "[vessel]\nvertices = [[-50.0, -10.0], [50.0, -10.0], [0.0, 0.0], [50.0, 10.0], [-50.0, 10.0]]\n"
               "frame_angle_deg = [80.0, 30.0, 30.0, 80.0, 80.0]\n",
        {"vessel.vertices", "not convex"}},
+      {"field_beyond_memory",
+       kSim + "[domain]\nx = [0.0, 1e7]\ny = [0.0, 1e7]\n[field]\nkind = \"hexagons\"\n",
+       {"field: about", "floes", "GB"}},
       {"duration_below_one_step", "[simulation]\ndt = 0.1\nduration = 0.01\n", {"simulation.duration", "shorter than one step"}},
   };
 }

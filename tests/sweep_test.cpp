@@ -388,6 +388,18 @@ INSTANTIATE_TEST_SUITE_P(
         BadSweep{"unsafe_case_name", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"../x\"\n", {"bad_sweep.toml:4:", "name"}},
         BadSweep{"nothing_to_run", "[sweep]\nbase = \"base.toml\"\n", {"bad_sweep.toml", "[parameters]"}},
         BadSweep{"toml_syntax", "[sweep]\nbase = \"base.toml\"\n[parameters]\nx = [1\n", {"bad_sweep.toml:4:"}},
+        BadSweep{"a_billion_cases",
+                 "[sweep]\nbase = \"base.toml\"\n[parameters]\n" +
+                     [] {
+                       std::string lists;
+                       for (const char* key : {"\"simulation.dt\"", "\"simulation.seed\"", "\"vessel.bollard_thrust\""}) {
+                         lists += std::string(key) + " = [";
+                         for (int k = 1; k <= 1000; ++k) lists += (k > 1 ? ", " : "") + std::to_string(k) + ".0";
+                         lists += "]\n";
+                       }
+                       return lists;
+                     }(),
+                 {"bad_sweep.toml:4:", "1e+09 cases", "at most 1000000"}},
         BadSweep{"varied_in_set_and_parameters",
                  "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n[[cases]]\nname = \"a\"\nset = { "
                  "vessel.bollard_thrust = 2.0 }\n",

@@ -1,5 +1,7 @@
 #include "framework/scenario/scenario.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -56,6 +58,32 @@ Domain readDomain(TableReader& t, const Scenario& s) {
     d.y0 = (*y)[0], d.y1 = (*y)[1];
   }
   return d;
+}
+
+// A generated field's size is known before it is made: refuse one that could not fit in this
+// machine's memory, with the estimate, instead of growing until std::bad_alloc (docs/scenario.md).
+// About 3 KB a floe: its polygon and state, and the step's per-body and per-contact buffers.
+void checkFieldMemory(const Scenario& s, TableReader& top) {
+  if (s.fieldKind != "random_convex" && s.fieldKind != "hexagons") return;
+  const double area = (static_cast<double>(s.domain.x1) - s.domain.x0) * (static_cast<double>(s.domain.y1) - s.domain.y0);
+  double floes = 0;
+  if (s.fieldKind == "hexagons") {
+    floes = area * s.hexagonField.concentration / (static_cast<double>(s.hexagonField.size) * s.hexagonField.size);
+  } else {
+    const RandomFieldSpec& r = s.randomField;
+    const double meanArea = static_cast<double>(r.sizeMean) * r.sizeMean + static_cast<double>(r.sizeSd) * r.sizeSd;
+    floes = r.count > 0 ? r.count : area * r.concentration / meanArea;
+  }
+  constexpr double kBytesPerFloe = 3072;
+  const double need = floes * kBytesPerFloe;
+  const double have = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  if (need > 0.8 * have || floes > 2e8)
+    throw InputError(
+        s.fileName, 0, 0,
+        fmt::format("field: about {:.3g} floes (the domain's {:.3g} m^2 x concentration / floe area), which need about {:.3g} GB; "
+                    "this machine has {:.3g} GB: make the [domain] smaller or the floes larger",
+                    floes, area, need / 1e9, have / 1e9));
+  (void)top;
 }
 
 void readField(TableReader& t, Scenario& s) {
@@ -368,6 +396,7 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
   // The field was read before [domain] may have been: bind the generators to the final domain.
   s.randomField.domain = s.domain;
   s.hexagonField.domain = s.domain;
+  checkFieldMemory(s, top);
   return s;
 }
 

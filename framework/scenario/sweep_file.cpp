@@ -113,6 +113,9 @@ struct Combination {
   std::string name;
 };
 
+// At most this many cases in one sweep (each holds its overrides and writes a folder).
+constexpr long kMaxSweepCases = 1000000;
+
 std::vector<Combination> expandParameters(const std::vector<Leaf>& parameters, const TableReader& reader) {
   std::vector<Combination> out;
   if (parameters.empty()) return {Combination{}};
@@ -125,6 +128,13 @@ std::vector<Combination> expandParameters(const std::vector<Leaf>& parameters, c
     lists.push_back(list);
     shortKeys.push_back(p.key.substr(p.key.rfind('.') == std::string::npos ? 0 : p.key.rfind('.') + 1));
   }
+  // The product's size is known before it is expanded: 10^9 cases would grow until bad_alloc.
+  double product = 1;
+  for (const toml::array* list : lists) product *= static_cast<double>(list->size());
+  if (product > static_cast<double>(kMaxSweepCases))
+    reader.failAt(*parameters.front().node,
+                  fmt::format("parameters: their product is {:.3g} cases; a sweep holds at most {} (split it into several sweeps)", product,
+                              kMaxSweepCases));
   std::vector<std::string> names = shortKeys;
   for (size_t i = 0; i < shortKeys.size(); ++i)
     if (std::count(shortKeys.begin(), shortKeys.end(), shortKeys[i]) > 1) names[i] = parameters[i].key;
