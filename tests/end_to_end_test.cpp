@@ -239,3 +239,27 @@ TEST(GemRun, SigtermKeepsTheFilesWholeAndSaysSo) {
   for (const auto& entry : std::filesystem::directory_iterator(out))
     EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
 }
+
+// A reused run folder describes only its last run: a re-run with frames off leaves none of the
+// earlier run's frames; the folder records the scenario as read (gem-run.toml, overrides applied,
+// with its seed), and running that record repeats the run.
+TEST(GemRun, AReusedRunFolderHoldsOnlyItsLastRunAndRecordsItsScenario) {
+  test::TempDir dir;
+  const auto scenario = dir.write("busy.toml", test::kBusyScene);
+  const auto out = dir.path() / "out";
+  const std::string run = "run " + scenario.string() + " --quiet --steps 30 --out " + out.string();
+  ASSERT_EQ(test::runGem(run + " --set output.frame_every=10", dir.path() / "log"), 0) << test::readFile(dir.path() / "log");
+  ASSERT_TRUE(std::filesystem::exists(out / "frames.pvd"));
+  ASSERT_TRUE(std::filesystem::exists(out / "frames.ice"));
+  ASSERT_EQ(test::runGem(run + " --set output.frame_every=0", dir.path() / "log"), 0) << test::readFile(dir.path() / "log");
+  EXPECT_FALSE(std::filesystem::exists(out / "frames.pvd"));
+  EXPECT_FALSE(std::filesystem::exists(out / "frames.ice"));
+  EXPECT_FALSE(std::filesystem::exists(out / "frames"));
+  const std::string record = test::readFile(out / "gem-run.toml");
+  EXPECT_NE(record.find("# --set output.frame_every=0"), std::string::npos) << record;
+  EXPECT_NE(record.find("seed = 3"), std::string::npos) << record;
+  ASSERT_EQ(
+      test::runGem("run " + (out / "gem-run.toml").string() + " --quiet --out " + (dir.path() / "again").string(), dir.path() / "log"), 0)
+      << test::readFile(dir.path() / "log");
+  EXPECT_EQ(test::readFile(dir.path() / "again" / "state.csv"), test::readFile(out / "state.csv"));
+}

@@ -13,6 +13,7 @@
 
 #include "events/propulsion.hpp"
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/run_folder.hpp"
 #include "framework/output/run_folder_lock.hpp"
 #include "framework/api/errors.hpp"
 #include "framework/field/ice_file.hpp"
@@ -109,7 +110,12 @@ class ScenarioRun {
     m_summary.device = sim.device();
     m_summary.floesInitial = sim.hostWorld().count(BodyKind::Floe);
     m_summary.iceMassInitial = sim.hostWorld().floeMass();
-    std::filesystem::remove(m_dir / "summary.json");  // a stale summary must not describe this run
+    // What an earlier run left here goes (a stale summary or old frames must not sit beside this
+    // run's files), and the scenario as read is recorded (gem-run.toml).
+    std::vector<std::string> recordFiles;
+    for (const RecordOutputEntry* output : Registry::global().recordOutputs()) recordFiles.push_back(output->file);
+    clearEarlierRun(m_dir, recordFiles);
+    recordScenario(m_dir, scenario);
 
     const OutputSpec& out = scenario.output;
     m_frames = out.frameEvery > 0;

@@ -311,6 +311,7 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
                      std::string(e.description()));
   }
   for (const std::string& o : overrides) applyOverride(s.root, o);
+  s.overrides = overrides;
   if (s.root.empty())
     throw InputError(fmt::format("{}: nothing in it: a scenario needs at least a [simulation] table or bodies", s.fileName));
 

@@ -30,9 +30,10 @@ struct PluginSpec {
 };
 
 struct Scenario {
-  std::filesystem::path file;  // the scenario file (absolute)
-  std::string fileName;        // as given, for messages
-  toml::table root;            // the parsed document, overrides applied
+  std::filesystem::path file;          // the scenario file (absolute)
+  std::string fileName;                // as given, for messages
+  toml::table root;                    // the parsed document, overrides applied
+  std::vector<std::string> overrides;  // the --set (and sweep) overrides, "key=VALUE", as applied
 
   // [simulation]
   Real dt = Real(0.1);

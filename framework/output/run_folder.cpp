@@ -1,0 +1,56 @@
+#include "framework/output/run_folder.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "framework/output/atomic_file.hpp"
+
+namespace gem {
+
+void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  // Temporaries of another process (an earlier run that was killed), never this run's own.
+  const std::string own = ".tmp-" + std::to_string(::getpid());
+  auto staleTemporary = [&](const fs::path& p) {
+    const std::string name = p.filename().string();
+    return name.find(".tmp-") != std::string::npos && name.substr(name.size() - std::min(name.size(), own.size())) != own;
+  };
+  std::vector<std::string> files{"summary.json", "state.csv", "timeseries.csv", "frames.pvd", "frames.ice"};
+  files.insert(files.end(), recordFiles.begin(), recordFiles.end());
+  for (const std::string& f : files) fs::remove(dir / f, ec);
+  const fs::path frames = dir / "frames";
+  if (fs::is_directory(frames, ec)) {
+    for (const auto& entry : fs::directory_iterator(frames, ec))
+      if (entry.path().extension() == ".vtp" || staleTemporary(entry.path())) fs::remove(entry.path(), ec);
+    if (fs::is_empty(frames, ec)) fs::remove(frames, ec);
+  }
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_regular_file() && staleTemporary(entry.path())) fs::remove(entry.path(), ec);
+}
+
+void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) {
+  toml::table root = scenario.root;
+  auto table = [&](const char* name) -> toml::table& {
+    if (!root.contains(name)) root.insert(name, toml::table{});
+    return *root.get(name)->as_table();
+  };
+  table("simulation").insert_or_assign("seed", static_cast<std::int64_t>(scenario.seed));
+  // The steps this run takes, whatever set them (duration, --steps, --duration).
+  table("simulation").erase("duration");
+  table("simulation").insert_or_assign("steps", static_cast<std::int64_t>(scenario.steps));
+  table("output").insert_or_assign("dir", scenario.output.dir.string());
+  if (scenario.fieldKind == "file") table("field").insert_or_assign("file", scenario.fieldFile.lexically_normal().string());
+  std::ostringstream out;
+  out << "# The scenario of this run as gem read it: " << scenario.file.string() << "\n";
+  for (const std::string& o : scenario.overrides) out << "# --set " << o << "\n";
+  out << "# gem " << GEM_VERSION << "; `gem run gem-run.toml` repeats the run.\n\n";
+  out << toml::toml_formatter{root, toml::toml_formatter::default_flags & ~toml::format_flags::indentation} << "\n";
+  writeFileAtomically(dir / "gem-run.toml", out.str());
+}
+
+}  // namespace gem

@@ -1,0 +1,24 @@
+// A run folder that can be trusted: a run starts by removing what an earlier run of GEM left there
+// (its summary, CSVs, frames, temporaries: a re-run with frames off must not leave the old frames
+// beside the new summary), and records the scenario it read, overrides applied, with its seed.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "framework/scenario/scenario.hpp"
+
+namespace gem {
+
+// Removes GEM's own outputs of an earlier run from dir (never other files): summary.json,
+// state.csv, timeseries.csv, the record streams' files (`recordFiles`), frames.pvd, frames.ice,
+// frames/*.vtp (and frames/ when that leaves it empty), and *.tmp-PID temporaries. Call it holding
+// the folder's lock (RunFolderLock): no other run of GEM is writing there.
+void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles);
+
+// Writes dir/gem-run.toml: the scenario as this run read it (every --set applied, its seed and its
+// step count, the field file and output folder by absolute path), so that `gem run
+// dir/gem-run.toml` repeats it.
+void recordScenario(const std::filesystem::path& dir, const Scenario& scenario);
+
+}  // namespace gem
