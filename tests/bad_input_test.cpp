@@ -143,6 +143,10 @@ TEST(BadInputCli, NotAScenarioFileAndBadNumbersOnTheCommandLine) {
     EXPECT_LE(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "summary.json")) << c.arguments;
   }
+  // A file where the run folder (or a folder above it) should be: exit 2 naming it.
+  const auto file = dir.write("a_file", "x");
+  EXPECT_EQ(gem::test::runGem("run " + good.string() + " --quiet --out " + (file / "run").string(), log), 2);
+  EXPECT_NE(gem::test::readFile(log).find(file.string() + ": a file, not a folder"), std::string::npos) << gem::test::readFile(log);
   // A 5 MB token in an unknown key is not echoed whole.
   const auto huge = dir.write("huge.toml", kSim + "[simulation.extra]\n" + std::string(5000000, 'k') + " = 1\n");
   EXPECT_EQ(gem::test::runGem("check " + huge.string(), log), 2);
