@@ -11,6 +11,7 @@
 #include <string>
 
 #include "framework/field/ice_file.hpp"
+#include "framework/api/plugin_api.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/step/cpu_stepper.hpp"
 #include "test_support.hpp"
@@ -262,4 +263,12 @@ TEST(GemRun, AReusedRunFolderHoldsOnlyItsLastRunAndRecordsItsScenario) {
       test::runGem("run " + (out / "gem-run.toml").string() + " --quiet --out " + (dir.path() / "again").string(), dir.path() / "log"), 0)
       << test::readFile(dir.path() / "log");
   EXPECT_EQ(test::readFile(dir.path() / "again" / "state.csv"), test::readFile(out / "state.csv"));
+}
+
+TEST(GemCli, VersionNamesTheVersionRealTypeAndPluginAbi) {
+  test::TempDir dir;
+  EXPECT_EQ(test::runGem("--version", dir.path() / "log"), 0);
+  const std::string text = test::readFile(dir.path() / "log");
+  EXPECT_NE(text.find(std::string("gem ") + GEM_VERSION), std::string::npos) << text;
+  EXPECT_NE(text.find("plugin ABI " + std::to_string(GEM_PLUGIN_ABI_VERSION)), std::string::npos) << text;
 }

@@ -147,6 +147,8 @@ int commandInfo(const std::vector<std::string>& plugins) {
 int main(int argc, char** argv) {
   CLI::App app{"GEM: GPU Event Mechanics, ships in 2D pack ice"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("gem ") + GEM_VERSION + " (real type " + GEM_REAL_NAME + ", plugin ABI " +
+                                        std::to_string(GEM_PLUGIN_ABI_VERSION) + ")");
   RunArguments args;
   auto addRunOptions = [&](CLI::App* c) {
     c->add_option("scenario", args.scenario, "scenario file (TOML)")->required();
