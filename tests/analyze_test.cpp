@@ -55,10 +55,20 @@ std::map<std::string, std::map<std::string, std::string>> readStatistics(const f
   for (std::stringstream s(line); std::getline(s, line, ',');) header.push_back(line);
   std::map<std::string, std::map<std::string, std::string>> rows;
   while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::stringstream s(line);
-    for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
-    if (!line.empty() && line.back() == ',') cells.emplace_back();
+    // RFC 4180: a quoted field may hold commas and doubled quotes.
+    std::vector<std::string> cells(1);
+    bool quoted = false;
+    for (size_t k = 0; k < line.size(); ++k) {
+      const char c = line[k];
+      if (quoted && c == '"' && k + 1 < line.size() && line[k + 1] == '"')
+        cells.back() += '"', ++k;
+      else if (c == '"')
+        quoted = !quoted;
+      else if (c == ',' && !quoted)
+        cells.emplace_back();
+      else
+        cells.back() += c;
+    }
     EXPECT_EQ(cells.size(), header.size()) << line;
     for (size_t i = 0; i < cells.size() && i < header.size(); ++i) rows[cells[0]][header[i]] = cells[i];
   }
@@ -162,6 +172,20 @@ TEST(Analyze, SweepFolderGroupsCasesByNamePrefix) {
   EXPECT_NE(bow.find("121,0,1,240,120\n"), std::string::npos) << bow;
   EXPECT_NE(bow.find("004,0,1,60,60\n"), std::string::npos) << bow;
   EXPECT_NE(bow.find("all,0,1,300,100\n"), std::string::npos) << bow;
+}
+
+// A sweep's default case names hold commas ("r35,bollard_thrust=92000"): the group's name is
+// quoted in statistics.csv, so the file still parses with one cell per column.
+TEST(Analyze, GroupNamesWithCommasAreQuoted) {
+  TempDir tmp;
+  writeImpacts(tmp.path() / "cases" / "r35,bollard_thrust=92000", 40, 1, 0.0, 1.0);
+  writeImpacts(tmp.path() / "cases" / "r40,bollard_thrust=92000", 30, 2, 0.0, 1.0);
+  tmp.write("summary.csv", "name\n");
+  ASSERT_EQ(runAnalyze(quietOptions(tmp.path())), 0);
+  const std::string text = gem::test::readFile(tmp.path() / "analysis" / "statistics.csv");
+  EXPECT_NE(text.find("\n\"r35,bollard\","), std::string::npos) << text;
+  auto rows = readStatistics(tmp.path() / "analysis" / "statistics.csv");
+  EXPECT_EQ(rows["r35,bollard"]["impacts"], "40");
 }
 
 TEST(Analyze, ChosenGroupsOnly) {

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/csv_field.hpp"
 #include "framework/api/errors.hpp"
 #include "framework/analysis/statistics.hpp"
 #include "framework/analysis/svg_plot.hpp"
@@ -187,7 +188,7 @@ std::string statisticsCsv(const std::vector<Group>& groups, const std::vector<Gr
   for (size_t i = 0; i < groups.size(); ++i) {
     const GroupStatistics& s = stats[i];
     auto power = [](const PowerLawFit& p) { return fmt::format("{},{},{}", cell(p.a, p.ok), cell(p.b, p.ok), cell(p.r2, p.ok)); };
-    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", groups[i].name, groups[i].runs.size(), s.impacts,
+    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csvField(groups[i].name), groups[i].runs.size(), s.impacts,
                        cell(s.forceMean, s.impacts > 0), cell(s.forceMax, s.impacts > 0), cell(s.force.shape, s.force.ok),
                        cell(s.force.scale, s.force.ok), s.struckFloes, cell(s.mass.mu, s.mass.ok), cell(s.mass.sigma, s.mass.ok),
                        cell(std::exp(s.mass.mu), s.mass.ok), cell(s.apex.shape, s.apex.ok), cell(s.apex.scale, s.apex.ok), power(s.vsStem),
@@ -229,7 +230,7 @@ std::string acrossBowCsv(const std::vector<Group>& groups, const AcrossBow& a) {
   std::string out = "group,y_min_m,y_max_m,impacts,impacts_per_m_per_run\n";
   for (size_t g = 0; g < groups.size(); ++g)
     for (size_t b = 0; b < a.counts[g].size(); ++b)
-      out += fmt::format("{},{:g},{:g},{},{:.6g}\n", groups[g].name, a.y0 + double(b), a.y0 + double(b) + 1, a.counts[g][b],
+      out += fmt::format("{},{:g},{:g},{},{:.6g}\n", csvField(groups[g].name), a.y0 + double(b), a.y0 + double(b) + 1, a.counts[g][b],
                          a.perMetrePerRun[g][b]);
   return out;
 }

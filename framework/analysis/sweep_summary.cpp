@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/csv_field.hpp"
 
 namespace fs = std::filesystem;
 
@@ -117,13 +118,6 @@ class JsonReader {
   std::string m_text, m_file;
   size_t m_pos = 0;
 };
-
-std::string csvField(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
 
 // summary.csv column -> summary.json key.
 const std::vector<std::pair<std::string, std::string>>& columnKeys() {
