@@ -47,8 +47,9 @@ GEM_REGISTER_RECORD_OUTPUT(
     "t,floe_id,floe_mass,thickness,apex_deg,frame_angle_deg,x,y,nx,ny,x_from_stem,y_from_centerline,vn,fn,flim,broke", writeImpactRow,
     "impacts", "impact_force_n", [](const void* record) { return static_cast<double>(static_cast<const ImpactRecord*>(record)->force); });
 
-GEM_REGISTER_PAIR_EVENT(ShipImpact, "ship_impact",
-                        "2.5D ship-ice impact force at contact onset, logged to impacts.csv; flags flexural failure (A.50-A.99)", true,
-                        parseShipImpact);
+GEM_REGISTER_PAIR_EVENT(
+    ShipImpact, "ship_impact",
+    "2.5D ship-ice impact force at every collision (overlap and approach), logged to impacts.csv; flags flexural failure (A.50-A.99)", true,
+    parseShipImpact);
 
 }  // namespace gem

@@ -1,6 +1,8 @@
 // Ship-ice impact force, 2.5D (docs/model.md 5, thesis A.50 to A.99). The kinematics stay 2D (impact
-// and elastic_contact move the bodies); at the onset of each vessel-floe contact this event
-// evaluates the 3D impact force, logs it, and asks for a flexural break when the edge fails.
+// and elastic_contact move the bodies); at every ship-ice collision, each step in which the vessel
+// and a floe overlap and their contact points approach (V_n > 0; thesis 3.2, 6.2.2: "each ship-ice
+// collision event"), this event evaluates the 3D impact force, logs it, and asks for a flexural
+// break when the edge fails. A floe pushed along the bow is struck, and logged, again and again.
 //
 //   3D normal (principal frames): (l_r cos beta, m_r cos beta, sin beta)
 //   moment arms (z = 0):  lambda = n_z y_r,  mu = -n_z x_r,  eta = n_y x_r - n_x y_r   (A.60 corrected)
@@ -23,7 +25,7 @@
 
 namespace gem {
 
-// A ship-ice impact at contact onset (docs/model.md 5): a row of the stream "impacts", which
+// A ship-ice impact, one collision step (docs/model.md 5): a row of the stream "impacts", which
 // ship_impact.cpp writes to impacts.csv.
 struct ImpactRecord {
   Real time;
@@ -119,7 +121,6 @@ struct ShipImpact {
 
   GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact, PairSlot&,
                            const StepContext& ctx, const RecordSink& sink) {
-    if (!contact.onset) return;
     const bool vesselFirst = a.kind == BodyKind::Vessel && b.kind == BodyKind::Floe;
     const bool vesselSecond = b.kind == BodyKind::Vessel && a.kind == BodyKind::Floe;
     if (!vesselFirst && !vesselSecond) return;

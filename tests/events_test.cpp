@@ -298,7 +298,35 @@ TEST(ShipImpact, ForceIsTheDirectEvaluationOfModelSection5) {
   EXPECT_TRUE(std::isinf(ShipImpact::evaluate(p, body(s), body(f), c, {1, 0}, vn, 0, phi).forceLimit));
 }
 
-TEST(ShipImpact, IsLoggedOnceAtContactOnsetWithTheHullAngleOfTheStem) {
+// docs/model.md 5: every ship-ice collision is an impact (the vessel and a floe overlap and their
+// contact points approach), not only a contact's first step. A floe pushed ahead of the bow by the
+// thrusting vessel, slowed by water drag, is struck again each time the hull closes on it: several
+// impacts, each with its own closing speed, all at the stem.
+TEST(ShipImpact, AFloePushedAlongTheBowIsStruckAgainAndAgain) {
+  TempDir dir;
+  Scenario s =
+      test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"ship_impact", "impact", "elastic_contact", "propulsion", "drag"}) +
+                                      "[vessel]\nposition = [0.0, 0.0]\nspeed = 2.0\n");
+  World w;
+  addVessel(w, s.vessel);
+  w.addBody(square({stemX(s) + 5.1, 0}, 10, 2.0));  // thick: it will not break
+  CpuStepper sim(s, std::move(w));
+  std::vector<double> speeds;
+  for (int i = 0; i < 600; ++i) {
+    sim.step();
+    for (const ImpactRecord& r : ::gem::test::impactsOf(sim)) {
+      EXPECT_NEAR(r.frameAngleDeg, 60, 1e-9);  // the default hull's stem
+      EXPECT_GT(r.closingSpeed, 0);
+      EXPECT_GT(r.force, 0);
+      speeds.push_back(r.closingSpeed);
+    }
+  }
+  ASSERT_GE(speeds.size(), 3u) << "a floe pushed along the bow is struck more than once";
+  EXPECT_LT(speeds.back(), speeds.front()) << "later strikes are slower than the first";
+  EXPECT_NE(speeds[1], speeds[2]) << "each strike has its own closing speed";
+}
+
+TEST(ShipImpact, IsLoggedAtTheFirstStrikeWithTheHullAngleOfTheStem) {
   TempDir dir;
   Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"ship_impact", "impact", "elastic_contact"}) +
                                                "[vessel]\nposition = [0.0, 0.0]\nspeed = 2.0\n");
@@ -318,7 +346,7 @@ TEST(ShipImpact, IsLoggedOnceAtContactOnsetWithTheHullAngleOfTheStem) {
       EXPECT_GT(r.force, 0);
     }
   }
-  EXPECT_EQ(logged, 1);
+  EXPECT_EQ(logged, 1);  // without thrust or drag the floe then moves with the hull: no second strike
   EXPECT_GE(stepsInContact, 1);
 }
 
