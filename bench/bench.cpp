@@ -1,6 +1,8 @@
 #include "bench/bench.hpp"
 
 #include <algorithm>
+#include <system_error>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -41,8 +43,33 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
+}  // namespace
+
+// Where the bench's scenes are read from: $GEM_SCENARIOS; else beside an installed or copied gem
+// (PREFIX/share/gem/scenarios, or a scenarios/ folder next to the binary); else the source tree it
+// was built from. A gem that finds none says where it looked.
+fs::path benchScenariosDir() {
+  std::vector<fs::path> candidates;
+  if (const char* env = std::getenv("GEM_SCENARIOS")) candidates.emplace_back(env);
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    candidates.push_back(exe.parent_path() / ".." / "share" / "gem" / "scenarios");
+    candidates.push_back(exe.parent_path() / "scenarios");
+  }
+  candidates.emplace_back(fs::path(GEM_SOURCE_DIR) / "scenarios");
+  std::string tried;
+  for (const fs::path& c : candidates) {
+    if (fs::is_regular_file(c / "thesis" / "random_35.toml", ec)) return fs::weakly_canonical(c, ec);
+    tried += (tried.empty() ? "" : ", ") + c.string();
+  }
+  throw InputError("gem bench: its scenes (scenarios/thesis/*.toml) are not found; looked in " + tried + " (set GEM_SCENARIOS)");
+}
+
+namespace {
+
 Scenario thesisField(const char* file) {
-  const fs::path path = fs::path(GEM_SOURCE_DIR) / "scenarios" / "thesis" / file;
+  const fs::path path = benchScenariosDir() / "thesis" / file;
   Scenario s = loadScenario(path);
   s.output.frameEvery = 0;
   return s;
@@ -275,8 +302,8 @@ std::string caseList(const std::vector<CaseKey>& cases) {
 void printTiming(const BenchOptions& o) {
   std::printf(
       "%ld timed steps per case (fewer for large fields; whole 200-step periods on a device) after a warm-up; "
-      "median of 5 chunks; real time at the scenario's dt (0.1 s)\n",
-      o.steps);
+      "median of 5 chunks; real time at the scenario's dt (0.1 s); scenes from %s\n",
+      o.steps, benchScenariosDir().string().c_str());
 }
 
 // --table step: every case x backend x broadphase (the README's table).

@@ -9,6 +9,7 @@
 // and the geometry tables intersection | triangulation (bench/geometry_bench.hpp); "all" runs
 // fields, blocks, copyback, scaling, intersection and triangulation one after another.
 #pragma once
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -37,5 +38,10 @@ int runBench(const BenchOptions& options);
 
 // "model name" of the first CPU in /proc/cpuinfo.
 std::string cpuName();
+
+// The folder of the scenes gem bench times: $GEM_SCENARIOS, else PREFIX/share/gem/scenarios or
+// scenarios/ beside the gem binary (installed or copied), else the source tree it was built from.
+// Throws InputError naming the places it looked.
+std::filesystem::path benchScenariosDir();
 
 }  // namespace gem

@@ -22,6 +22,9 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/geometry ${PROJECT_SOURCE_DIR}/events ${
 # The forwarding headers of GEM 0.1's include paths ("framework/event_api.hpp"), for one release.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/framework/api/deprecated/ DESTINATION ${GEM_INSTALL_INCLUDEDIR})
 
+# The scenarios (the thesis fields, studies, calibration): gem bench reads its scenes from here.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenarios DESTINATION ${CMAKE_INSTALL_DATADIR}/gem)
+
 # gem finds libgem_core (and libgem_cuda) beside it, wherever the prefix is.
 set_target_properties(gem PROPERTIES INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
 install(TARGETS gem_core gem EXPORT gemTargets

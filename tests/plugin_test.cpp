@@ -240,6 +240,10 @@ TEST(PluginSdk, InstallBuildEachExampleOutOfTreeRunItAndSeeItInGemInfo) {
   const std::string cmake = std::string("\"") + GEM_CMAKE_COMMAND + "\"";
   ASSERT_EQ(run(cmake + " --install " GEM_BINARY_DIR " --prefix " + prefix.string(), log), 0) << readFile(log);
   const std::string gem = (prefix / "bin" / "gem").string();
+  // The installed gem runs gem bench from its own share/gem/scenarios, not the source tree.
+  ASSERT_EQ(run(gem + " bench --backend cpu --cases 456 --steps 3", log), 0) << readFile(log);
+  EXPECT_NE(readFile(log).find("scenes from " + fs::weakly_canonical(prefix / "share" / "gem" / "scenarios").string()), std::string::npos)
+      << readFile(log);
   ASSERT_TRUE(fs::exists(prefix / "lib" / "cmake" / "gem" / "gemConfig.cmake"));
   ASSERT_TRUE(fs::exists(prefix / "include" / "gem" / "framework" / "plugin_api.hpp"));
 
