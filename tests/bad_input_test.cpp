@@ -52,7 +52,7 @@ std::vector<BadCase> badCases() {
       {"unknown_top_key", kSim + "[simulaton]\ndt = 0.1\n", {"unknown key \"simulaton\"", "simulation"}},
       {"unknown_section_key", "[simulation]\ndtt = 0.1\n", {"simulation.dtt", "valid keys here", "dt"}},
       {"unknown_event", kSim + "[events.dragg]\n", {"events.dragg", "unknown event", "drag"}},
-      {"unknown_event_key", kSim + "[events.drag]\ncdd = 0.1\n", {"events.drag.cdd", "cd"}},
+      {"unknown_event_key", kSim + "[events.drag]\ncdd = 0.1\n", {"events.drag.cdd", "did you mean \"cd\"?"}},
       {"unknown_broadphase", "[simulation]\nbroadphase = \"octree\"\n", {"octree", "uniform_grid", "variable_radius"}},
       {"wrong_type", "[simulation]\ndt = \"fast\"\n", {"simulation.dt", "expected a number", ":2:"}},
       {"malformed_toml", "[simulation]\ndt = 0.1\nduration = = 3\n", {":3:"}},

@@ -1,5 +1,8 @@
 #include "framework/api/table_reader.hpp"
 
+#include <algorithm>
+#include <vector>
+
 #include <cmath>
 
 #include <fmt/format.h>
@@ -34,6 +37,24 @@ void TableReader::failAt(const toml::node& n, const std::string& message) const 
   const auto& src = n.source();
   throw InputError(m_file, static_cast<int>(src.begin.line), static_cast<int>(src.begin.column), message);
 }
+
+namespace {
+// Edit distance (insertions, deletions, substitutions), for "did you mean".
+size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t next = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = row[j];
+      row[j] = next;
+    }
+  }
+  return row[b.size()];
+}
+}  // namespace
 
 Real TableReader::toReal(const toml::node& n, const std::string& key) const {
   double v;
@@ -150,7 +171,13 @@ void TableReader::finish() const {
     std::string key(k.str());
     if (m_known.count(key)) continue;
     std::vector<std::string> valid(m_known.begin(), m_known.end());
-    failAt(v, fmt::format("unknown key \"{}\" (valid keys here: {})", keyPath(key),
+    // The nearest valid key, when it is near enough to be a typo.
+    std::string nearest;
+    size_t best = std::max<size_t>(2, key.size() / 3) + 1;
+    for (const std::string& candidate : valid)
+      if (const size_t d = editDistance(key, candidate); d < best) best = d, nearest = candidate;
+    failAt(v, fmt::format("unknown key \"{}\"{} (valid keys here: {})", keyPath(key),
+                          nearest.empty() ? "" : fmt::format("; did you mean \"{}\"?", nearest),
                           valid.empty() ? std::string("none") : fmt::format("{}", fmt::join(valid, ", "))));
   }
 }
