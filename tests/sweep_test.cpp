@@ -229,6 +229,26 @@ TEST(Sweep, ResumeRunsOnlyIncompleteOrChangedCases) {
   for (const auto& s : summaries) EXPECT_EQ(readSummaryJson(s).at("steps"), "31");
 }
 
+// gem sweep takes --set and --backend as gem run does, for every case (after the sweep's own keys).
+TEST(Sweep, SetAndBackendApplyToEveryCase) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("study.toml", kProduct);
+  const fs::path out = dir.path() / "out", log = dir.path() / "log.txt";
+  ASSERT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --quiet --backend cpu --set simulation.steps=3", log), 0)
+      << test::readFile(log);
+  int cases = 0;
+  for (const auto& entry : fs::directory_iterator(out / "cases")) {
+    ++cases;
+    const std::string summary = test::readFile(entry.path() / "summary.json");
+    EXPECT_NE(summary.find("\"steps\": 3,"), std::string::npos) << entry.path() << ": " << summary;
+    EXPECT_NE(summary.find("\"backend\": \"cpu\""), std::string::npos) << summary;
+  }
+  EXPECT_EQ(cases, 4);
+  EXPECT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --set simulation.dtt=0.1", log), 2);
+  EXPECT_NE(test::readFile(log).find("did you mean \"dt\""), std::string::npos) << test::readFile(log);
+}
+
 TEST(Sweep, CaseIndexRunsExactlyOne) {
   TempDir dir;
   dir.write("base.toml", kBase);

@@ -217,6 +217,8 @@ int main(int argc, char** argv) {
                    "on a GPU, the most cases run together in one device state (default 0: automatic; 1: one case at a time)")
       ->check(CLI::NonNegativeNumber);
   sweepCommand->add_flag("--quiet", sweep.quiet, "no progress");
+  sweepCommand->add_option("--set", sweep.set, "override a scenario key in every case: --set simulation.dt=0.05")->take_all();
+  sweepCommand->add_option("--backend", sweep.backend, "auto, cpu or cuda, for every case");
 
   try {
     app.parse(argc, argv);

@@ -163,7 +163,17 @@ struct SweepState {
 
 int runSweep(const SweepOptions& options) {
   MpiWork mpi;  // under mpirun: this rank's share of the world; finalised when the sweep returns
-  const SweepDefinition sweep = readSweepFile(options.sweepFile);
+  SweepDefinition sweep = readSweepFile(options.sweepFile);
+  // The command line's overrides go to every case, last (so they win), as in gem run.
+  std::vector<std::string> extra = options.set;
+  if (!options.backend.empty()) extra.push_back("simulation.backend=\"" + options.backend + "\"");
+  for (const std::string& assignment : extra) {
+    const size_t eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(fmt::format("--set {}: expected KEY=VALUE, e.g. simulation.dt=0.05", assignment));
+    for (SweepCase& c : sweep.cases)
+      c.overrides.push_back(SweepOverride{assignment.substr(0, eq), assignment.substr(eq + 1), assignment.substr(eq + 1)});
+  }
   const fs::path outDir =
       options.outDir.empty() ? sweep.file.parent_path() / "runs" / sweep.name : fs::absolute(options.outDir).lexically_normal();
   const size_t count = sweep.cases.size();

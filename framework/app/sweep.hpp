@@ -69,6 +69,7 @@
 // reported with its message, the others go on, and the exit status is 1.
 #pragma once
 #include <string>
+#include <vector>
 
 namespace gem {
 
@@ -79,6 +80,8 @@ struct SweepOptions {
   long caseIndex = -1;  // run only this case (job arrays); -1 = all
   int batch = 0;        // on a GPU, the most cases run together in one device state; 0 = automatic, 1 = none
   bool quiet = false;
+  std::vector<std::string> set;  // --set KEY=VALUE: applied to every case, after the sweep's own
+  std::string backend;           // --backend: simulation.backend of every case ("" = as the cases say)
 };
 
 // Returns the exit status: 0 when every case selected is complete, 1 when one failed at run time.
