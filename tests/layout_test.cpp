@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <set>
 #include <string>
 #include <vector>
@@ -57,7 +56,6 @@ struct Include {
 
 std::vector<Include> projectIncludes() {
   std::vector<Include> includes;
-  const std::regex directive(R"(^\s*#\s*include\s*"([^"]+)\")");
   for (const char* top : {"framework", "geometry", "events", "broadphase", "bench", "plugins", "tests"}) {
     for (const auto& entry : fs::recursive_directory_iterator(kSource / top)) {
       const std::string ext = entry.path().extension().string();
@@ -67,8 +65,13 @@ std::vector<Include> projectIncludes() {
       std::ifstream in(entry.path());
       std::string text;
       for (int line = 1; std::getline(in, text); ++line) {
-        std::smatch m;
-        if (std::regex_search(text, m, directive)) includes.push_back({file, line, m[1]});
+        // #include "target" (spaces allowed around '#'); system includes <...> are not GEM's.
+        const size_t hash = text.find_first_not_of(" \t");
+        if (hash == std::string::npos || text[hash] != '#') continue;
+        const size_t word = text.find_first_not_of(" \t", hash + 1);
+        if (word == std::string::npos || text.compare(word, 7, "include") != 0) continue;
+        const size_t open = text.find('"', word + 7), close = open == std::string::npos ? open : text.find('"', open + 1);
+        if (close != std::string::npos) includes.push_back({file, line, text.substr(open + 1, close - open - 1)});
       }
     }
   }
