@@ -55,20 +55,7 @@ std::map<std::string, std::map<std::string, std::string>> readStatistics(const f
   for (std::stringstream s(line); std::getline(s, line, ',');) header.push_back(line);
   std::map<std::string, std::map<std::string, std::string>> rows;
   while (std::getline(in, line)) {
-    // RFC 4180: a quoted field may hold commas and doubled quotes.
-    std::vector<std::string> cells(1);
-    bool quoted = false;
-    for (size_t k = 0; k < line.size(); ++k) {
-      const char c = line[k];
-      if (quoted && c == '"' && k + 1 < line.size() && line[k + 1] == '"')
-        cells.back() += '"', ++k;
-      else if (c == '"')
-        quoted = !quoted;
-      else if (c == ',' && !quoted)
-        cells.emplace_back();
-      else
-        cells.back() += c;
-    }
+    const std::vector<std::string> cells = gem::test::csvCells(line);  // quoted names hold commas
     EXPECT_EQ(cells.size(), header.size()) << line;
     for (size_t i = 0; i < cells.size() && i < header.size(); ++i) rows[cells[0]][header[i]] = cells[i];
   }

@@ -66,23 +66,7 @@ std::vector<std::string> lines(const fs::path& file) {
   return out;
 }
 
-// Splits one CSV line, honouring quoted fields.
-std::vector<std::string> csvCells(const std::string& line) {
-  std::vector<std::string> cells(1);
-  bool quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"')
-      cells.back() += '"', ++i;
-    else if (c == '"')
-      quoted = !quoted;
-    else if (c == ',' && !quoted)
-      cells.emplace_back();
-    else
-      cells.back() += c;
-  }
-  return cells;
-}
+using test::csvCells;
 
 int sweep(const fs::path& file, const fs::path& out, int jobs = 2, long caseIndex = -1) {
   SweepOptions o;

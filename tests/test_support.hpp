@@ -80,6 +80,24 @@ inline int runGem(const std::string& arguments, const std::filesystem::path& log
 // The impacts the last step logged (ship_impact's record stream).
 inline std::vector<ImpactRecord> impactsOf(const Stepper& stepper) { return stepper.records().rows<ImpactRecord>(kImpactStream); }
 
+// Splits one CSV line, honouring quoted fields (RFC 4180: commas and doubled quotes inside).
+inline std::vector<std::string> csvCells(const std::string& line) {
+  std::vector<std::string> cells(1);
+  bool quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"')
+      cells.back() += '"', ++i;
+    else if (c == '"')
+      quoted = !quoted;
+    else if (c == ',' && !quoted)
+      cells.emplace_back();
+    else
+      cells.back() += c;
+  }
+  return cells;
+}
+
 inline std::string readFile(const std::filesystem::path& file) {
   std::ifstream in(file);
   return std::string(std::istreambuf_iterator<char>(in), {});
