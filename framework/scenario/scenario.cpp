@@ -64,7 +64,7 @@ Domain readDomain(TableReader& t, const Scenario& s) {
 // A generated field's size is known before it is made: refuse one that could not fit in this
 // machine's memory, with the estimate, instead of growing until std::bad_alloc (docs/scenario.md).
 // About 3 KB a floe: its polygon and state, and the step's per-body and per-contact buffers.
-void checkFieldMemory(const Scenario& s, TableReader& top) {
+void checkFieldMemory(const Scenario& s) {
   if (s.fieldKind != "random_convex" && s.fieldKind != "hexagons") return;
   const double area = (static_cast<double>(s.domain.x1) - s.domain.x0) * (static_cast<double>(s.domain.y1) - s.domain.y0);
   double floes = 0;
@@ -84,7 +84,6 @@ void checkFieldMemory(const Scenario& s, TableReader& top) {
         fmt::format("field: about {:.3g} floes (the domain's {:.3g} m^2 x concentration / floe area), which need about {:.3g} GB; "
                     "this machine has {:.3g} GB: make the [domain] smaller or the floes larger",
                     floes, area, need / 1e9, have / 1e9));
-  (void)top;
 }
 
 void readField(TableReader& t, Scenario& s) {
@@ -271,7 +270,7 @@ void readBroadphaseSettings(TableReader& t, const BroadphaseEntry& strategy, Bro
 
 // [broadphase.NAME] tables: each names a registered strategy and holds only its settings. The
 // chosen strategy's table applies; another's is still checked (a sweep may switch strategies).
-void readBroadphaseTables(const toml::table& tables, TableReader& top, Scenario& s) {
+void readBroadphaseTables(const toml::table& tables, Scenario& s) {
   TableReader all(&tables, "broadphase", s.fileName);
   for (const auto& [name, node] : tables) {
     const std::string key(name.str());
@@ -290,7 +289,6 @@ void readBroadphaseTables(const toml::table& tables, TableReader& top, Scenario&
     if (key == s.broadphase) s.broadphaseSettings = settings;
   }
   all.finish();
-  (void)top;
 }
 
 }  // namespace
@@ -352,7 +350,7 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
     if (s.cudaBlockSize % 32 != 0) t.fail("cuda_block_size", "must be a multiple of 32 (a whole number of warps)");
     t.finish();
   }
-  if (const toml::table* b = top.findTable("broadphase")) readBroadphaseTables(*b, top, s);
+  if (const toml::table* b = top.findTable("broadphase")) readBroadphaseTables(*b, s);
   if (const toml::table* d = top.findTable("domain")) {
     TableReader t(d, "domain", s.fileName);
     s.hasDomain = true;
@@ -398,7 +396,7 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
   // The field was read before [domain] may have been: bind the generators to the final domain.
   s.randomField.domain = s.domain;
   s.hexagonField.domain = s.domain;
-  checkFieldMemory(s, top);
+  checkFieldMemory(s);
   return s;
 }
 
