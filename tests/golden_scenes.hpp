@@ -78,8 +78,10 @@ inline std::vector<GoldenScene> goldenScenes() {
 }
 
 // The scene's scenario on `backend`, its outputs in `dir` and none written but what a run needs.
-inline Scenario loadGoldenScene(const GoldenScene& scene, const TempDir& dir, const std::string& backend) {
+inline Scenario loadGoldenScene(const GoldenScene& scene, const TempDir& dir, const std::string& backend,
+                                const std::vector<std::string>& extra = {}) {
   std::vector<std::string> overrides = scene.overrides;
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
   overrides.push_back("simulation.backend=\"" + backend + "\"");
   overrides.push_back("output.frame_every=0");
   overrides.push_back("output.dir=\"" + dir.path().string() + "\"");
@@ -89,11 +91,13 @@ inline Scenario loadGoldenScene(const GoldenScene& scene, const TempDir& dir, co
 
 // The test of one scene on one backend: its hash against the recorded one in `goldenFile`
 // (relative to the source tree). GEM_GOLDEN_RECORD=FILE appends "scene hash" lines to FILE
-// instead: how the golden files were made, on a commit whose behaviour is the reference.
-inline void expectGoldenHash(const GoldenScene& scene, const std::string& backend, const std::string& goldenFile) {
+// instead: how the golden files were made, on a commit whose behaviour is the reference. extra:
+// overrides of every scene (the CUDA driver, say), which must step to the same hash.
+inline void expectGoldenHash(const GoldenScene& scene, const std::string& backend, const std::string& goldenFile,
+                             const std::vector<std::string>& extra = {}) {
   if (sizeof(Real) != sizeof(double)) GTEST_SKIP() << "the golden hashes are recorded for GEM_REAL=double";
   TempDir dir;
-  const Scenario s = loadGoldenScene(scene, dir, backend);
+  const Scenario s = loadGoldenScene(scene, dir, backend, extra);
   auto stepper = makeStepper(s);
   RunActivity activity;
   const std::string hash = hex(fingerprintRun(*stepper, std::min(s.steps, kGoldenSteps), &activity));
@@ -106,7 +110,8 @@ inline void expectGoldenHash(const GoldenScene& scene, const std::string& backen
   const auto golden = readGoldenFile(sourceDir() / goldenFile);
   const auto it = golden.find(scene.name);
   ASSERT_NE(it, golden.end()) << "no golden hash for scene " << scene.name << " in " << goldenFile;
-  EXPECT_EQ(hash, it->second) << "scene " << scene.name << " on " << backend << " no longer steps as it did when its hash was recorded";
+  EXPECT_EQ(hash, it->second) << "scene " << scene.name << " on " << backend << (extra.empty() ? "" : " with " + extra.front())
+                              << " no longer steps as it did when its hash was recorded";
 }
 
 }  // namespace gem::test

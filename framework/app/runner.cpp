@@ -81,13 +81,13 @@ std::string summaryJson(const RunSummary& s) {
   return fmt::format(
       "{{\n"
       "  \"gem_version\": \"{}\",\n  \"steps\": {},\n  \"sim_time_s\": {},\n  \"wall_time_s\": {},\n"
-      "  \"real_time_factor\": {},\n  \"backend\": \"{}\",\n  \"broadphase\": \"{}\",\n  \"device\": \"{}\",\n"
+      "  \"real_time_factor\": {},\n  \"backend\": \"{}\",\n  \"driver\": \"{}\",\n  \"broadphase\": \"{}\",\n  \"device\": \"{}\",\n"
       "  \"floes_initial\": {},\n  \"floes_final\": {},\n  \"floes_broken\": {},\n"
       "  \"ice_mass_initial_kg\": {},\n  \"ice_mass_final_kg\": {},\n  \"rubble_mass_kg\": {},\n"
       "  \"cases_on_device\": {},\n{}  \"ship_speed\": {},\n  \"net_thrust_n\": {},\n"
       "  \"resistance_mean_n\": {},\n  \"ship_speed_in_ice\": {},\n  \"resistance_in_ice_n\": {}\n}}\n",
       GEM_VERSION, s.steps, jsonNumber(s.simTime), jsonNumber(s.wallTime), jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY),
-      s.backend, s.broadphase, s.device, s.floesInitial, s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial),
+      s.backend, s.driver, s.broadphase, s.device, s.floesInitial, s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial),
       jsonNumber(s.iceMassFinal), jsonNumber(s.rubbleMass), s.casesOnDevice, recordTotalsJson(s), jsonStats(s.shipSpeed),
       jsonStats(s.netThrust), s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null", jsonStats(s.shipSpeedInIce),
       s.netThrustInIce.count ? jsonNumber(s.netThrustInIce.mean) : "null");
@@ -105,6 +105,7 @@ class ScenarioRun {
       : m_scenario(scenario), m_stepper(&stepper), m_dir(scenario.output.dir), m_lock(m_dir), m_timeseries(m_dir / "timeseries.csv") {
     Stepper& sim = *m_stepper;
     m_summary.backend = sim.backend();  // "auto" may have fallen back to the cpu
+    m_summary.driver = sim.driver();
     m_summary.broadphase = scenario.broadphase;
     m_summary.outputDir = scenario.output.dir.string();
     m_summary.device = sim.device();

@@ -33,7 +33,7 @@ struct RecordTotals {
 struct RunSummary {
   long steps = 0;
   double simTime = 0, wallTime = 0;
-  std::string backend, broadphase, device;
+  std::string backend, driver, broadphase, device;
   int floesInitial = 0, floesFinal = 0;
   double iceMassInitial = 0, iceMassFinal = 0, rubbleMass = 0;
   long floesBroken = 0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "framework/api/cuda_check.hpp"
+#include "framework/cuda/body_phases.cuh"
 #include "framework/cuda/device_state.cuh"
 #include "framework/cuda/step_phases.cuh"
 #include "framework/step/phases.hpp"
@@ -32,18 +33,13 @@ __global__ void narrowphaseKernel(int capacity, const int* needed, const int* ca
     flag[p] = 0;
     return;
   }
-  const int a = candA[p], b = candB[p];
-  // The prefilter (phases.hpp): a device broadphase may propose more than the grid's accept() lets
-  // through; dropping the same pairs here keeps the contacts bit-identical. Bodies of two worlds
-  // never touch (a device strategy does not know the worlds).
-  if (world[a] != world[b] || !mayTouch(invMass[a], invMass[b], boxes[a], boxes[b])) {
+  Contact c{};
+  if (!contactOfPair(candA[p], candB[p], worldVertices, vertexCount, x, y, boxes, invMass, world, c)) {
     flag[p] = 0;
     return;
   }
-  const Contact c = computeContact(worldVertices + static_cast<size_t>(a) * kMaxVertices, vertexCount[a], Vec2{x[a], y[a]},
-                                   worldVertices + static_cast<size_t>(b) * kMaxVertices, vertexCount[b], Vec2{x[b], y[b]});
   out[p] = c;
-  flag[p] = c.touching ? 1 : 0;
+  flag[p] = 1;
 }
 
 __device__ inline unsigned long long contactIdKey(std::int64_t ia, std::int64_t ib, int bits) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 #include <thread>
 
@@ -17,6 +18,7 @@
 
 #include "framework/api/cuda_check.hpp"
 #include "framework/cuda/device_step.hpp"
+#include "framework/cuda/resident.cuh"
 #include "framework/api/log_channel.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/step/phases.hpp"
@@ -51,6 +53,49 @@ std::unique_ptr<cuda::CudaBroadphase> deviceBroadphase(const Scenario& scenario)
 }
 
 namespace {
+
+// simulation.cuda_driver = "auto": the resident driver up to this many bodies in the largest world
+// (docs/performance.md "CUDA drivers" has the measurements it comes from), the device-wide one past it.
+constexpr int kResidentAutoMostBodies = 4096;
+
+// The resident kernel's program for these events, and each world's row of their Params; or why the
+// kernel cannot run them (an event it does not hold: a plugin's).
+std::string residentProgramOf(const std::vector<const CpuStepper*>& members, cuda::ResidentProgram& program,
+                              std::vector<unsigned char>& params, int& stride) {
+  const std::vector<EnabledEvent>& events = members.front()->events();
+  struct Placed {
+    size_t event, size;
+    int offset;
+  };
+  std::vector<Placed> placed;
+  int offset = 0;
+  for (size_t e = 0; e < events.size(); ++e) {
+    const EnabledEvent& event = events[e];
+    if (event.phase == EventPhase::Topology) continue;  // runs on the host
+    const EventEntry* entry = Registry::global().findEvent(event.name);
+    if (entry && entry->origin != "built-in")
+      return "event \"" + event.name + "\" comes from a plugin (" + entry->origin + "), and the resident kernel holds GEM's own events only";
+    const cuda::ResidentPhase phase = event.phase == EventPhase::Pair   ? cuda::kResidentPair
+                                      : event.phase == EventPhase::Solo ? cuda::kResidentSolo
+                                                                        : cuda::kResidentMotion;
+    size_t size = 0;
+    const int kind = cuda::residentEventKind(event.name, phase, &size);
+    if (kind < 0) return "event \"" + event.name + "\" is not in the resident kernel (framework/cuda/resident_events.cu)";
+    int& count = phase == cuda::kResidentPair ? program.pairCount : phase == cuda::kResidentSolo ? program.soloCount : program.motionCount;
+    cuda::ResidentEventCall* calls = phase == cuda::kResidentPair ? program.pair : phase == cuda::kResidentSolo ? program.solo : program.motion;
+    if (count == cuda::kResidentMaxEvents) return fmt::format("more than {} events of one phase", cuda::kResidentMaxEvents);
+    calls[count++] = cuda::ResidentEventCall{kind, offset};
+    placed.push_back(Placed{e, size, offset});
+    offset += static_cast<int>((size + 15) / 16 * 16);
+  }
+  stride = std::max(offset, 16);
+  params.assign(members.size() * static_cast<size_t>(stride), 0);
+  for (size_t w = 0; w < members.size(); ++w)
+    for (const Placed& p : placed)
+      std::memcpy(params.data() + w * static_cast<size_t>(stride) + static_cast<size_t>(p.offset),
+                  members[w]->events()[p.event].instance->params(), p.size);
+  return "";
+}
 
 // Rows [first, from.size()) of `from` appended to `to`, ids shifted by idOffset.
 void appendRows(World& to, const World& from, int first, std::int64_t idOffset) {
@@ -120,7 +165,30 @@ CudaBatch::CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal)
       throw BackendUnsupported(
           fmt::format("{} cases of up to {} bodies are too many for one device state; run fewer together", worlds(), most));
   }
-  m_device->setBroadphase(deviceBroadphase(s));
+  // The driver: resident (a block per world) or device-wide (kernels over the whole state).
+  cuda::ResidentProgram program;
+  std::vector<unsigned char> params;
+  int stride = 0;
+  std::vector<const CpuStepper*> cpus;
+  for (const CudaStepper* m : m_members) cpus.push_back(m->m_cpu.get());
+  const std::string notResident = residentProgramOf(cpus, program, params, stride);
+  int most = 0;
+  for (CudaStepper* m : m_members) most = std::max(most, m->world().size());
+  bool resident = false;
+  if (s.cudaDriver == "resident") {
+    if (!notResident.empty())
+      throw BackendUnsupported("simulation.cuda_driver = \"resident\": " + notResident + "; use \"device\" or \"auto\"");
+    resident = true;
+  } else if (s.cudaDriver == "auto") {
+    // Several worlds with a broadphase other than the device-wide driver's grid can only share a
+    // device resident (batchKey let them in together).
+    resident = notResident.empty() && (most <= kResidentAutoMostBodies || (worlds() > 1 && s.broadphase != "uniform_grid"));
+  }
+  if (resident) {
+    m_device->useResident(program, params, stride);
+  } else {
+    m_device->setBroadphase(deviceBroadphase(s));
+  }
   m_device->setGridCell(s.broadphase == "uniform_grid" ? s.broadphaseSettings.cellSize : 0);
   m_device->setIdStride(m_idStride);
   // The record streams, as the events opened them (the same in every case: the same events parsed
@@ -137,7 +205,7 @@ CudaBatch::CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal)
       for (int q : event.instance->streamsRead())
         if (q >= 0) halt |= 1u << q;
   m_device->setRecordStreams(strides, halt);
-  if (worlds() > 1 && m_device->broadphase())
+  if (worlds() > 1 && !resident && s.broadphase != "uniform_grid")
     throw BackendUnsupported("cases run together on one device need the uniform_grid broadphase (it keeps their worlds apart)");
   for (CudaStepper* m : m_members) m->locateVessel();
   uploadAll();

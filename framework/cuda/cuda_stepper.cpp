@@ -73,10 +73,13 @@ World& CudaStepper::world() { return m_cpu->world(); }
 const Scenario& CudaStepper::scenario() const { return m_cpu->scenario(); }
 
 std::string CudaStepper::batchKey(const Scenario& s) {
-  if (s.broadphase != "uniform_grid") return "";
-  std::string key =
-      fmt::format("dt={} steps={} copy_back_every={} block={} morton={} frames={} vessel_dof={} cell={}", s.dt, s.steps, s.copyBackEvery,
-                  s.cudaBlockSize, s.mortonSort, s.output.frameEvery, s.vessel.dof, s.broadphaseSettings.cellSize);
+  // The device-wide driver keeps worlds apart only with its own grid (uniform_grid); the resident
+  // driver, a block per world, with any broadphase. A plugin's events have no place in the resident
+  // kernel, so with one only uniform_grid cases share a device.
+  if (s.broadphase != "uniform_grid" && (s.cudaDriver == "device" || !s.plugins.empty())) return "";
+  std::string key = fmt::format("dt={} steps={} copy_back_every={} block={} morton={} frames={} vessel_dof={} cell={} driver={} broadphase={}",
+                                s.dt, s.steps, s.copyBackEvery, s.cudaBlockSize, s.mortonSort, s.output.frameEvery, s.vessel.dof,
+                                s.broadphaseSettings.cellSize, s.cudaDriver, s.broadphase);
   for (const auto& [name, setting] : s.events) key += fmt::format(" {}={}", name, setting.enabled);
   for (const PluginSpec& p : s.plugins) key += fmt::format(" plugin={}{}", p.path.string(), p.override ? "!" : "");
   return key;
@@ -86,6 +89,8 @@ long CudaStepper::broadphaseRebuilds() const {
   const cuda::CudaBroadphase* b = m_batch->device().broadphase();
   return b ? b->rebuilds() : 0;
 }
+
+std::string CudaStepper::driver() const { return m_batch->device().resident() ? "resident" : "device"; }
 
 int CudaStepper::casesOnDevice() const { return m_batch->worlds(); }
 

@@ -47,6 +47,13 @@ struct StepStats {
   int stepsDone, halt;  // completed steps of the batch, and why it stopped
 };
 
+// The resident driver's own buffers (resident.cu): the worlds' members and per-world scratch.
+struct ResidentState;
+void destroyResident(ResidentState*);
+struct ResidentDeleter {
+  void operator()(ResidentState* r) const { destroyResident(r); }
+};
+
 struct DeviceState {
   // World (structure of arrays, as World).
   GraphArray<std::int64_t> id;
@@ -132,6 +139,7 @@ struct DeviceState {
   long captures = 0;  // step graphs captured and instantiated (GEM_CUDA_TIMING)
   double captureSeconds = 0;
   std::vector<std::unique_ptr<CudaEventDriver>> pairEvents, soloEvents, motionEvents;
+  std::unique_ptr<ResidentState, ResidentDeleter> resident;  // set: the resident driver steps (resident.cu)
 
   DeviceState() {
     GEM_CUDA_CHECK(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking));

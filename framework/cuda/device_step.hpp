@@ -14,6 +14,7 @@
 namespace gem::cuda {
 
 struct DeviceState;
+struct ResidentProgram;
 
 // One completed step's results, as the device's step graph writes them into its ring. The record
 // ends index the batch's rows of each record stream: step s's rows of stream q are
@@ -99,6 +100,11 @@ class DeviceStep {
                   const std::vector<int>& vesselDofs);
   // The device broadphase rebuilds its per-body storage from the host world (in the device's order).
   void uploadBroadphase(const World& world);
+  // The resident driver (framework/cuda/resident.cuh) steps from now on: each world's whole step in
+  // one thread block. program: the events as the resident kernel holds them; params: worlds rows of
+  // paramsStride bytes, the Params of world w's events at the program's offsets.
+  void useResident(const ResidentProgram& program, const std::vector<unsigned char>& params, int paramsStride);
+  bool resident() const;
   // Steps kept on the device between two copies to the host (the ring's length), and threads per
   // block of the per-body and per-contact kernels. Before the first run.
   void configure(int copyBackEvery, int blockSize);

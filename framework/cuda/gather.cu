@@ -1,6 +1,7 @@
 // Phase 5 of a step, around the motion events: each body's contact impulses gathered in the
 // CPU's order, then the motion written back into the state.
 #include "framework/api/cuda_check.hpp"
+#include "framework/cuda/body_phases.cuh"
 #include "framework/cuda/device_state.cuh"
 #include "framework/cuda/step_phases.cuh"
 #include "framework/step/phases.hpp"
@@ -29,25 +30,16 @@ __global__ void gatherKernel(int n, const int* world, const int* vesselSlot, con
                              const PairSlot* slots, MotionBody* motion, WorldStepRecord* worldStats) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
-  const int vessel = vesselSlot[world[i]];
-  const PairBody& b = bodies[i];
-  VelocityChange total = changes[i];
-  Vec2 vesselImpulse{0, 0};
-  for (int q = lowerBound(bKeySorted, capacity, i); q < capacity && bKeySorted[q] == i; ++q) {
-    const int k = bIndexSorted[q];
-    const Vec2 j = slots[k].impulse;
-    if (j.x == 0 && j.y == 0) continue;
-    if (i == vessel) vesselImpulse += j;
-    addContactImpulse(b, j, contacts[k].geometry.point, total);
-  }
-  for (int k = lowerBound(contactA, capacity, i); k < capacity && contactA[k] == i; ++k) {
-    const Vec2 j = slots[k].impulse;
-    if (j.x == 0 && j.y == 0) continue;
-    if (i == vessel) vesselImpulse += -j;
-    addContactImpulse(b, -j, contacts[k].geometry.point, total);
-  }
-  if (i == vessel) worldStats[world[i]].vesselImpulse = vesselImpulse;
-  motion[i] = MotionBody{b.kind, b.dof, b.position, b.angle, b.velocity + total.dv, b.omega + total.domega};
+  const bool isVessel = i == vesselSlot[world[i]];
+  const int firstB = lowerBound(bKeySorted, capacity, i);
+  int endB = firstB;
+  while (endB < capacity && bKeySorted[endB] == i) ++endB;
+  const int firstA = lowerBound(contactA, capacity, i);
+  int endA = firstA;
+  while (endA < capacity && contactA[endA] == i) ++endA;
+  motion[i] = gatherBody(
+      bodies[i], changes[i], [&](int q) { return bIndexSorted[firstB + q]; }, endB - firstB, firstA, endA, contacts, slots, isVessel,
+      &worldStats[world[i]].vesselImpulse);
 }
 
 // The only write of the state; skipped when the step overflowed, so it can simply be run again.
@@ -55,19 +47,8 @@ __global__ void writeBackKernel(int n, const int* world, const int* vesselSlot, 
                                 Real* vx, Real* vy, Real* omega, const StepStats* stats, WorldStepRecord* worldStats) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n || stats->overflow) return;
-  const MotionBody& b = motion[i];
-  x[i] = b.position.x;
-  y[i] = b.position.y;
-  angle[i] = b.angle;
-  vx[i] = b.velocity.x;
-  vy[i] = b.velocity.y;
-  omega[i] = b.omega;
-  if (i == vesselSlot[world[i]]) {
-    WorldStepRecord& r = worldStats[world[i]];
-    r.vesselPosition = b.position;
-    r.vesselVelocity = b.velocity;
-    r.vesselAngle = b.angle;
-  }
+  const bool isVessel = i == vesselSlot[world[i]];
+  writeBackBody(motion[i], i, x, y, angle, vx, vy, omega, isVessel, worldStats[world[i]]);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "framework/api/cuda_check.hpp"
+#include "framework/cuda/body_phases.cuh"
 #include "framework/cuda/device_state.cuh"
 #include "framework/cuda/step_phases.cuh"
 #include "framework/step/phases.hpp"
@@ -11,27 +12,6 @@
 namespace gem::cuda {
 namespace {
 
-struct PrepareArgs {
-  int n;
-  const std::int64_t* id;
-  const BodyKind* kind;
-  const int *vertexCount, *dof;
-  const Vec2* local;
-  const Real *x, *y, *angle, *vx, *vy, *omega, *area, *thickness, *mass, *invMass, *invInertia, *gyration2, *gyrationX2, *gyrationY2,
-      *principalAngle;
-  const unsigned char* isLarge;
-  const int* world;
-  std::int64_t idStride;  // the events see each case's own ids (PairBody::id)
-  Real cell;
-  unsigned mask, largeKey;
-  Vec2* worldVertices;
-  Box* boxes;
-  PairBody* pairBodies;
-  SoloBody* soloBodies;
-  VelocityChange* changes;
-  unsigned* cellKey;
-  int* slot;
-};
 
 // Phase 1 and the views: as CpuStepper::narrowphase's box loop and CpuStepper::step's view loops.
 // A body's rows (16 vertices, a PairBody, a SoloBody) are large, and a thread writing its own is a
@@ -64,20 +44,7 @@ __device__ void copyRows(T* to, const T* from, int count) {
 
 __global__ void prepareDirectKernel(PrepareArgs a) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= a.n) return;
-  Vec2* v = a.worldVertices + static_cast<size_t>(i) * kMaxVertices;
-  const int count = a.vertexCount[i];
-  toWorld(a.local + static_cast<size_t>(i) * kMaxVertices, count, Vec2{a.x[i], a.y[i]}, a.angle[i], v);
-  const Box box = boundingBox(v, count);
-  a.boxes[i] = box;
-  PairBody b = pairBodyOf(a, i, a.dof[i], v, count);
-  b.id -= static_cast<std::int64_t>(a.world[i]) * a.idStride;
-  a.pairBodies[i] = b;
-  a.soloBodies[i] = SoloBody{b.kind, b.dof, b.position, b.angle, b.velocity, b.omega, b.mass, b.area, b.thickness};
-  a.changes[i] = VelocityChange{{0, 0}, 0};
-  // A small body lives in the cell of its box's lower-left corner; large ones stay out of the grid.
-  a.cellKey[i] = a.isLarge[i] ? a.largeKey : cellHash(cellCoord(box.x0, a.cell), cellCoord(box.y0, a.cell), a.world[i], a.mask);
-  a.slot[i] = i;
+  if (i < a.n) prepareBody(a, i);
 }
 
 __global__ void __launch_bounds__(kPrepareBlock) prepareStagedKernel(PrepareArgs a) {
@@ -127,44 +94,48 @@ __global__ void __launch_bounds__(kPrepareBlock) prepareStagedKernel(PrepareArgs
 
 }  // namespace
 
+PrepareArgs prepareArgsOf(DeviceState& d, unsigned largeKey, bool grid) {
+  return PrepareArgs{d.n,
+                     d.id.get(),
+                     d.kind.get(),
+                     d.vertexCount.get(),
+                     d.dof.get(),
+                     d.local.get(),
+                     d.x.get(),
+                     d.y.get(),
+                     d.angle.get(),
+                     d.vx.get(),
+                     d.vy.get(),
+                     d.omega.get(),
+                     d.area.get(),
+                     d.thickness.get(),
+                     d.mass.get(),
+                     d.invMass.get(),
+                     d.invInertia.get(),
+                     d.gyration2.get(),
+                     d.gyrationX2.get(),
+                     d.gyrationY2.get(),
+                     d.principalAngle.get(),
+                     d.isLarge.get(),
+                     d.world.get(),
+                     d.idStride,
+                     d.cell,
+                     d.tableSize - 1,
+                     largeKey,
+                     d.worldVertices.get(),
+                     d.boxes.get(),
+                     d.pairBodies.get(),
+                     d.soloBodies.get(),
+                     d.changes.get(),
+                     grid ? d.cellKey.get() : nullptr,
+                     grid ? d.slot.get() : nullptr};
+}
+
 void enqueuePrepare(DeviceState& d, unsigned largeKey) {
   cudaStream_t s = d.stream;
   const int n = d.n, block = d.block;
   // 1. World vertices, boxes, views, cell keys.
-  PrepareArgs a{n,
-                d.id.get(),
-                d.kind.get(),
-                d.vertexCount.get(),
-                d.dof.get(),
-                d.local.get(),
-                d.x.get(),
-                d.y.get(),
-                d.angle.get(),
-                d.vx.get(),
-                d.vy.get(),
-                d.omega.get(),
-                d.area.get(),
-                d.thickness.get(),
-                d.mass.get(),
-                d.invMass.get(),
-                d.invInertia.get(),
-                d.gyration2.get(),
-                d.gyrationX2.get(),
-                d.gyrationY2.get(),
-                d.principalAngle.get(),
-                d.isLarge.get(),
-                d.world.get(),
-                d.idStride,
-                d.cell,
-                d.tableSize - 1,
-                largeKey,
-                d.worldVertices.get(),
-                d.boxes.get(),
-                d.pairBodies.get(),
-                d.soloBodies.get(),
-                d.changes.get(),
-                d.cellKey.get(),
-                d.slot.get()};
+  const PrepareArgs a = prepareArgsOf(d, largeKey, true);
   if (stagedPrepare(n))
     prepareStagedKernel<<<blocksFor(n, kPrepareBlock), kPrepareBlock, 0, s>>>(a);  // a fixed block
   else

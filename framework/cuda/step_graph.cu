@@ -316,6 +316,10 @@ void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& resu
     result.worldSteps.assign(static_cast<size_t>(steps) * static_cast<size_t>(d.worlds), WorldStepRecord{});
     return;
   }
+  if (d.resident) {
+    runResident(d, firstStep, dt, steps, result);
+    return;
+  }
   static const bool useGraph = [] {
     const char* v = std::getenv("GEM_CUDA_GRAPH");  // 0: launch the kernels one by one (debugging)
     return !(v && v[0] == '0');

@@ -46,6 +46,9 @@ void enqueueCommitContacts(DeviceState& d);
 // (contacts.cu; sizeForBodies calls it).
 void rekeyContacts(DeviceState& d, int newBits);
 
+// The resident driver's batch of steps, in place of the step graph's (resident.cu).
+void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatchResult& result);
+
 // A large body's row is split into chunks of kLargeChunk bodies (broadphase_grid.cu says why);
 // sizeForBodies sizes the chunk counts.
 constexpr int kLargeChunk = 256;

@@ -49,6 +49,9 @@ struct Scenario {
   // per block of the per-body and per-contact kernels.
   int copyBackEvery = 16;
   int cudaBlockSize = 128;
+  // The CUDA driver (docs/performance.md "CUDA drivers"): "resident" runs each world's whole step
+  // in one thread block, "device" each phase as kernels over the whole field, "auto" picks by size.
+  std::string cudaDriver = "auto";
 
   // [domain]
   bool hasDomain = false;

@@ -41,6 +41,8 @@ class Stepper {
   virtual long floesBroken() const = 0;
   virtual std::string device() const = 0;
   virtual std::string backend() const = 0;  // "cpu", "cuda"
+  // The backend's driver that steps: "cpu", or the CUDA driver ("resident", "device").
+  virtual std::string driver() const { return backend(); }
 };
 
 // A backend that cannot run this scenario (e.g. an event without a driver for it). Bad input when

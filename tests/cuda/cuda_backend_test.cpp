@@ -553,7 +553,15 @@ TEST(CudaBackend, ReSortOnTheDeviceGivesTheHostsCurveOrder) {
 // Cases run together in one device state (gem sweep's batches on a GPU): each must step exactly as
 // it does alone, bit for bit, though they differ in field, ice, thrust (a Params of its own per
 // world) and in how their floes break (each world's edits, re-sorts and new ids are its own).
-TEST(CudaBackend, CasesRunTogetherStepExactlyAsAlone) {
+// Cases run together on either CUDA driver: the device-wide one (its own grid keeps the worlds
+// apart), the resident one (a block per world) with that grid or with any other broadphase.
+struct TogetherDriver {
+  const char* driver;
+  const char* broadphase;
+};
+class CasesTogether : public ::testing::TestWithParam<TogetherDriver> {};
+
+TEST_P(CasesTogether, StepExactlyAsAlone) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const std::vector<std::vector<std::string>> variants = {
@@ -564,7 +572,8 @@ TEST(CudaBackend, CasesRunTogetherStepExactlyAsAlone) {
   std::vector<Scenario> scenarios;
   for (size_t k = 0; k < variants.size(); ++k) {
     std::vector<std::string> overrides = variants[k];
-    overrides.insert(overrides.end(), {"simulation.steps=420", "simulation.broadphase=\"uniform_grid\""});
+    overrides.insert(overrides.end(), {"simulation.steps=420", std::string("simulation.broadphase=\"") + GetParam().broadphase + "\"",
+                                       std::string("simulation.cuda_driver=\"") + GetParam().driver + "\""});
     scenarios.push_back(loadScenario(dir.write("case" + std::to_string(k) + ".toml", kBusyScene), overrides));
   }
   std::vector<const Scenario*> pointers;
@@ -572,6 +581,7 @@ TEST(CudaBackend, CasesRunTogetherStepExactlyAsAlone) {
   std::vector<std::unique_ptr<CudaStepper>> together = CudaStepper::together(pointers);
   ASSERT_EQ(together.size(), 3u);
   EXPECT_EQ(together[0]->casesOnDevice(), 3);
+  EXPECT_EQ(together[0]->driver(), GetParam().driver);
   std::vector<std::unique_ptr<CudaStepper>> alone;
   for (const Scenario& s : scenarios) alone.push_back(std::make_unique<CudaStepper>(s));
 
@@ -614,15 +624,26 @@ TEST(CudaBackend, CasesRunTogetherStepExactlyAsAlone) {
   EXPECT_GT(together[2]->floesBroken(), 0);
 }
 
+INSTANTIATE_TEST_SUITE_P(Drivers, CasesTogether,
+                         ::testing::Values(TogetherDriver{"device", "uniform_grid"}, TogetherDriver{"resident", "uniform_grid"},
+                                           TogetherDriver{"resident", "variable_radius"}),
+                         [](const auto& info) { return std::string(info.param.driver) + "_" + info.param.broadphase; });
+
 TEST(CudaBackend, CasesThatCannotShareADeviceStateAreRefused) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const std::string grid = "simulation.broadphase=\"uniform_grid\"";
   const Scenario a = test::scenarioFromToml(dir, kBusyScene, {grid});
   const Scenario longer = test::scenarioFromToml(dir, kBusyScene, {grid, "simulation.steps=301"});
-  const Scenario kept = test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"variable_radius\""});
+  // The device-wide driver batches only its own grid; the resident driver (auto picks it for
+  // these sizes) any broadphase, but cases of two broadphases stay apart.
+  const Scenario kept =
+      test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"variable_radius\"", "simulation.cuda_driver=\"device\""});
+  const Scenario resident = test::scenarioFromToml(dir, kBusyScene, {"simulation.broadphase=\"variable_radius\""});
   EXPECT_NE(CudaStepper::batchKey(a), "");
   EXPECT_EQ(CudaStepper::batchKey(kept), "");
+  EXPECT_NE(CudaStepper::batchKey(resident), "");
+  EXPECT_NE(CudaStepper::batchKey(resident), CudaStepper::batchKey(a));
   EXPECT_THROW(CudaStepper::together({&a, &longer}), BackendUnsupported);
   EXPECT_THROW(CudaStepper::together({&a, &kept}), BackendUnsupported);
   // What a sweep varies (thrust, ice, the field) does not keep cases apart.

@@ -1,0 +1,75 @@
+// The events the resident kernel holds: GEM's built-in evaluators, the very structs the CPU driver
+// and the device-wide driver call (events/NAME.hpp), compiled into the kernel so that a step is one
+// launch. This is the one file of framework/ that includes events/ (tests/layout_test.cpp allows
+// it): a built-in event joins the resident driver by one line below. An event not listed here (a
+// plugin's) runs on the device-wide driver; simulation.cuda_driver = "auto" picks it.
+#include <cstring>
+
+#include "events/autopilot.hpp"
+#include "events/drag.hpp"
+#include "events/elastic_contact.hpp"
+#include "events/environmental_force.hpp"
+#include "events/impact.hpp"
+#include "events/motion.hpp"
+#include "events/propulsion.hpp"
+#include "events/ship_impact.hpp"
+#include "framework/api/cuda_check.hpp"
+#include "framework/cuda/resident.cuh"
+#include "framework/cuda/resident_kernel.cuh"
+
+namespace gem::cuda {
+namespace {
+
+using BuiltIn = resident::EventSet<resident::Pair<Impact>, resident::Pair<ElasticContact>, resident::Pair<ShipImpact>,
+                                   resident::Solo<Drag>, resident::Solo<EnvironmentalForce>, resident::Solo<EnvironmentalForce>,
+                                   resident::Solo<Propulsion>, resident::Solo<Autopilot>, resident::Motion<Motion>>;
+
+struct Entry {
+  const char* name;
+  ResidentPhase phase;
+  std::size_t paramsSize;
+};
+// By kind: the names the registry knows the events by, in BuiltIn's order.
+const Entry kEntries[] = {
+    {"impact", kResidentPair, sizeof(Impact::Params)},
+    {"elastic_contact", kResidentPair, sizeof(ElasticContact::Params)},
+    {"ship_impact", kResidentPair, sizeof(ShipImpact::Params)},
+    {"drag", kResidentSolo, sizeof(Drag::Params)},
+    {"wind", kResidentSolo, sizeof(EnvironmentalForce::Params)},
+    {"current", kResidentSolo, sizeof(EnvironmentalForce::Params)},
+    {"propulsion", kResidentSolo, sizeof(Propulsion::Params)},
+    {"autopilot", kResidentSolo, sizeof(Autopilot::Params)},
+    {"motion", kResidentMotion, sizeof(Motion::Params)},
+};
+static_assert(sizeof(kEntries) / sizeof(kEntries[0]) == BuiltIn::size, "one name per event of the table");
+
+}  // namespace
+
+int residentEventKind(const std::string& name, ResidentPhase phase, std::size_t* paramsSize) {
+  for (int k = 0; k < BuiltIn::size; ++k)
+    if (name == kEntries[k].name && phase == kEntries[k].phase) {
+      if (paramsSize) *paramsSize = kEntries[k].paramsSize;
+      return k;
+    }
+  return -1;
+}
+
+void launchResident(const ResidentArgs& args, int grid, cudaStream_t stream) {
+  if (grid == 1) {
+    resident::residentKernel<BuiltIn><<<1, kResidentBlock, 0, stream>>>(args);
+    GEM_CUDA_CHECK_LAUNCH();
+    return;
+  }
+  ResidentArgs copy = args;
+  void* params[] = {&copy};
+  GEM_CUDA_CHECK(cudaLaunchCooperativeKernel(reinterpret_cast<void*>(resident::residentKernel<BuiltIn>), dim3(static_cast<unsigned>(grid)),
+                                             dim3(kResidentBlock), params, 0, stream));
+}
+
+int residentBlocksPerMultiprocessor() {
+  int blocks = 0;
+  GEM_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, resident::residentKernel<BuiltIn>, kResidentBlock, 0));
+  return blocks;
+}
+
+}  // namespace gem::cuda

@@ -1,0 +1,483 @@
+// Internal to framework/cuda: the resident driver's kernel (resident.cuh says what it is), a template
+// over the table of events it holds; resident_events.cu instantiates it with the built-in events.
+//
+// One block steps one world at a time; a block of a launch of many worlds takes worlds blockIdx.x,
+// blockIdx.x + gridDim.x, ... Per step and world:
+//   1. prepare every body (body_phases.cuh), and key it by its box's left edge;
+//   2. its pairs: a sort and sweep along x over the world's bodies, then the prefilter (mayTouch):
+//      exactly the pairs the device-wide driver's narrowphase tests, sorted by (a, b) slots;
+//   3. narrowphase (contactOfPair), compaction in order, onset against the previous step's pairs;
+//   4. the pair events, contact by contact, each contact's events in the declared order; the solo
+//      events, body by body;
+//   -- a grid barrier: every world knows whether any overflowed a buffer or asked for a break --
+//   5. gather in the CPU's order, the motion events, write-back; this step's pairs kept for onset.
+//   -- a grid barrier: the step is over everywhere --
+// A step that overflowed leaves every world's state alone (phase 5 is where the state is written),
+// so the host can grow the buffer and run it again, bit-identically.
+#pragma once
+#include <cooperative_groups.h>
+
+#include <cstring>
+
+#include "framework/cuda/resident.cuh"
+#include "framework/step/phases.hpp"
+
+namespace gem::cuda::resident {
+
+// ---- the table of events ---------------------------------------------------------------------
+
+template <class E>
+struct Pair {
+  using Event = E;
+  static constexpr ResidentPhase phase = kResidentPair;
+};
+template <class E>
+struct Solo {
+  using Event = E;
+  static constexpr ResidentPhase phase = kResidentSolo;
+};
+template <class E>
+struct Motion {
+  using Event = E;
+  static constexpr ResidentPhase phase = kResidentMotion;
+};
+
+// The events a kernel holds, in a fixed order: an event's kind is its place here.
+template <class... Entries>
+struct EventSet {
+  static constexpr int size = sizeof...(Entries);
+  // Calls visitor(entry) for the entry at `kind` (a switch the compiler builds from the fold).
+  template <class Visitor>
+  __device__ static void visit(int kind, const Visitor& visitor) {
+    int i = 0;
+    (void)((i++ == kind ? (visitor(Entries{}), true) : false) || ...);
+  }
+};
+
+// An event's Params from the world's row of parameters: a copy, as the other drivers pass them.
+template <class Params>
+__device__ inline Params paramsAt(const unsigned char* row, int offset) {
+  Params p;
+  memcpy(&p, row + offset, sizeof p);
+  return p;
+}
+
+struct PairCall {
+  const unsigned char* row;
+  int offset;
+  const PairBody& a;
+  const PairBody& b;
+  const PairContact& contact;
+  PairSlot& slot;
+  const StepContext& ctx;
+  const RecordSink& sink;
+  template <class E>
+  __device__ void operator()(Pair<E>) const {
+    E::apply(paramsAt<typename E::Params>(row, offset), a, b, contact, slot, ctx, sink);
+  }
+  template <class Other>
+  __device__ void operator()(Other) const {}
+};
+
+struct SoloCall {
+  const unsigned char* row;
+  int offset;
+  const SoloBody& body;
+  VelocityChange& change;
+  const StepContext& ctx;
+  template <class E>
+  __device__ void operator()(Solo<E>) const {
+    E::apply(paramsAt<typename E::Params>(row, offset), body, change, ctx);
+  }
+  template <class Other>
+  __device__ void operator()(Other) const {}
+};
+
+struct MotionCall {
+  const unsigned char* row;
+  int offset;
+  MotionBody& body;
+  const StepContext& ctx;
+  template <class E>
+  __device__ void operator()(Motion<E>) const {
+    E::apply(paramsAt<typename E::Params>(row, offset), body, ctx);
+  }
+  template <class Other>
+  __device__ void operator()(Other) const {}
+};
+
+// ---- block tools -----------------------------------------------------------------------------
+
+// Keys sorted in shared memory up to this many, in global memory past it.
+constexpr int kSharedSort = 2048;
+
+struct BlockShared {
+  int scan[33];
+  int count;
+  long long cycles[10], stamp;  // block 0's time by phase (ResidentControl::phaseCycles)
+  unsigned long long sort[kSharedSort];
+};
+
+// The end of phase k in block 0: its cycles since the last mark go to phase k.
+__device__ inline void mark(BlockShared& sh, int k) {
+  if (blockIdx.x != 0 || threadIdx.x != 0) return;
+  const long long now = clock64();
+  sh.cycles[k] += now - sh.stamp;
+  sh.stamp = now;
+}
+
+// data[0..n) replaced by its exclusive prefix sum; returns the total, on every thread.
+__device__ inline int blockExclusiveScan(int* data, int n, BlockShared& sh) {
+  const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5, warps = blockDim.x >> 5;
+  int carry = 0;
+  for (int base = 0; base < n; base += blockDim.x) {
+    const int i = base + threadIdx.x;
+    const int value = i < n ? data[i] : 0;
+    int inclusive = value;
+    for (int o = 1; o < 32; o <<= 1) {
+      const int t = __shfl_up_sync(~0u, inclusive, o);
+      if (lane >= o) inclusive += t;
+    }
+    if (lane == 31) sh.scan[warp] = inclusive;
+    __syncthreads();
+    if (warp == 0) {
+      int total = lane < warps ? sh.scan[lane] : 0;
+      for (int o = 1; o < 32; o <<= 1) {
+        const int t = __shfl_up_sync(~0u, total, o);
+        if (lane >= o) total += t;
+      }
+      if (lane < warps) sh.scan[lane] = total;
+    }
+    __syncthreads();
+    if (i < n) data[i] = carry + (warp > 0 ? sh.scan[warp - 1] : 0) + inclusive - value;
+    carry += sh.scan[warps - 1];
+    __syncthreads();
+  }
+  return carry;
+}
+
+__device__ inline void bitonicSort(unsigned long long* keys, int m) {
+  for (int k = 2; k <= m; k <<= 1)
+    for (int j = k >> 1; j > 0; j >>= 1) {
+      for (int i = threadIdx.x; i < m; i += blockDim.x) {
+        const int l = i ^ j;
+        if (l <= i) continue;
+        const unsigned long long x = keys[i], y = keys[l];
+        if ((x > y) == ((i & k) == 0)) {
+          keys[i] = y;
+          keys[l] = x;
+        }
+      }
+      __syncthreads();
+    }
+}
+
+// keys[0..n) sorted ascending; keys has room for the next power of two of n (the padding).
+__device__ inline void blockSort(unsigned long long* keys, int n, BlockShared& sh) {
+  int m = 1;
+  while (m < n) m <<= 1;
+  if (n <= 1) return;
+  if (m <= kSharedSort) {
+    for (int i = threadIdx.x; i < m; i += blockDim.x) sh.sort[i] = i < n ? keys[i] : ~0ull;
+    __syncthreads();
+    bitonicSort(sh.sort, m);
+    for (int i = threadIdx.x; i < n; i += blockDim.x) keys[i] = sh.sort[i];
+  } else {
+    for (int i = n + threadIdx.x; i < m; i += blockDim.x) keys[i] = ~0ull;
+    __syncthreads();
+    bitonicSort(keys, m);
+  }
+  __syncthreads();
+}
+
+template <class T>
+__device__ inline int lowerBoundOf(const T* v, int n, T x) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (v[mid] < x)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+// A float's bits as an unsigned integer that sorts as the float does.
+__device__ inline unsigned orderedBits(float f) {
+  const unsigned u = __float_as_uint(f);
+  return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+
+// Counters the worlds of a launch share: read past the L1, which other multiprocessors do not see.
+__device__ inline int readShared(const int* p) { return *static_cast<const volatile int*>(p); }
+
+// ---- one world's step --------------------------------------------------------------------------
+
+struct WorldScratch {
+  int begin, n;
+  const int* members;
+  unsigned long long *sweep, *pairs, *ids, *bs, *previous;
+  Contact* candidates;
+  int* flag;
+  int *contactA, *contactB;
+  PairContact* contacts;
+  PairSlot* slots;
+};
+
+__device__ inline WorldScratch scratchOf(const ResidentArgs& a, int w) {
+  const size_t cap = static_cast<size_t>(a.capacity), sortCap = static_cast<size_t>(a.capacitySort), ww = static_cast<size_t>(w);
+  WorldScratch s;
+  s.begin = a.memberBegin[w];
+  s.n = a.memberBegin[w + 1] - s.begin;
+  s.members = a.members + s.begin;
+  s.sweep = a.sweepKeys + ww * static_cast<size_t>(a.bodySort);
+  s.pairs = a.pairKeys + ww * sortCap;
+  s.ids = a.idKeys + ww * sortCap;
+  s.bs = a.bKeys + ww * sortCap;
+  s.previous = a.previous + ww * cap;
+  s.candidates = a.candContact + ww * cap;
+  s.flag = a.flag + ww * (cap + 1);
+  s.contactA = a.contactA + ww * cap;
+  s.contactB = a.contactB + ww * cap;
+  s.contacts = a.contacts + ww * cap;
+  s.slots = a.slots + ww * cap;
+  return s;
+}
+
+// Phases 1 to 4 of world w. Returns its contact count (every thread), or -1 when its candidate
+// pairs passed the capacity (the step is then run again with more room).
+template <class Events>
+__device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, int parity, BlockShared& sh) {
+  const WorldScratch s = scratchOf(a, w);
+  const PrepareArgs& p = a.prepare;
+  const int n = s.n;
+  // 1. Prepare, and the sweep's keys: the box's left edge rounded down (a float sorts as its double
+  // does, ties aside), then the body's place in the world.
+  for (int i = threadIdx.x; i < n; i += blockDim.x) {
+    const int slot = s.members[i];
+    prepareBody(p, slot);
+    s.sweep[i] = (static_cast<unsigned long long>(orderedBits(__double2float_rd(p.boxes[slot].x0))) << 32) | static_cast<unsigned>(i);
+  }
+  if (threadIdx.x == 0) sh.count = 0;
+  __syncthreads();
+  blockSort(s.sweep, n, sh);
+  mark(sh, 0);
+
+  // 2. Pairs: a warp per body in sweep order; its lanes walk the bodies after it while their left
+  // edge (rounded down) is not past its right edge (rounded up): every pair whose boxes overlap
+  // along x is met exactly once, from whichever of the two comes first. The prefilter keeps what
+  // the narrowphase of every other driver tests.
+  const int lane = threadIdx.x & 31, warps = blockDim.x >> 5;
+  for (int q = threadIdx.x >> 5; q < n; q += warps) {
+    const int ia = static_cast<int>(s.sweep[q] & 0xffffffffu), sa = s.members[ia];
+    const Box boxA = p.boxes[sa];
+    const unsigned long long limit = static_cast<unsigned long long>(orderedBits(__double2float_ru(boxA.x1)));
+    for (int first = q + 1; first < n; first += 32) {
+      const int r = first + lane;
+      bool inReach = false;
+      if (r < n) {
+        const unsigned long long key = s.sweep[r];
+        inReach = (key >> 32) <= limit;
+        if (inReach) {
+          const int ib = static_cast<int>(key & 0xffffffffu), sb = s.members[ib];
+          if (mayTouch(p.invMass[sa], p.invMass[sb], boxA, p.boxes[sb])) {
+            const int at = atomicAdd(&sh.count, 1);
+            const unsigned lo = ia < ib ? ia : ib, hi = ia < ib ? ib : ia;
+            if (at < a.capacity) s.pairs[at] = (static_cast<unsigned long long>(lo) << 32) | hi;
+          }
+        }
+      }
+      if (__any_sync(~0u, !inReach)) break;
+    }
+  }
+  __syncthreads();
+  mark(sh, 1);
+  const int pairs = sh.count;
+  if (threadIdx.x == 0) {
+    atomicAdd(&a.control->candidates[parity], pairs);
+    atomicMax(&a.control->candidatesNeeded, pairs);
+    if (pairs > a.capacity) atomicOr(&a.control->overflow[parity], 1);
+  }
+  if (pairs > a.capacity) return -1;
+  blockSort(s.pairs, pairs, sh);
+  mark(sh, 2);
+
+  // 3. Narrowphase, compaction in (a, b) order, onset.
+  for (int k = threadIdx.x; k < pairs; k += blockDim.x) {
+    const unsigned long long key = s.pairs[k];
+    const int sa = s.members[key >> 32], sb = s.members[key & 0xffffffffu];
+    Contact c{};
+    const bool touching = contactOfPair(sa, sb, p.worldVertices, p.vertexCount, p.x, p.y, p.boxes, p.invMass, p.world, c);
+    s.flag[k] = touching ? 1 : 0;
+    if (touching) s.candidates[k] = c;
+  }
+  if (threadIdx.x == 0) s.flag[pairs] = 0;
+  __syncthreads();
+  const int contacts = blockExclusiveScan(s.flag, pairs + 1, sh);
+  const int previous = a.previousCount[w];
+  for (int k = threadIdx.x; k < pairs; k += blockDim.x) {
+    if (s.flag[k + 1] == s.flag[k]) continue;
+    const int c = s.flag[k];
+    const unsigned long long key = s.pairs[k];
+    const int sa = s.members[key >> 32], sb = s.members[key & 0xffffffffu];
+    // The pair by the case's own ids (PairBody::id), the smaller first: kept for the next step's onset.
+    const unsigned long long ida = static_cast<unsigned long long>(p.pairBodies[sa].id), idb = static_cast<unsigned long long>(p.pairBodies[sb].id);
+    const unsigned long long idKey = ida < idb ? (ida << 32) | idb : (idb << 32) | ida;
+    s.contactA[c] = sa;
+    s.contactB[c] = sb;
+    const int seen = lowerBoundOf(s.previous, previous, idKey);
+    s.contacts[c] = PairContact{s.candidates[k], seen == previous || s.previous[seen] != idKey};
+    s.slots[c] = PairSlot{{0, 0}};
+    s.ids[c] = idKey;
+    s.bs[c] = ((key & 0xffffffffu) << 32) | static_cast<unsigned>(c);  // b's place in the world, then the contact
+  }
+  if (threadIdx.x == 0) atomicAdd(&a.control->contacts[parity], contacts);
+  __syncthreads();
+  mark(sh, 3);
+
+  // 4. The pair events, a contact at a time, each contact's events in order; then the solo events.
+  const unsigned char* row = a.params + static_cast<size_t>(w) * static_cast<size_t>(a.paramsStride);
+  for (int k = threadIdx.x; k < contacts; k += blockDim.x) {
+    const PairBody bodyA = p.pairBodies[s.contactA[k]], bodyB = p.pairBodies[s.contactB[k]];
+    const PairContact contact = s.contacts[k];
+    PairSlot slot = s.slots[k];
+    for (int e = 0; e < a.program.pairCount; ++e)
+      Events::visit(a.program.pair[e].kind, PairCall{row, a.program.pair[e].paramsOffset, bodyA, bodyB, contact, slot, ctx, a.sink.at(e, k, w)});
+    s.slots[k] = slot;
+  }
+  for (int i = threadIdx.x; i < n; i += blockDim.x) {
+    const int slot = s.members[i];
+    const SoloBody body = p.soloBodies[slot];
+    VelocityChange change = p.changes[slot];
+    for (int e = 0; e < a.program.soloCount; ++e)
+      Events::visit(a.program.solo[e].kind, SoloCall{row, a.program.solo[e].paramsOffset, body, change, ctx});
+    p.changes[slot] = change;
+  }
+  __syncthreads();
+  mark(sh, 4);
+  // Phase 5 reads the b side in contact order, and the next step's onset the pairs by id.
+  blockSort(s.bs, contacts, sh);
+  blockSort(s.ids, contacts, sh);
+  mark(sh, 5);
+  return contacts;
+}
+
+// Phase 5 of world w: gather, motion, write-back, this step's pairs kept; its record of the step.
+template <class Events>
+__device__ void secondHalf(const ResidentArgs& a, int w, int contacts, const StepContext& ctx, WorldStepRecord& record) {
+  const WorldScratch s = scratchOf(a, w);
+  const PrepareArgs& p = a.prepare;
+  const int vessel = a.vessel[w];
+  if (threadIdx.x == 0) record = WorldStepRecord{contacts, {0, 0}, {0, 0}, {0, 0}, 0};
+  __syncthreads();
+  const unsigned char* row = a.params + static_cast<size_t>(w) * static_cast<size_t>(a.paramsStride);
+  for (int i = threadIdx.x; i < s.n; i += blockDim.x) {
+    const int slot = s.members[i];
+    const bool isVessel = slot == vessel;
+    const int firstB = lowerBoundOf(s.bs, contacts, static_cast<unsigned long long>(i) << 32);
+    int endB = firstB;
+    while (endB < contacts && (s.bs[endB] >> 32) == static_cast<unsigned long long>(i)) ++endB;
+    const int firstA = lowerBoundOf(s.contactA, contacts, slot);
+    int endA = firstA;
+    while (endA < contacts && s.contactA[endA] == slot) ++endA;
+    MotionBody body = gatherBody(
+        p.pairBodies[slot], p.changes[slot], [&](int q) { return static_cast<int>(s.bs[firstB + q] & 0xffffffffu); }, endB - firstB,
+        firstA, endA, s.contacts, s.slots, isVessel, &record.vesselImpulse);
+    for (int e = 0; e < a.program.motionCount; ++e)
+      Events::visit(a.program.motion[e].kind, MotionCall{row, a.program.motion[e].paramsOffset, body, ctx});
+    a.motion[slot] = body;
+    writeBackBody(body, slot, a.x, a.y, a.angle, a.vx, a.vy, a.omega, isVessel, record);
+  }
+  for (int k = threadIdx.x; k < contacts; k += blockDim.x) s.previous[k] = s.ids[k];
+  if (threadIdx.x == 0) a.previousCount[w] = contacts;
+  __syncthreads();
+}
+
+// Is any record stream past its capacity (the step is then run again with more room)?
+__device__ inline bool recordsOverflowed(const RecordSink& sink) {
+  for (int q = 0; q < kMaxRecordStreams; ++q)
+    if (sink.streams[q].count && readShared(sink.streams[q].count) > sink.streams[q].capacity) return true;
+  return false;
+}
+
+template <class Events>
+__global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a) {
+  __shared__ BlockShared sh;
+  ResidentControl& control = *a.control;
+  if (threadIdx.x == 0) {
+    for (long long& c : sh.cycles) c = 0;
+    sh.stamp = clock64();
+  }
+  __syncthreads();
+  auto gridBarrier = [&] {
+    if (gridDim.x > 1)
+      cooperative_groups::this_grid().sync();
+    else
+      __syncthreads();
+  };
+  const bool leader = blockIdx.x == 0 && threadIdx.x == 0;
+  for (int s = 0; s < a.steps; ++s) {
+    const int parity = s & 1;
+    const long step = a.firstStep + s;
+    const StepContext ctx{a.dt, stepTime(step, a.dt), step};
+    // The contact counts of this block's worlds, for phase 5 (a block has one world but for
+    // ensembles larger than the device; those keep theirs in the world's record slot).
+    for (int w = blockIdx.x; w < a.worlds; w += gridDim.x) {
+      const int contacts = firstHalf<Events>(a, w, ctx, parity, sh);
+      if (threadIdx.x == 0) a.worldRing[static_cast<size_t>(s) * a.worlds + w].contacts = contacts;
+    }
+    gridBarrier();
+    mark(sh, 6);
+    // Nothing is pushed between the two barriers: every block reads the same counters.
+    const bool overflow = readShared(&control.overflow[parity]) != 0 || recordsOverflowed(a.sink);
+    if (leader && !overflow) {
+      StepRecord r{readShared(&control.candidates[parity]), readShared(&control.contacts[parity]), {}};
+      bool topology = false;
+      for (int q = 0; q < kMaxRecordStreams; ++q) {
+        r.recordEnd[q] = a.sink.streams[q].count ? readShared(a.sink.streams[q].count) : 0;
+        topology = topology || (((a.haltStreams >> q) & 1u) && r.recordEnd[q] > control.recordBegin[q]);
+        control.recordBegin[q] = r.recordEnd[q];
+      }
+      a.ring[s] = r;
+      control.stepsDone = s + 1;
+      if (topology) {
+        control.halt[parity] = 1;
+        control.haltReason = kHaltBreak;
+      } else if (s + 1 == a.steps) {
+        control.haltReason = kHaltDone;
+      }
+    }
+    if (!overflow) {
+      __syncthreads();
+      for (int w = blockIdx.x; w < a.worlds; w += gridDim.x) {
+        WorldStepRecord& record = a.worldRing[static_cast<size_t>(s) * a.worlds + w];
+        const int contacts = record.contacts;
+        __syncthreads();
+        secondHalf<Events>(a, w, contacts, ctx, record);
+      }
+    }
+    mark(sh, 7);
+    if (leader) {
+      // The next step's counters start at zero (this step's parity is read until the barrier).
+      control.candidates[parity ^ 1] = control.contacts[parity ^ 1] = control.overflow[parity ^ 1] = control.halt[parity ^ 1] = 0;
+    }
+    gridBarrier();
+    mark(sh, 8);
+    if (overflow) {
+      if (leader) {
+        // The overflowed step's rows are dropped: the counters go back to its start.
+        for (int q = 0; q < kMaxRecordStreams; ++q)
+          if (a.sink.streams[q].count) *a.sink.streams[q].count = control.recordBegin[q];
+        control.haltReason = kHaltOverflow;
+      }
+      break;
+    }
+    if (readShared(&control.halt[parity])) break;
+    mark(sh, 9);
+  }
+  if (blockIdx.x == 0 && threadIdx.x == 0)
+    for (int k = 0; k < 10; ++k) control.phaseCycles[k] += sh.cycles[k];
+}
+
+}  // namespace gem::cuda::resident
