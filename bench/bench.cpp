@@ -4,6 +4,8 @@
 #include <system_error>
 #include <cstdlib>
 #include <chrono>
+#include <ctime>
+#include <tuple>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -34,7 +36,8 @@ std::string cpuName() {
 }
 
 const std::vector<std::string>& benchTables() {
-  static const std::vector<std::string> tables{"step", "fields", "blocks", "copyback", "scaling", "intersection", "triangulation", "all"};
+  static const std::vector<std::string> tables{"step",         "fields",        "blocks",   "copyback", "scaling",
+                                               "intersection", "triangulation", "resident", "all"};
   return tables;
 }
 
@@ -427,6 +430,117 @@ void scalingTable(const TableRun& run) {
   table.finish();
 }
 
+// --table resident: the CUDA drivers on the thesis fields as one world (the CPU on one core beside
+// them), then ensembles of thesis-size worlds (the 456-hexagon field, a case each) run together on
+// the resident driver, a block per world. A row: its wall time per step (host bookkeeping of every
+// case included) and its device time per step (the launches and copies alone).
+struct ResidentRow {
+  std::string caseName, driver, device;
+  int worlds = 1;
+  long bodies = 0, floes = 0;
+  double seconds = 0, deviceSeconds = 0;  // per step
+};
+
+std::string todayUtc() {
+  const std::time_t now = std::time(nullptr);
+  char text[16];
+  std::strftime(text, sizeof text, "%Y-%m-%d", std::gmtime(&now));
+  return text;
+}
+
+// Steppers stepped together, every one's step k before any one's step k + 1: seconds of wall and
+// of device time per step over `steps` steps after `warm` steps.
+std::pair<double, double> timeTogether(std::vector<std::unique_ptr<Stepper>>& sims, long warm, long steps) {
+  for (long k = 0; k < warm; ++k)
+    for (auto& sim : sims) sim->step();
+  const double device0 = sims.front()->deviceSeconds();
+  const auto start = Clock::now();
+  for (long k = 0; k < steps; ++k)
+    for (auto& sim : sims) sim->step();
+  return {secondsSince(start) / static_cast<double>(steps), (sims.front()->deviceSeconds() - device0) / static_cast<double>(steps)};
+}
+
+void residentTable(const TableRun& run) {
+  const BenchOptions& o = run.options;
+  const BackendEntry* cuda = findBackend("cuda");
+  if (!cudaUsable()) {
+    if (run.skipCuda) {
+      std::printf("resident table skipped: it times the CUDA drivers, and %s\n",
+                  cuda ? "no CUDA device was found on this machine" : "this build has no CUDA backend");
+      return;
+    }
+    throw InputError(std::string("gem bench --table resident: it times the CUDA drivers, and ") +
+                     (cuda ? "no CUDA device was found on this machine" : "this build has no CUDA backend"));
+  }
+  const std::string date = todayUtc(), commit = GEM_COMMIT;
+  const std::vector<long> ensembles = o.sizes.empty() ? std::vector<long>{10, 100, 1000, 10000} : o.sizes;
+  std::printf(
+      "gem bench --table resident: the thesis fields as one world on each CUDA driver (and the CPU, one core), then ensembles of "
+      "456-hexagon worlds on the resident driver (--sizes: the world counts); %s, commit %s\n",
+      date.c_str(), commit.c_str());
+  std::printf("%-28s %7s %9s %-8s %10s %10s %14s %14s %16s  %s\n", "case", "worlds", "bodies", "driver", "ms/step", "device ms",
+              "steps/s/world", "floe-steps/s", "dev floe-steps/s", "device");
+  std::string csv =
+      "case,worlds,bodies,driver,ms_per_step,device_ms_per_step,steps_per_s_per_world,floe_steps_per_s,device_floe_steps_per_s,device,"
+      "date,commit\n";
+  auto add = [&](const ResidentRow& r) {
+    const double floeSteps = static_cast<double>(r.floes) / r.seconds;
+    const double deviceFloeSteps = r.deviceSeconds > 0 ? static_cast<double>(r.floes) / r.deviceSeconds : 0;
+    std::printf("%-28s %7d %9ld %-8s %10.4f %10.4f %14.0f %14.3g %16.3g  %s\n", r.caseName.c_str(), r.worlds, r.bodies, r.driver.c_str(),
+                r.seconds * 1e3, r.deviceSeconds * 1e3, 1 / r.seconds, floeSteps, deviceFloeSteps, r.device.c_str());
+    std::fflush(stdout);
+    csv += fmt::format("\"{}\",{},{},{},{:.6f},{:.6f},{:.1f},{:.6g},{:.6g},\"{}\",{},{}\n", r.caseName, r.worlds, r.bodies, r.driver,
+                       r.seconds * 1e3, r.deviceSeconds * 1e3, 1 / r.seconds, floeSteps, deviceFloeSteps, r.device, date, commit);
+    if (!run.csvPath.empty()) writeFileAtomically(run.csvPath, csv);
+  };
+  // One world: each driver, and the CPU.
+  for (const CaseKey& c : casesOf(o, {"456", "824"})) {
+    for (const std::string driver : {"resident", "device", "cpu"}) {
+      Scenario s = run.scenarios.get(c);
+      s.backend = driver == "cpu" ? "cpu" : "cuda";
+      if (driver != "cpu") s.cudaDriver = driver;
+      s.steps = std::max<long>(s.steps, 2 * o.steps + 1000);
+      std::vector<std::unique_ptr<Stepper>> sims;
+      sims.push_back(makeStepper(s));
+      ResidentRow r;
+      r.caseName = c.name, r.driver = sims.front()->driver();
+      r.bodies = sims.front()->hostWorld().size(), r.floes = sims.front()->hostWorld().count(BodyKind::Floe);
+      r.device = driver == "cpu" ? cpuName() + " (one core)" : sims.front()->device();
+      // Whole 200-step periods (re-sorts, copy-backs) from a period's start.
+      const long steps = std::max<long>(200, o.steps / 200 * 200);
+      std::tie(r.seconds, r.deviceSeconds) = timeTogether(sims, 200, steps);
+      add(r);
+    }
+  }
+  // Ensembles: a 456-hexagon world per case, run together on the resident driver.
+  for (long worlds : ensembles) {
+    if (worlds < 1 || worlds > 100000) throw InputError(fmt::format("gem bench --table resident --sizes {}: from 1 to 100000 worlds", worlds));
+    Scenario s = run.scenarios.get(parseCase("456"));
+    s.backend = "cuda";
+    s.cudaDriver = "resident";
+    // Steps in whole copy-back batches (16), fewer for many worlds (each step of each case is also
+    // the host's bookkeeping), at least one re-sort period.
+    const long steps = std::clamp<long>(20000 / worlds / 16 * 16, 32, std::max<long>(32, o.steps / 16 * 16));
+    s.steps = 16 + steps + 200;
+    const auto setUp = Clock::now();
+    std::fprintf(stderr, "gem bench: setting up %ld worlds...\n", worlds);
+    const std::vector<Scenario> cases(static_cast<size_t>(worlds), s);
+    std::vector<const Scenario*> pointers;
+    for (const Scenario& one : cases) pointers.push_back(&one);
+    std::vector<std::unique_ptr<Stepper>> sims = cuda->makeTogether(pointers);
+    std::fprintf(stderr, "gem bench: %ld worlds set up in %.1f s\n", worlds, secondsSince(setUp));
+    ResidentRow r;
+    r.caseName = fmt::format("{} x 456 hexagons", worlds);
+    r.worlds = static_cast<int>(worlds);
+    r.driver = sims.front()->driver();
+    r.device = sims.front()->device();
+    for (auto& sim : sims) r.bodies += sim->hostWorld().size(), r.floes += sim->hostWorld().count(BodyKind::Floe);
+    std::tie(r.seconds, r.deviceSeconds) = timeTogether(sims, 16, steps);
+    add(r);
+  }
+  if (!run.csvPath.empty()) std::printf("CSV: %s\n", run.csvPath.c_str());
+}
+
 void geometryTable(const TableRun& run, const std::string& name) {
   runGeometryBench(GeometryBenchOptions{name, run.options.sizes, run.csvPath, run.options.reps});
   if (!run.csvPath.empty()) std::printf("CSV: %s\n", run.csvPath.c_str());
@@ -441,6 +555,8 @@ void runTable(const TableRun& run, const std::string& name) {
     sweepTable(run, name);
   else if (name == "scaling")
     scalingTable(run);
+  else if (name == "resident")
+    residentTable(run);
   else
     geometryTable(run, name);
 }

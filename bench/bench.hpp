@@ -6,6 +6,8 @@
 //   blocks    CUDA threads per block (simulation.cuda_block_size) on 3584 and 7168 random floes
 //   copyback  CUDA steps between copies to the host (simulation.copy_back_every) on 824 and 10^5
 //   scaling   10^4, 10^5, 10^6 random floes per built-in broadphase on CUDA, the CPU at 10^4 and 10^5
+//   resident  456 and 824 as one world on each CUDA driver (and the CPU), then ensembles of 456-floe
+//             worlds run together on the resident driver, with date and commit (not in "all")
 // and the geometry tables intersection | triangulation (bench/geometry_bench.hpp); "all" runs
 // fields, blocks, copyback, scaling, intersection and triangulation one after another.
 #pragma once
@@ -17,7 +19,7 @@ namespace gem {
 
 struct BenchOptions {
   std::string table = "step";  // see above
-  std::vector<long> sizes;     // geometry tables: N per row (empty: the thesis's sizes)
+  std::vector<long> sizes;     // geometry tables: N per row (empty: the thesis's sizes); resident: world counts
   int reps = 50;               // geometry tables: timed repetitions (median)
   long steps = 2000;           // timed steps per case (after a warm-up); fewer for large fields
   // A CSV file for one table; a directory (TABLE.csv in it) for "all", or when it names an existing

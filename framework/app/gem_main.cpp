@@ -179,6 +179,8 @@ int main(int argc, char** argv) {
                            "copyback: copy_back_every 1..128 on 824 and 10^5 floes (cuda);\n"
                            "scaling: 10^4, 10^5, 10^6 floes, every broadphase on cuda, variable_radius on the cpu;\n"
                            "intersection, triangulation: the geometry tables (thesis 5.2, 5.3);\n"
+                           "resident: 456 and 824 floes on each CUDA driver and the CPU, then ensembles of 10, 100, 1000, "
+                           "10000 456-floe worlds on the resident driver (cuda; --sizes: world counts);\n"
                            "all: fields, blocks, copyback, scaling, intersection, triangulation (without a CUDA device "
                            "the CUDA rows are skipped, saying so; each table its own cases and broadphases)");
   benchCommand->add_option("--csv", bench.csv,
@@ -192,7 +194,7 @@ int main(int argc, char** argv) {
   benchCommand->add_option("--broadphase", bench.broadphases, "broadphases to time (default: the table's own; step: variable_radius)");
   benchCommand->add_option("--blocks", bench.blockSizes, "blocks: block sizes (default 32 64 128 256 512 1024)");
   benchCommand->add_option("--copy-back", bench.copyBackEvery, "copyback: intervals k (default 1 2 4 8 16 32 64 128)");
-  benchCommand->add_option("--sizes", bench.sizes, "intersection/triangulation: N per row (default the thesis's sizes)");
+  benchCommand->add_option("--sizes", bench.sizes, "intersection/triangulation: N per row (default the thesis's sizes); resident: world counts");
   benchCommand->add_option("--reps", bench.reps, "intersection/triangulation: timed repetitions, median (default 50)");
 
   std::string calibrationFile = std::string(GEM_SOURCE_DIR) + "/scenarios/thesis/calibration.toml", calibrationOut = "runs/calibration";

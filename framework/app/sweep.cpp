@@ -103,7 +103,7 @@ std::string formatDuration(double seconds) {
 // one device state (a backend with makeTogether; cases with the same batchKey). batch: the most
 // cases per device state (0: automatic, 1: none together). Automatic: up to kMostTogether, and
 // each group split over the node's devices (under MPI, over the ranks) so that every one has work.
-constexpr size_t kMostTogether = 128;
+constexpr size_t kMostTogether = 1024;
 
 std::vector<std::vector<size_t>> workUnits(const std::vector<Scenario>& scenarios, const std::vector<size_t>& todo, int batch, int ranks) {
   std::vector<std::vector<size_t>> units;

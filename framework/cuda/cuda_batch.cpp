@@ -62,6 +62,12 @@ constexpr int kResidentAutoMostBodies = 4096;
 // kernel cannot run them (an event it does not hold: a plugin's).
 std::string residentProgramOf(const std::vector<const CpuStepper*>& members, cuda::ResidentProgram& program,
                               std::vector<unsigned char>& params, int& stride) {
+  // The resident kernel finds its own pairs (the contacts every built-in strategy gives, as the
+  // broadphase-equivalence tests check); a plugin's strategy may mean to give others.
+  const std::string& broadphase = members.front()->scenario().broadphase;
+  const std::string origin = Registry::global().broadphase(broadphase).origin;
+  if (origin != "built-in")
+    return "broadphase \"" + broadphase + "\" comes from a plugin (" + origin + "), and the resident kernel finds its pairs itself";
   const std::vector<EnabledEvent>& events = members.front()->events();
   struct Placed {
     size_t event, size;
@@ -297,7 +303,43 @@ void CudaBatch::runBatch(long step) {
   m_resultFirst = step;
   times.batch += clock.lap();
   ++times.batches;
+  indexRows();
   for (CudaStepper* m : m_members) m->m_hostCurrent = false;
+}
+
+void CudaBatch::indexRows() {
+  const cuda::DeviceBatchResult& r = *m_result;
+  const size_t cells = r.steps.size() * static_cast<size_t>(worlds());
+  const RecordStreams& streams = m_members.front()->m_cpu->recordStreams();
+  for (int q = 0; q < streams.count(); ++q) {
+    const size_t stride = static_cast<size_t>(streams.info(q).stride);
+    const unsigned char* all = r.records[q].data();
+    std::vector<int>& offsets = m_rowOffsets[q];
+    std::vector<int>& rows = m_rows[q];
+    offsets.assign(cells + 1, 0);
+    auto worldOf = [&](int row) {
+      RecordTag t;
+      std::memcpy(&t, all + static_cast<size_t>(row) * stride, sizeof t);
+      return t.world;
+    };
+    // A counting sort of the rows by (step, world), keeping their device order within each.
+    for (size_t k = 0; k < r.steps.size(); ++k)
+      for (int row = k ? r.steps[k - 1].recordEnd[q] : 0; row < r.steps[k].recordEnd[q]; ++row)
+        ++offsets[k * static_cast<size_t>(worlds()) + static_cast<size_t>(worldOf(row)) + 1];
+    for (size_t c = 0; c < cells; ++c) offsets[c + 1] += offsets[c];
+    rows.assign(static_cast<size_t>(offsets[cells]), 0);
+    std::vector<int> at(offsets.begin(), offsets.end() - 1);
+    for (size_t k = 0; k < r.steps.size(); ++k)
+      for (int row = k ? r.steps[k - 1].recordEnd[q] : 0; row < r.steps[k].recordEnd[q]; ++row)
+        rows[static_cast<size_t>(at[k * static_cast<size_t>(worlds()) + static_cast<size_t>(worldOf(row))]++)] = row;
+  }
+}
+
+std::pair<const int*, const int*> CudaBatch::rowsOf(int q, size_t k, int w) const {
+  const size_t cell = k * static_cast<size_t>(worlds()) + static_cast<size_t>(w);
+  const std::vector<int>& offsets = m_rowOffsets[q];
+  const int* rows = m_rows[q].data();
+  return {rows + offsets[cell], rows + offsets[cell + 1]};
 }
 
 void CudaBatch::addEdit(int world, const std::vector<int>& removedLocal, const World& mirror, int firstAdded) {

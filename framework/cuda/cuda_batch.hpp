@@ -49,6 +49,8 @@ class CudaBatch {
   cuda::DeviceStep& device() { return *m_device; }
   const cuda::DeviceBatchResult& result() const { return *m_result; }
   long resultFirst() const { return m_resultFirst; }  // step index of result().steps[0]
+  // The rows of record stream q that world w recorded in result().steps[k], in device order.
+  std::pair<const int*, const int*> rowsOf(int q, size_t k, int w) const;
   std::int64_t idOffset(int world) const { return static_cast<std::int64_t>(world) * m_idStride; }
   int worldOfId(std::int64_t id) const { return static_cast<int>(id / m_idStride); }
   // World w's device slot `local` in the shared state.
@@ -80,6 +82,10 @@ class CudaBatch {
   int m_deviceOrdinal;
   std::unique_ptr<cuda::DeviceStep> m_device;
   std::unique_ptr<cuda::DeviceBatchResult> m_result;
+  // rowsOf's index, made once a batch (each case then reads its own rows, not every case's):
+  // stream q's rows by (step, world), as offsets into the rows.
+  std::vector<int> m_rowOffsets[kMaxRecordStreams], m_rows[kMaxRecordStreams];
+  void indexRows();
   long m_resultFirst = 0;
   std::int64_t m_idStride = std::int64_t(1) << 62;  // one world: the ids as they are
   std::vector<std::vector<int>> m_slotsOfWorld;     // empty: stale

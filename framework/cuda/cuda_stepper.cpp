@@ -92,6 +92,8 @@ long CudaStepper::broadphaseRebuilds() const {
 
 std::string CudaStepper::driver() const { return m_batch->device().resident() ? "resident" : "device"; }
 
+double CudaStepper::deviceSeconds() const { return m_batch->times.batch; }
+
 int CudaStepper::casesOnDevice() const { return m_batch->worlds(); }
 
 CudaStepper::CudaStepper(const Scenario& scenario, Member)
@@ -310,7 +312,6 @@ void CudaStepper::step() {
   const cuda::DeviceBatchResult& result = batch.result();
   const size_t k = static_cast<size_t>(m_step - batch.resultFirst());
   const cuda::StepRecord& r = result.steps[k];
-  const cuda::StepRecord before = k > 0 ? result.steps[k - 1] : cuda::StepRecord{};
   const cuda::WorldStepRecord& mine = result.worldSteps[k * static_cast<size_t>(result.worlds) + static_cast<size_t>(m_world)];
   m_taken = m_step + 1;
   m_candidateCount = r.candidates;
@@ -318,8 +319,8 @@ void CudaStepper::step() {
 
   // Records: the device appends in any order; the CPU's order is by event, then by contact, which
   // each row's tag gives (a contact's index orders this world's contacts as its run alone does).
-  // With several worlds, a row is this case's when its tag says so; the events saw the case's own
-  // body ids, so the rows need no translation.
+  // With several worlds, the batch has indexed each step's rows by their tag's world
+  // (CudaBatch::rowsOf); the events saw the case's own body ids, so the rows need no translation.
   {
     Stopwatch clock;
     m_records.clear();
@@ -332,9 +333,8 @@ void CudaStepper::step() {
         std::memcpy(&t, all + static_cast<size_t>(row) * stride, sizeof t);
         return t;
       };
-      rows.clear();
-      for (int row = before.recordEnd[q]; row < r.recordEnd[q]; ++row)
-        if (tagOf(row).world == m_world) rows.push_back(row);
+      const auto [first, last] = batch.rowsOf(q, k, m_world);
+      rows.assign(first, last);
       std::stable_sort(rows.begin(), rows.end(), [&](int x, int y) {
         const RecordTag a = tagOf(x), b = tagOf(y);
         return a.event != b.event ? a.event < b.event : a.contact < b.contact;

@@ -59,6 +59,7 @@ class CudaStepper final : public Stepper {
   std::string device() const override { return m_deviceName; }
   std::string backend() const override { return "cuda"; }
   std::string driver() const override;  // "resident" or "device"
+  double deviceSeconds() const override;
   int candidateCount() const { return m_candidateCount; }  // over the whole device state
   int casesOnDevice() const;                               // 1 alone, the batch's size when run together
   // Rebuilds of the device broadphase's kept list (0 for one that keeps none): reads the device.

@@ -30,13 +30,13 @@ struct ResidentState {
   int capacity = 0, capacitySort = 0, bodySort = 0;
   DeviceArray<unsigned long long> sweepKeys, pairKeys, idKeys, bKeys, previous;
   DeviceArray<Contact> candContact;
-  DeviceArray<int> flag, contactA, contactB;
+  DeviceArray<int> flag, survivors, contactA, contactB;
   DeviceArray<PairContact> contacts;
   DeviceArray<PairSlot> slots;
   DeviceArray<ResidentControl> control{1};
   ResidentControl* h_control = nullptr;  // pinned
   DeviceArray<int> recordCount{kMaxRecordStreams};
-  long long phaseCycles[10] = {};  // block 0's, over every launch (GEM_CUDA_TIMING=1 prints them)
+  long long phaseCycles[kResidentPhases] = {};  // block 0's, over every launch (GEM_CUDA_TIMING=1 prints them)
   long launches = 0, steps = 0;
   ResidentState() { GEM_CUDA_CHECK(cudaMallocHost(&h_control, sizeof(ResidentControl))); }
   ~ResidentState() {
@@ -50,7 +50,7 @@ struct ResidentState {
     for (long long c : phaseCycles) total += c;
     std::fprintf(stderr, "gem resident driver: %ld launches, %ld steps, block 0 %.2f us a step:", launches, steps,
                  1e3 * static_cast<double>(total) / kHz / static_cast<double>(steps));
-    for (int k = 0; k < 10; ++k)
+    for (int k = 0; k < kResidentPhases; ++k)
       std::fprintf(stderr, "%s %s %.2f", k ? "," : "", kResidentPhaseNames[k], 1e3 * static_cast<double>(phaseCycles[k]) / kHz / static_cast<double>(steps));
     std::fprintf(stderr, " (us a step)\n");
   }
@@ -99,7 +99,7 @@ void sizeScratch(DeviceState& d, ResidentState& r, int capacity) {
   r.capacitySort = powerOfTwoAtLeast(capacity);
   const size_t cap = static_cast<size_t>(capacity), sortCap = static_cast<size_t>(r.capacitySort);
   r.pairKeys.ensure(worlds * sortCap), r.idKeys.ensure(worlds * sortCap), r.bKeys.ensure(worlds * sortCap);
-  r.candContact.ensure(worlds * cap), r.flag.ensure(worlds * (cap + 1));
+  r.candContact.ensure(worlds * cap), r.flag.ensure(worlds * 2 * (cap + 1)), r.survivors.ensure(worlds * cap);
   r.contactA.ensure(worlds * cap), r.contactB.ensure(worlds * cap), r.contacts.ensure(worlds * cap), r.slots.ensure(worlds * cap);
   r.previous.ensure(worlds * cap);
   if (oldCapacity == 0) {
@@ -141,8 +141,15 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
   int device = 0, multiprocessors = 1;
   GEM_CUDA_CHECK(cudaGetDevice(&device));
   GEM_CUDA_CHECK(cudaDeviceGetAttribute(&multiprocessors, cudaDevAttrMultiProcessorCount, device));
-  const int grid = std::max(1, std::min(d.worlds, multiprocessors * std::max(1, residentBlocksPerMultiprocessor())));
+  const std::size_t shared = residentSharedBytes(r.mostBodies);
+  const int grid = std::max(1, std::min(d.worlds, multiprocessors * std::max(1, residentBlocksPerMultiprocessor(shared))));
 
+  // GEM_RESIDENT_CLIP_LANES: the lanes of a warp that clip (a tuning knob for the measurements in
+  // docs/performance.md; the results do not depend on it).
+  static const int clipLanes = [] {
+    const char* v = std::getenv("GEM_RESIDENT_CLIP_LANES");
+    return std::clamp(v ? std::atoi(v) : kResidentClipLanes, 1, 32);
+  }();
   long next = firstStep;
   int remaining = steps;
   while (remaining > 0) {
@@ -158,7 +165,7 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     a.capacity = r.capacity, a.capacitySort = r.capacitySort, a.bodySort = r.bodySort;
     a.sweepKeys = r.sweepKeys.get(), a.pairKeys = r.pairKeys.get(), a.idKeys = r.idKeys.get(), a.bKeys = r.bKeys.get();
     a.previous = r.previous.get(), a.previousCount = r.previousCount.get();
-    a.candContact = r.candContact.get(), a.flag = r.flag.get(), a.contactA = r.contactA.get(), a.contactB = r.contactB.get();
+    a.candContact = r.candContact.get(), a.flag = r.flag.get(), a.survivors = r.survivors.get(), a.contactA = r.contactA.get(), a.contactB = r.contactB.get();
     a.contacts = r.contacts.get(), a.slots = r.slots.get();
     a.program = r.program;
     a.params = r.params.get(), a.paramsStride = r.paramsStride;
@@ -166,8 +173,9 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
       a.sink.streams[q] = RecordBuffer{d.records[q].get(), d.recordStride[q], d.recordCapacity, r.recordCount.get() + q};
     a.haltStreams = d.haltStreams;
     a.firstStep = next, a.dt = dt, a.steps = batch;
+    a.clipLanes = clipLanes;
     a.ring = d.ring.get(), a.worldRing = d.worldRing.get(), a.control = r.control.get();
-    launchResident(a, grid, d.stream);
+    launchResident(a, grid, shared, d.stream);
     GEM_CUDA_CHECK(cudaMemcpyAsync(r.h_control, r.control.get(), sizeof(ResidentControl), cudaMemcpyDeviceToHost, d.stream));
     GEM_CUDA_CHECK(
         cudaMemcpyAsync(d.h_ring, d.ring.get(), sizeof(StepRecord) * static_cast<size_t>(batch), cudaMemcpyDeviceToHost, d.stream));
@@ -179,7 +187,7 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     const int done = control.stepsDone;
     ++r.launches;
     r.steps += done;
-    for (int k = 0; k < 10; ++k) r.phaseCycles[k] += control.phaseCycles[k];
+    for (int k = 0; k < kResidentPhases; ++k) r.phaseCycles[k] += control.phaseCycles[k];
 
     // The completed steps' records, appended; their ends shifted past what earlier launches added.
     const StepRecord last = done > 0 ? d.h_ring[done - 1] : StepRecord{};

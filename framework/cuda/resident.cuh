@@ -25,6 +25,8 @@ namespace gem::cuda {
 // Threads per world: 16 warps, so that the narrowphase and the events of a thesis field (about 600
 // candidate pairs, 60 contacts) take a few rounds, and four worlds fit on one multiprocessor.
 constexpr int kResidentBlock = 512;
+// Lanes of each warp that clip contact pairs (docs/performance.md "CUDA drivers").
+constexpr int kResidentClipLanes = 32;
 // The most events of each phase the kernel runs (a scenario has a handful).
 constexpr int kResidentMaxEvents = 16;
 
@@ -48,12 +50,13 @@ struct ResidentControl {
   int stepsDone, haltReason;
   // Where block 0's time went, in clock cycles, by phase (kResidentPhaseNames): GEM_CUDA_TIMING=1
   // prints them when the state goes.
-  long long phaseCycles[10];
+  long long phaseCycles[12];
 };
 // The phases the kernel times (ResidentControl::phaseCycles).
-inline constexpr const char* kResidentPhaseNames[10] = {"prepare and sweep sort", "pairs", "pair sort",     "narrowphase and onset",
-                                                        "events",                 "sorts", "first barrier", "gather, motion, write-back",
-                                                        "second barrier",         "step edges"};
+constexpr int kResidentPhases = 12;
+inline constexpr const char* kResidentPhaseNames[kResidentPhases] = {
+    "prepare", "sweep sort", "pairs",         "pair sort",  "separating axes", "contact geometry and onset", "events",
+    "sorts",   "first barrier", "gather, motion, write-back", "second barrier", "step edges"};
 
 struct ResidentArgs {
   PrepareArgs prepare;  // the world's arrays, cellKey nullptr
@@ -68,7 +71,7 @@ struct ResidentArgs {
   unsigned long long *sweepKeys, *pairKeys, *idKeys, *bKeys, *previous;
   int* previousCount;
   Contact* candContact;
-  int* flag;
+  int *flag, *survivors;  // flag: 2 x (capacity + 1) a world
   int *contactA, *contactB;
   PairContact* contacts;
   PairSlot* slots;
@@ -82,6 +85,7 @@ struct ResidentArgs {
   long firstStep;
   Real dt;
   int steps;
+  int clipLanes;  // lanes of each warp that compute contact geometry (the rest wait)
   StepRecord* ring;
   WorldStepRecord* worldRing;
   ResidentControl* control;
@@ -92,9 +96,14 @@ enum ResidentPhase : int { kResidentPair = 0, kResidentSolo = 1, kResidentMotion
 // resident_events.cu: the built-in events the kernel holds. Returns the event's kind and the size
 // of its Params, or -1 when the kernel does not hold an event of that name and phase.
 int residentEventKind(const std::string& name, ResidentPhase phase, std::size_t* paramsSize);
-// The kernel, launched (cooperatively when grid > 1) on the stream.
-void launchResident(const ResidentArgs& args, int grid, cudaStream_t stream);
+// Shared memory for the sweep of a world of up to `bodies` bodies (its keys, boxes and inverse
+// masses), or 0 past kResidentSharedBytes: the sweep then reads them from global memory.
+std::size_t residentSharedBytes(int bodies);
+constexpr std::size_t kResidentSharedBytes = 160 * 1024;
+// The kernel, launched (cooperatively when grid > 1) on the stream with `shared` bytes of dynamic
+// shared memory (residentSharedBytes of the largest world).
+void launchResident(const ResidentArgs& args, int grid, std::size_t shared, cudaStream_t stream);
 // Blocks of kResidentBlock threads that one multiprocessor keeps resident at once.
-int residentBlocksPerMultiprocessor();
+int residentBlocksPerMultiprocessor(std::size_t shared);
 
 }  // namespace gem::cuda

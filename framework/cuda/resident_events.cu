@@ -54,21 +54,40 @@ int residentEventKind(const std::string& name, ResidentPhase phase, std::size_t*
   return -1;
 }
 
-void launchResident(const ResidentArgs& args, int grid, cudaStream_t stream) {
+std::size_t residentSharedBytes(int bodies) {
+  int sorted = 1;
+  while (sorted < bodies) sorted <<= 1;
+  const std::size_t bytes = static_cast<std::size_t>(sorted) * (sizeof(unsigned long long) + sizeof(Box) + sizeof(Real));
+  return bytes <= kResidentSharedBytes ? bytes : 0;
+}
+
+// Dynamic shared memory past 48 KB must be asked for, once per size.
+static void allowShared(std::size_t shared) {
+  static std::size_t allowed = 0;
+  if (shared <= allowed) return;
+  GEM_CUDA_CHECK(cudaFuncSetAttribute(resident::residentKernel<BuiltIn>, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                      static_cast<int>(kResidentSharedBytes)));
+  allowed = kResidentSharedBytes;
+}
+
+void launchResident(const ResidentArgs& args, int grid, std::size_t shared, cudaStream_t stream) {
+  allowShared(shared);
   if (grid == 1) {
-    resident::residentKernel<BuiltIn><<<1, kResidentBlock, 0, stream>>>(args);
+    resident::residentKernel<BuiltIn><<<1, kResidentBlock, shared, stream>>>(args, shared > 0);
     GEM_CUDA_CHECK_LAUNCH();
     return;
   }
   ResidentArgs copy = args;
-  void* params[] = {&copy};
+  bool staged = shared > 0;
+  void* params[] = {&copy, &staged};
   GEM_CUDA_CHECK(cudaLaunchCooperativeKernel(reinterpret_cast<void*>(resident::residentKernel<BuiltIn>), dim3(static_cast<unsigned>(grid)),
-                                             dim3(kResidentBlock), params, 0, stream));
+                                             dim3(kResidentBlock), params, shared, stream));
 }
 
-int residentBlocksPerMultiprocessor() {
+int residentBlocksPerMultiprocessor(std::size_t shared) {
+  allowShared(shared);
   int blocks = 0;
-  GEM_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, resident::residentKernel<BuiltIn>, kResidentBlock, 0));
+  GEM_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, resident::residentKernel<BuiltIn>, kResidentBlock, shared));
   return blocks;
 }
 

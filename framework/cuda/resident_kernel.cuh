@@ -114,7 +114,7 @@ constexpr int kSharedSort = 2048;
 struct BlockShared {
   int scan[33];
   int count;
-  long long cycles[10], stamp;  // block 0's time by phase (ResidentControl::phaseCycles)
+  long long cycles[kResidentPhases], stamp;  // block 0's time by phase (ResidentControl::phaseCycles)
   unsigned long long sort[kSharedSort];
 };
 
@@ -177,7 +177,11 @@ __device__ inline void blockSort(unsigned long long* keys, int n, BlockShared& s
   int m = 1;
   while (m < n) m <<= 1;
   if (n <= 1) return;
-  if (m <= kSharedSort) {
+  if (__isShared(keys)) {  // already in shared memory (the sweep's keys, staged): in place
+    for (int i = n + threadIdx.x; i < m; i += blockDim.x) keys[i] = ~0ull;
+    __syncthreads();
+    bitonicSort(keys, m);
+  } else if (m <= kSharedSort) {
     for (int i = threadIdx.x; i < m; i += blockDim.x) sh.sort[i] = i < n ? keys[i] : ~0ull;
     __syncthreads();
     bitonicSort(sh.sort, m);
@@ -219,7 +223,7 @@ struct WorldScratch {
   const int* members;
   unsigned long long *sweep, *pairs, *ids, *bs, *previous;
   Contact* candidates;
-  int* flag;
+  int *flag, *touching, *survivors;
   int *contactA, *contactB;
   PairContact* contacts;
   PairSlot* slots;
@@ -237,7 +241,9 @@ __device__ inline WorldScratch scratchOf(const ResidentArgs& a, int w) {
   s.bs = a.bKeys + ww * sortCap;
   s.previous = a.previous + ww * cap;
   s.candidates = a.candContact + ww * cap;
-  s.flag = a.flag + ww * (cap + 1);
+  s.flag = a.flag + ww * 2 * (cap + 1);
+  s.touching = s.flag + (cap + 1);
+  s.survivors = a.survivors + ww * cap;
   s.contactA = a.contactA + ww * cap;
   s.contactB = a.contactB + ww * cap;
   s.contacts = a.contacts + ww * cap;
@@ -248,21 +254,33 @@ __device__ inline WorldScratch scratchOf(const ResidentArgs& a, int w) {
 // Phases 1 to 4 of world w. Returns its contact count (every thread), or -1 when its candidate
 // pairs passed the capacity (the step is then run again with more room).
 template <class Events>
-__device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, int parity, BlockShared& sh) {
-  const WorldScratch s = scratchOf(a, w);
+__device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, int parity, BlockShared& sh, unsigned char* dynamic) {
+  WorldScratch s = scratchOf(a, w);
   const PrepareArgs& p = a.prepare;
   const int n = s.n;
+  // The sweep's keys, boxes and inverse masses by the body's place in the world: in shared memory
+  // when the launch has room for them (residentSharedBytes), else in global memory.
+  Box* boxes = nullptr;
+  Real* invMass = nullptr;
+  if (dynamic) {
+    s.sweep = reinterpret_cast<unsigned long long*>(dynamic);
+    boxes = reinterpret_cast<Box*>(s.sweep + a.bodySort);
+    invMass = reinterpret_cast<Real*>(boxes + a.bodySort);
+  }
   // 1. Prepare, and the sweep's keys: the box's left edge rounded down (a float sorts as its double
   // does, ties aside), then the body's place in the world.
   for (int i = threadIdx.x; i < n; i += blockDim.x) {
     const int slot = s.members[i];
     prepareBody(p, slot);
-    s.sweep[i] = (static_cast<unsigned long long>(orderedBits(__double2float_rd(p.boxes[slot].x0))) << 32) | static_cast<unsigned>(i);
+    const Box box = p.boxes[slot];
+    if (boxes) boxes[i] = box, invMass[i] = p.invMass[slot];
+    s.sweep[i] = (static_cast<unsigned long long>(orderedBits(__double2float_rd(box.x0))) << 32) | static_cast<unsigned>(i);
   }
   if (threadIdx.x == 0) sh.count = 0;
   __syncthreads();
-  blockSort(s.sweep, n, sh);
   mark(sh, 0);
+  blockSort(s.sweep, n, sh);
+  mark(sh, 1);
 
   // 2. Pairs: a warp per body in sweep order; its lanes walk the bodies after it while their left
   // edge (rounded down) is not past its right edge (rounded up): every pair whose boxes overlap
@@ -270,8 +288,9 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
   // the narrowphase of every other driver tests.
   const int lane = threadIdx.x & 31, warps = blockDim.x >> 5;
   for (int q = threadIdx.x >> 5; q < n; q += warps) {
-    const int ia = static_cast<int>(s.sweep[q] & 0xffffffffu), sa = s.members[ia];
-    const Box boxA = p.boxes[sa];
+    const int ia = static_cast<int>(s.sweep[q] & 0xffffffffu);
+    const Box boxA = boxes ? boxes[ia] : p.boxes[s.members[ia]];
+    const Real invMassA = boxes ? invMass[ia] : p.invMass[s.members[ia]];
     const unsigned long long limit = static_cast<unsigned long long>(orderedBits(__double2float_ru(boxA.x1)));
     for (int first = q + 1; first < n; first += 32) {
       const int r = first + lane;
@@ -280,8 +299,10 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
         const unsigned long long key = s.sweep[r];
         inReach = (key >> 32) <= limit;
         if (inReach) {
-          const int ib = static_cast<int>(key & 0xffffffffu), sb = s.members[ib];
-          if (mayTouch(p.invMass[sa], p.invMass[sb], boxA, p.boxes[sb])) {
+          const int ib = static_cast<int>(key & 0xffffffffu);
+          const bool touch = boxes ? mayTouch(invMassA, invMass[ib], boxA, boxes[ib])
+                                   : mayTouch(invMassA, p.invMass[s.members[ib]], boxA, p.boxes[s.members[ib]]);
+          if (touch) {
             const int at = atomicAdd(&sh.count, 1);
             const unsigned lo = ia < ib ? ia : ib, hi = ia < ib ? ib : ia;
             if (at < a.capacity) s.pairs[at] = (static_cast<unsigned long long>(lo) << 32) | hi;
@@ -292,7 +313,7 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
     }
   }
   __syncthreads();
-  mark(sh, 1);
+  mark(sh, 2);
   const int pairs = sh.count;
   if (threadIdx.x == 0) {
     atomicAdd(&a.control->candidates[parity], pairs);
@@ -301,24 +322,44 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
   }
   if (pairs > a.capacity) return -1;
   blockSort(s.pairs, pairs, sh);
-  mark(sh, 2);
+  mark(sh, 3);
 
-  // 3. Narrowphase, compaction in (a, b) order, onset.
+  // 3. Narrowphase in two passes: the separating-axis test over every pair, then the contact
+  // geometry (clipping) over the pairs that overlap only, so that the few long clipping chains
+  // are spread over the block instead of queued behind the many quick rejections. The same
+  // functions as the device-wide driver's contactOfPair, in the same order: the same contacts.
   for (int k = threadIdx.x; k < pairs; k += blockDim.x) {
     const unsigned long long key = s.pairs[k];
-    const int sa = s.members[key >> 32], sb = s.members[key & 0xffffffffu];
-    Contact c{};
-    const bool touching = contactOfPair(sa, sb, p.worldVertices, p.vertexCount, p.x, p.y, p.boxes, p.invMass, p.world, c);
-    s.flag[k] = touching ? 1 : 0;
-    if (touching) s.candidates[k] = c;
+    s.flag[k] = overlapOfPair(s.members[key >> 32], s.members[key & 0xffffffffu], p.worldVertices, p.vertexCount, p.boxes, p.invMass,
+                              p.world)
+                    ? 1
+                    : 0;
   }
   if (threadIdx.x == 0) s.flag[pairs] = 0;
   __syncthreads();
-  const int contacts = blockExclusiveScan(s.flag, pairs + 1, sh);
+  const int overlapping = blockExclusiveScan(s.flag, pairs + 1, sh);
+  for (int k = threadIdx.x; k < pairs; k += blockDim.x)
+    if (s.flag[k + 1] != s.flag[k]) s.survivors[s.flag[k]] = k;
+  __syncthreads();
+  mark(sh, 4);
+  // clipLanes lanes of each warp clip, the others wait: the lanes of a warp that clip different
+  // pairs diverge through the whole clipping, so fewer of them can finish sooner.
+  const int clipLane = threadIdx.x & 31, clipWarp = threadIdx.x >> 5, clipStride = (blockDim.x >> 5) * a.clipLanes;
+  for (int j = clipWarp * a.clipLanes + clipLane; clipLane < a.clipLanes && j < overlapping; j += clipStride) {
+    const unsigned long long key = s.pairs[s.survivors[j]];
+    Contact c{};
+    const bool touching = contactOfPair(s.members[key >> 32], s.members[key & 0xffffffffu], p.worldVertices, p.vertexCount, p.x, p.y,
+                                        p.boxes, p.invMass, p.world, c);
+    s.touching[j] = touching ? 1 : 0;
+    if (touching) s.candidates[j] = c;
+  }
+  if (threadIdx.x == 0) s.touching[overlapping] = 0;
+  __syncthreads();
+  const int contacts = blockExclusiveScan(s.touching, overlapping + 1, sh);
   const int previous = a.previousCount[w];
-  for (int k = threadIdx.x; k < pairs; k += blockDim.x) {
-    if (s.flag[k + 1] == s.flag[k]) continue;
-    const int c = s.flag[k];
+  for (int j = threadIdx.x; j < overlapping; j += blockDim.x) {
+    if (s.touching[j + 1] == s.touching[j]) continue;
+    const int c = s.touching[j], k = s.survivors[j];
     const unsigned long long key = s.pairs[k];
     const int sa = s.members[key >> 32], sb = s.members[key & 0xffffffffu];
     // The pair by the case's own ids (PairBody::id), the smaller first: kept for the next step's onset.
@@ -327,14 +368,14 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
     s.contactA[c] = sa;
     s.contactB[c] = sb;
     const int seen = lowerBoundOf(s.previous, previous, idKey);
-    s.contacts[c] = PairContact{s.candidates[k], seen == previous || s.previous[seen] != idKey};
+    s.contacts[c] = PairContact{s.candidates[j], seen == previous || s.previous[seen] != idKey};
     s.slots[c] = PairSlot{{0, 0}};
     s.ids[c] = idKey;
     s.bs[c] = ((key & 0xffffffffu) << 32) | static_cast<unsigned>(c);  // b's place in the world, then the contact
   }
   if (threadIdx.x == 0) atomicAdd(&a.control->contacts[parity], contacts);
   __syncthreads();
-  mark(sh, 3);
+  mark(sh, 5);
 
   // 4. The pair events, a contact at a time, each contact's events in order; then the solo events.
   const unsigned char* row = a.params + static_cast<size_t>(w) * static_cast<size_t>(a.paramsStride);
@@ -355,11 +396,11 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
     p.changes[slot] = change;
   }
   __syncthreads();
-  mark(sh, 4);
+  mark(sh, 6);
   // Phase 5 reads the b side in contact order, and the next step's onset the pairs by id.
   blockSort(s.bs, contacts, sh);
   blockSort(s.ids, contacts, sh);
-  mark(sh, 5);
+  mark(sh, 7);
   return contacts;
 }
 
@@ -402,8 +443,10 @@ __device__ inline bool recordsOverflowed(const RecordSink& sink) {
 }
 
 template <class Events>
-__global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a) {
+__global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a, bool staged) {
   __shared__ BlockShared sh;
+  extern __shared__ __align__(16) unsigned char dynamicShared[];
+  unsigned char* const dynamic = staged ? dynamicShared : nullptr;
   ResidentControl& control = *a.control;
   if (threadIdx.x == 0) {
     for (long long& c : sh.cycles) c = 0;
@@ -424,11 +467,11 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a)
     // The contact counts of this block's worlds, for phase 5 (a block has one world but for
     // ensembles larger than the device; those keep theirs in the world's record slot).
     for (int w = blockIdx.x; w < a.worlds; w += gridDim.x) {
-      const int contacts = firstHalf<Events>(a, w, ctx, parity, sh);
+      const int contacts = firstHalf<Events>(a, w, ctx, parity, sh, dynamic);
       if (threadIdx.x == 0) a.worldRing[static_cast<size_t>(s) * a.worlds + w].contacts = contacts;
     }
     gridBarrier();
-    mark(sh, 6);
+    mark(sh, 8);
     // Nothing is pushed between the two barriers: every block reads the same counters.
     const bool overflow = readShared(&control.overflow[parity]) != 0 || recordsOverflowed(a.sink);
     if (leader && !overflow) {
@@ -457,13 +500,13 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a)
         secondHalf<Events>(a, w, contacts, ctx, record);
       }
     }
-    mark(sh, 7);
+    mark(sh, 9);
     if (leader) {
       // The next step's counters start at zero (this step's parity is read until the barrier).
       control.candidates[parity ^ 1] = control.contacts[parity ^ 1] = control.overflow[parity ^ 1] = control.halt[parity ^ 1] = 0;
     }
     gridBarrier();
-    mark(sh, 8);
+    mark(sh, 10);
     if (overflow) {
       if (leader) {
         // The overflowed step's rows are dropped: the counters go back to its start.
@@ -474,10 +517,10 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a)
       break;
     }
     if (readShared(&control.halt[parity])) break;
-    mark(sh, 9);
+    mark(sh, 11);
   }
   if (blockIdx.x == 0 && threadIdx.x == 0)
-    for (int k = 0; k < 10; ++k) control.phaseCycles[k] += sh.cycles[k];
+    for (int k = 0; k < kResidentPhases; ++k) control.phaseCycles[k] += sh.cycles[k];
 }
 
 }  // namespace gem::cuda::resident

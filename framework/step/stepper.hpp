@@ -43,6 +43,9 @@ class Stepper {
   virtual std::string backend() const = 0;  // "cpu", "cuda"
   // The backend's driver that steps: "cpu", or the CUDA driver ("resident", "device").
   virtual std::string driver() const { return backend(); }
+  // Wall seconds the backend's device has spent stepping so far, copies of results included (its
+  // share when cases run together is the whole batch's); 0 for a backend without a device.
+  virtual double deviceSeconds() const { return 0; }
 };
 
 // A backend that cannot run this scenario (e.g. an event without a driver for it). Bad input when

@@ -51,6 +51,7 @@ Trajectory runOnDevice(const Scenario& s, int steps) {
 
 Scenario withBroadphase(const TempDir& dir, const std::string& scene, const std::string& broadphase, std::vector<std::string> more = {}) {
   more.push_back("simulation.broadphase=\"" + broadphase + "\"");
+  more.push_back("simulation.cuda_driver=\"device\"");  // the device parts of the strategies (the resident driver finds its own pairs)
   return test::scenarioFromToml(dir, scene, more);
 }
 
@@ -262,12 +263,13 @@ TEST(CudaBroadphase, ASettingTheDevicePartDoesNotHonourIsRefused) {
       "[simulation]\nsteps = 5\nbroadphase = \"skin_only_on_the_cpu\"\n[broadphase.skin_only_on_the_cpu]\nskin = 1.0\n"
       "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
   try {
-    makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"cuda\""}));
+    makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"cuda\"", "simulation.cuda_driver=\"device\""}));
     ADD_FAILURE() << "a setting the device part does not honour was accepted on cuda";
   } catch (const BackendUnsupported& e) {
     EXPECT_NE(std::string(e.what()).find("does not honour the setting skin"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"auto\""}))->backend(), "cpu");
+  EXPECT_EQ(makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"auto\"", "simulation.cuda_driver=\"device\""}))->backend(),
+            "cpu");
   // Without the setting it runs on the device.
   const std::string plain =
       "[simulation]\nsteps = 5\nbroadphase = \"skin_only_on_the_cpu\"\n[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";
