@@ -514,7 +514,8 @@ void residentTable(const TableRun& run) {
   }
   // Ensembles: a 456-hexagon world per case, run together on the resident driver.
   for (long worlds : ensembles) {
-    if (worlds < 1 || worlds > 100000) throw InputError(fmt::format("gem bench --table resident --sizes {}: from 1 to 100000 worlds", worlds));
+    if (worlds < 1 || worlds > 100000)
+      throw InputError(fmt::format("gem bench --table resident --sizes {}: from 1 to 100000 worlds", worlds));
     Scenario s = run.scenarios.get(parseCase("456"));
     s.backend = "cuda";
     s.cudaDriver = "resident";

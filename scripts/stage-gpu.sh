@@ -60,11 +60,19 @@ if [ "${GEM_SKIP_SANITIZER:-0}" != 1 ]; then
   echo "== compute-sanitizer (memcheck) on the CUDA tests (fast ones), with the step graph and without"
   sanitizer="$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)"
   # GEM_CUDA_GRAPH=0: the same kernels launched one by one, a sync per step.
+  # The device-wide driver (GEM_CUDA_DRIVER=device), with its step graph and without.
   for graph in 1 0; do
-    GEM_CUDA_GRAPH=$graph "$sanitizer" --tool memcheck --error-exitcode 9 --show-backtrace yes ./gem_cuda_tests --gtest_color=no \
+    GEM_CUDA_DRIVER=device GEM_CUDA_GRAPH=$graph "$sanitizer" --tool memcheck --error-exitcode 9 --show-backtrace yes ./gem_cuda_tests --gtest_color=no \
       --gtest_filter='CudaBackend.TwoFloes*:CudaBackend.BusyChannelMatchesTheCpuAfter50Steps:CudaBackend.CandidateOverflow*:CudaPlugin.Rafting*:CudaBroadphase.Candidate*:*CasesTogether*' > "$out/sanitizer-graph$graph.txt" 2>&1
     rc=$?
     tail -3 "$out/sanitizer-graph$graph.txt"; echo "compute-sanitizer (GEM_CUDA_GRAPH=$graph) exit $rc"; [ $rc = 0 ] || status=1
+  done
+  # The resident driver: memcheck, and racecheck for its shared memory (one world, and three together).
+  for tool in memcheck racecheck; do
+    GEM_CUDA_DRIVER=resident "$sanitizer" --tool $tool --error-exitcode 9 --show-backtrace yes ./gem_cuda_tests --gtest_color=no \
+      --gtest_filter='CudaBackend.TwoFloes*:CudaBackend.BusyChannelMatchesTheCpuAfter50Steps:CudaBackend.CandidateOverflow*:*CasesTogether*resident_variable*' > "$out/sanitizer-resident-$tool.txt" 2>&1
+    rc=$?
+    tail -3 "$out/sanitizer-resident-$tool.txt"; echo "compute-sanitizer $tool (resident driver) exit $rc"; [ $rc = 0 ] || status=1
   done
 fi
 if [ -n "${GEM_BENCH_TABLE:-}" ]; then

@@ -57,6 +57,7 @@ std::vector<BadCase> badCases() {
       {"wrong_type", "[simulation]\ndt = \"fast\"\n", {"simulation.dt", "expected a number", ":2:"}},
       {"malformed_toml", "[simulation]\ndt = 0.1\nduration = = 3\n", {":3:"}},
       {"bad_dof", kSim + "[vessel]\ndof = 2\n", {"vessel.dof"}},
+      {"unknown_cuda_driver", "[simulation]\ncuda_driver = \"warp\"\n", {"simulation.cuda_driver", "resident", "device", ":2:"}},
       {"missing_ice_file", kSim + "[field]\nkind = \"file\"\nfile = \"nowhere.ice\"\n", {"nowhere.ice"}, "nowhere.ice"},
       {"malformed_ice_file", kSim + "[field]\nkind = \"file\"\nfile = \"bad.ice\"\n", {"bad.ice:4:1", "malformed XML"}, "bad.ice"},
       {"field_without_domain", kSim + "[field]\nconcentration = 0.3\n", {"[domain]"}},

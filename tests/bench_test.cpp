@@ -54,4 +54,11 @@ TEST(GemBench, BadTablesAndOptionsAreBadInput) {
   EXPECT_EQ(test::runGem("bench --table fields --copy-back 4", log), 2);
   EXPECT_EQ(test::runGem("bench --table fields --cases 12x", log), 2);
   EXPECT_EQ(test::runGem("bench --table all --cases 456", log), 2);
+  // The resident table times the CUDA drivers: without a device it says so (a GPU run times it).
+  ASSERT_EQ(test::runGem("info", log), 0);
+  const std::string info = test::readFile(log);
+  if (info.find("no CUDA backend in this build") != std::string::npos || info.find("no CUDA device found") != std::string::npos) {
+    EXPECT_EQ(test::runGem("bench --table resident", log), 2);
+    EXPECT_NE(test::readFile(log).find("it times the CUDA drivers"), std::string::npos) << test::readFile(log);
+  }
 }

@@ -194,7 +194,8 @@ int main(int argc, char** argv) {
   benchCommand->add_option("--broadphase", bench.broadphases, "broadphases to time (default: the table's own; step: variable_radius)");
   benchCommand->add_option("--blocks", bench.blockSizes, "blocks: block sizes (default 32 64 128 256 512 1024)");
   benchCommand->add_option("--copy-back", bench.copyBackEvery, "copyback: intervals k (default 1 2 4 8 16 32 64 128)");
-  benchCommand->add_option("--sizes", bench.sizes, "intersection/triangulation: N per row (default the thesis's sizes); resident: world counts");
+  benchCommand->add_option("--sizes", bench.sizes,
+                           "intersection/triangulation: N per row (default the thesis's sizes); resident: world counts");
   benchCommand->add_option("--reps", bench.reps, "intersection/triangulation: timed repetitions, median (default 50)");
 
   std::string calibrationFile = std::string(GEM_SOURCE_DIR) + "/scenarios/thesis/calibration.toml", calibrationOut = "runs/calibration";

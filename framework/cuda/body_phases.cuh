@@ -74,8 +74,8 @@ __device__ inline bool contactOfPair(int a, int b, const Vec2* worldVertices, co
 // The first half of contactOfPair: the prefilter and the separating-axis test, which reject most
 // pairs cheaply. contactOfPair is false whenever this is (it runs the same test first), so a driver
 // may test every pair with this and run contactOfPair on the survivors only.
-__device__ inline bool overlapOfPair(int a, int b, const Vec2* worldVertices, const int* vertexCount, const Box* boxes,
-                                     const Real* invMass, const int* world) {
+__device__ inline bool overlapOfPair(int a, int b, const Vec2* worldVertices, const int* vertexCount, const Box* boxes, const Real* invMass,
+                                     const int* world) {
   if (world[a] != world[b] || !mayTouch(invMass[a], invMass[b], boxes[a], boxes[b])) return false;
   return convexOverlap(worldVertices + static_cast<size_t>(a) * kMaxVertices, vertexCount[a],
                        worldVertices + static_cast<size_t>(b) * kMaxVertices, vertexCount[b]);

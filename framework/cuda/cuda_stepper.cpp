@@ -77,9 +77,10 @@ std::string CudaStepper::batchKey(const Scenario& s) {
   // driver, a block per world, with any broadphase. A plugin's events have no place in the resident
   // kernel, so with one only uniform_grid cases share a device.
   if (s.broadphase != "uniform_grid" && (s.cudaDriver == "device" || !s.plugins.empty())) return "";
-  std::string key = fmt::format("dt={} steps={} copy_back_every={} block={} morton={} frames={} vessel_dof={} cell={} driver={} broadphase={}",
-                                s.dt, s.steps, s.copyBackEvery, s.cudaBlockSize, s.mortonSort, s.output.frameEvery, s.vessel.dof,
-                                s.broadphaseSettings.cellSize, s.cudaDriver, s.broadphase);
+  std::string key =
+      fmt::format("dt={} steps={} copy_back_every={} block={} morton={} frames={} vessel_dof={} cell={} driver={} broadphase={}", s.dt,
+                  s.steps, s.copyBackEvery, s.cudaBlockSize, s.mortonSort, s.output.frameEvery, s.vessel.dof, s.broadphaseSettings.cellSize,
+                  s.cudaDriver, s.broadphase);
   for (const auto& [name, setting] : s.events) key += fmt::format(" {}={}", name, setting.enabled);
   for (const PluginSpec& p : s.plugins) key += fmt::format(" plugin={}{}", p.path.string(), p.override ? "!" : "");
   return key;

@@ -12,7 +12,6 @@
 namespace gem::cuda {
 namespace {
 
-
 // Phase 1 and the views: as CpuStepper::narrowphase's box loop and CpuStepper::step's view loops.
 // A body's rows (16 vertices, a PairBody, a SoloBody) are large, and a thread writing its own is a
 // strided pattern that wastes most of each memory transaction (0.92 ms of a 10^6-floe step): on

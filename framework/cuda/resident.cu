@@ -28,6 +28,7 @@ struct ResidentState {
   int mostBodies = 0;
   // Per-world scratch (ResidentArgs).
   int capacity = 0, capacitySort = 0, bodySort = 0;
+  int startCapacity = 0;  // GEM_CUDA_CAPACITY (tests force the regrowth path with it); 0: 4 x bodies + 256
   DeviceArray<unsigned long long> sweepKeys, pairKeys, idKeys, bKeys, previous;
   DeviceArray<Contact> candContact;
   DeviceArray<int> flag, survivors, contactA, contactB;
@@ -51,7 +52,8 @@ struct ResidentState {
     std::fprintf(stderr, "gem resident driver: %ld launches, %ld steps, block 0 %.2f us a step:", launches, steps,
                  1e3 * static_cast<double>(total) / kHz / static_cast<double>(steps));
     for (int k = 0; k < kResidentPhases; ++k)
-      std::fprintf(stderr, "%s %s %.2f", k ? "," : "", kResidentPhaseNames[k], 1e3 * static_cast<double>(phaseCycles[k]) / kHz / static_cast<double>(steps));
+      std::fprintf(stderr, "%s %s %.2f", k ? "," : "", kResidentPhaseNames[k],
+                   1e3 * static_cast<double>(phaseCycles[k]) / kHz / static_cast<double>(steps));
     std::fprintf(stderr, " (us a step)\n");
   }
 };
@@ -77,7 +79,8 @@ void buildMembers(DeviceState& d, ResidentState& r) {
     begin[static_cast<size_t>(w) + 1] += begin[static_cast<size_t>(w)];
   }
   std::vector<int> at(begin.begin(), begin.end() - 1);
-  for (size_t k = 0; k < d.worldHost.size(); ++k) members[static_cast<size_t>(at[static_cast<size_t>(d.worldHost[k])]++)] = static_cast<int>(k);
+  for (size_t k = 0; k < d.worldHost.size(); ++k)
+    members[static_cast<size_t>(at[static_cast<size_t>(d.worldHost[k])]++)] = static_cast<int>(k);
   r.members.upload(members.data(), members.size());
   r.memberBegin.upload(begin.data(), begin.size());
   r.worldOfMembers = d.worldHost;
@@ -124,6 +127,7 @@ void DeviceStep::useResident(const ResidentProgram& program, const std::vector<u
   r.program = program;
   r.paramsStride = paramsStride;
   r.params.upload(params.data(), std::max<size_t>(params.size(), 1));
+  if (const char* start = std::getenv("GEM_CUDA_CAPACITY")) r.startCapacity = std::max(1, std::atoi(start));
 }
 
 bool DeviceStep::resident() const { return m_state->resident != nullptr; }
@@ -131,7 +135,7 @@ bool DeviceStep::resident() const { return m_state->resident != nullptr; }
 void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatchResult& result) {
   ResidentState& r = *d.resident;
   if (!r.membersBuilt || r.worldOfMembers != d.worldHost) buildMembers(d, r);
-  if (r.capacity == 0) sizeScratch(d, r, 4 * r.mostBodies + 256);
+  if (r.capacity == 0) sizeScratch(d, r, r.startCapacity > 0 ? r.startCapacity : 4 * r.mostBodies + 256);
   // Records of a whole launch: room for a row per pair at first; a launch that fills a buffer
   // stops there, and a single step that passes one grows them all.
   d.recordCapacity = std::max(d.recordCapacity, r.capacity);
@@ -165,7 +169,8 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     a.capacity = r.capacity, a.capacitySort = r.capacitySort, a.bodySort = r.bodySort;
     a.sweepKeys = r.sweepKeys.get(), a.pairKeys = r.pairKeys.get(), a.idKeys = r.idKeys.get(), a.bKeys = r.bKeys.get();
     a.previous = r.previous.get(), a.previousCount = r.previousCount.get();
-    a.candContact = r.candContact.get(), a.flag = r.flag.get(), a.survivors = r.survivors.get(), a.contactA = r.contactA.get(), a.contactB = r.contactB.get();
+    a.candContact = r.candContact.get(), a.flag = r.flag.get(), a.survivors = r.survivors.get(), a.contactA = r.contactA.get(),
+    a.contactB = r.contactB.get();
     a.contacts = r.contacts.get(), a.slots = r.slots.get();
     a.program = r.program;
     a.params = r.params.get(), a.paramsStride = r.paramsStride;
@@ -216,8 +221,10 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
       d.recordCapacity = std::max(d.recordCapacity, r.capacity);
       for (int q = 0; q < d.recordStreams; ++q)
         d.records[q].ensure(static_cast<size_t>(d.recordCapacity) * static_cast<size_t>(d.recordStride[q]));
-    } else if (done == 0) {
-      d.recordCapacity *= 4;  // one step's records alone passed the buffers (a launch that filled them just stops)
+    } else if (done == 0 || (done < batch / 2 && d.recordCapacity < (1 << 24))) {
+      // One step's records alone passed the buffers (4x), or a launch filled them in less than half
+      // its steps (2x; many worlds log many rows a step): more room, so launches keep their length.
+      d.recordCapacity *= done == 0 ? 4 : 2;
       for (int q = 0; q < d.recordStreams; ++q)
         d.records[q].ensure(static_cast<size_t>(d.recordCapacity) * static_cast<size_t>(d.recordStride[q]));
     }

@@ -54,9 +54,12 @@ struct ResidentControl {
 };
 // The phases the kernel times (ResidentControl::phaseCycles).
 constexpr int kResidentPhases = 12;
-inline constexpr const char* kResidentPhaseNames[kResidentPhases] = {
-    "prepare", "sweep sort", "pairs",         "pair sort",  "separating axes", "contact geometry and onset", "events",
-    "sorts",   "first barrier", "gather, motion, write-back", "second barrier", "step edges"};
+inline constexpr const char* kResidentPhaseNames[kResidentPhases] = {"prepare",         "sweep sort",
+                                                                     "pairs",           "pair sort",
+                                                                     "separating axes", "contact geometry and onset",
+                                                                     "events",          "sorts",
+                                                                     "first barrier",   "gather, motion, write-back",
+                                                                     "second barrier",  "step edges"};
 
 struct ResidentArgs {
   PrepareArgs prepare;  // the world's arrays, cellKey nullptr

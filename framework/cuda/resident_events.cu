@@ -20,9 +20,9 @@
 namespace gem::cuda {
 namespace {
 
-using BuiltIn = resident::EventSet<resident::Pair<Impact>, resident::Pair<ElasticContact>, resident::Pair<ShipImpact>,
-                                   resident::Solo<Drag>, resident::Solo<EnvironmentalForce>, resident::Solo<EnvironmentalForce>,
-                                   resident::Solo<Propulsion>, resident::Solo<Autopilot>, resident::Motion<Motion>>;
+using BuiltIn = resident::EventSet<resident::Pair<Impact>, resident::Pair<ElasticContact>, resident::Pair<ShipImpact>, resident::Solo<Drag>,
+                                   resident::Solo<EnvironmentalForce>, resident::Solo<EnvironmentalForce>, resident::Solo<Propulsion>,
+                                   resident::Solo<Autopilot>, resident::Motion<Motion>>;
 
 struct Entry {
   const char* name;
@@ -31,14 +31,10 @@ struct Entry {
 };
 // By kind: the names the registry knows the events by, in BuiltIn's order.
 const Entry kEntries[] = {
-    {"impact", kResidentPair, sizeof(Impact::Params)},
-    {"elastic_contact", kResidentPair, sizeof(ElasticContact::Params)},
-    {"ship_impact", kResidentPair, sizeof(ShipImpact::Params)},
-    {"drag", kResidentSolo, sizeof(Drag::Params)},
-    {"wind", kResidentSolo, sizeof(EnvironmentalForce::Params)},
-    {"current", kResidentSolo, sizeof(EnvironmentalForce::Params)},
-    {"propulsion", kResidentSolo, sizeof(Propulsion::Params)},
-    {"autopilot", kResidentSolo, sizeof(Autopilot::Params)},
+    {"impact", kResidentPair, sizeof(Impact::Params)},           {"elastic_contact", kResidentPair, sizeof(ElasticContact::Params)},
+    {"ship_impact", kResidentPair, sizeof(ShipImpact::Params)},  {"drag", kResidentSolo, sizeof(Drag::Params)},
+    {"wind", kResidentSolo, sizeof(EnvironmentalForce::Params)}, {"current", kResidentSolo, sizeof(EnvironmentalForce::Params)},
+    {"propulsion", kResidentSolo, sizeof(Propulsion::Params)},   {"autopilot", kResidentSolo, sizeof(Autopilot::Params)},
     {"motion", kResidentMotion, sizeof(Motion::Params)},
 };
 static_assert(sizeof(kEntries) / sizeof(kEntries[0]) == BuiltIn::size, "one name per event of the table");

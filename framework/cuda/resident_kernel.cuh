@@ -330,10 +330,9 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
   // functions as the device-wide driver's contactOfPair, in the same order: the same contacts.
   for (int k = threadIdx.x; k < pairs; k += blockDim.x) {
     const unsigned long long key = s.pairs[k];
-    s.flag[k] = overlapOfPair(s.members[key >> 32], s.members[key & 0xffffffffu], p.worldVertices, p.vertexCount, p.boxes, p.invMass,
-                              p.world)
-                    ? 1
-                    : 0;
+    s.flag[k] =
+        overlapOfPair(s.members[key >> 32], s.members[key & 0xffffffffu], p.worldVertices, p.vertexCount, p.boxes, p.invMass, p.world) ? 1
+                                                                                                                                       : 0;
   }
   if (threadIdx.x == 0) s.flag[pairs] = 0;
   __syncthreads();
@@ -363,7 +362,8 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
     const unsigned long long key = s.pairs[k];
     const int sa = s.members[key >> 32], sb = s.members[key & 0xffffffffu];
     // The pair by the case's own ids (PairBody::id), the smaller first: kept for the next step's onset.
-    const unsigned long long ida = static_cast<unsigned long long>(p.pairBodies[sa].id), idb = static_cast<unsigned long long>(p.pairBodies[sb].id);
+    const unsigned long long ida = static_cast<unsigned long long>(p.pairBodies[sa].id),
+                             idb = static_cast<unsigned long long>(p.pairBodies[sb].id);
     const unsigned long long idKey = ida < idb ? (ida << 32) | idb : (idb << 32) | ida;
     s.contactA[c] = sa;
     s.contactB[c] = sb;
@@ -384,7 +384,8 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
     const PairContact contact = s.contacts[k];
     PairSlot slot = s.slots[k];
     for (int e = 0; e < a.program.pairCount; ++e)
-      Events::visit(a.program.pair[e].kind, PairCall{row, a.program.pair[e].paramsOffset, bodyA, bodyB, contact, slot, ctx, a.sink.at(e, k, w)});
+      Events::visit(a.program.pair[e].kind,
+                    PairCall{row, a.program.pair[e].paramsOffset, bodyA, bodyB, contact, slot, ctx, a.sink.at(e, k, w)});
     s.slots[k] = slot;
   }
   for (int i = threadIdx.x; i < n; i += blockDim.x) {
@@ -423,8 +424,8 @@ __device__ void secondHalf(const ResidentArgs& a, int w, int contacts, const Ste
     int endA = firstA;
     while (endA < contacts && s.contactA[endA] == slot) ++endA;
     MotionBody body = gatherBody(
-        p.pairBodies[slot], p.changes[slot], [&](int q) { return static_cast<int>(s.bs[firstB + q] & 0xffffffffu); }, endB - firstB,
-        firstA, endA, s.contacts, s.slots, isVessel, &record.vesselImpulse);
+        p.pairBodies[slot], p.changes[slot], [&](int q) { return static_cast<int>(s.bs[firstB + q] & 0xffffffffu); }, endB - firstB, firstA,
+        endA, s.contacts, s.slots, isVessel, &record.vesselImpulse);
     for (int e = 0; e < a.program.motionCount; ++e)
       Events::visit(a.program.motion[e].kind, MotionCall{row, a.program.motion[e].paramsOffset, body, ctx});
     a.motion[slot] = body;

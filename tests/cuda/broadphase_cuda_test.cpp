@@ -268,8 +268,9 @@ TEST(CudaBroadphase, ASettingTheDevicePartDoesNotHonourIsRefused) {
   } catch (const BackendUnsupported& e) {
     EXPECT_NE(std::string(e.what()).find("does not honour the setting skin"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"auto\"", "simulation.cuda_driver=\"device\""}))->backend(),
-            "cpu");
+  EXPECT_EQ(
+      makeStepper(test::scenarioFromToml(dir, scene, {"simulation.backend=\"auto\"", "simulation.cuda_driver=\"device\""}))->backend(),
+      "cpu");
   // Without the setting it runs on the device.
   const std::string plain =
       "[simulation]\nsteps = 5\nbroadphase = \"skin_only_on_the_cpu\"\n[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0]]\n";

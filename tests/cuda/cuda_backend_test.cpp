@@ -405,17 +405,21 @@ TEST(CudaBackend, StagedPrepareChangesNothing) {
 TEST(CudaBackend, CandidateOverflowIsRedoneBitIdentically) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
-  const Scenario s = test::scenarioFromToml(dir, kBusyScene);
-  CudaStepper roomy(s);
-  ::setenv("GEM_CUDA_CAPACITY", "8", 1);
-  CudaStepper cramped(s);
-  ::unsetenv("GEM_CUDA_CAPACITY");
-  const State a = run(roomy, 100), b = run(cramped, 100);
-  ASSERT_EQ(a.ids, b.ids);
-  ASSERT_EQ(a.values.size(), b.values.size());
-  EXPECT_EQ(0, std::memcmp(a.values.data(), b.values.data(), a.values.size() * sizeof(Real)));
-  EXPECT_EQ(a.impacts, b.impacts);
-  EXPECT_GT(roomy.candidateCount(), 8);
+  for (const char* driver : {"device", "resident"}) {
+    SCOPED_TRACE(driver);
+    const Scenario s = test::scenarioFromToml(dir, kBusyScene, {std::string("simulation.cuda_driver=\"") + driver + "\""});
+    CudaStepper roomy(s);
+    ::setenv("GEM_CUDA_CAPACITY", "8", 1);
+    CudaStepper cramped(s);
+    ::unsetenv("GEM_CUDA_CAPACITY");
+    ASSERT_EQ(cramped.driver(), driver);
+    const State a = run(roomy, 100), b = run(cramped, 100);
+    ASSERT_EQ(a.ids, b.ids);
+    ASSERT_EQ(a.values.size(), b.values.size());
+    EXPECT_EQ(0, std::memcmp(a.values.data(), b.values.data(), a.values.size() * sizeof(Real)));
+    EXPECT_EQ(a.impacts, b.impacts);
+    EXPECT_GT(roomy.candidateCount(), 8);
+  }
 }
 
 // A step past the candidate capacity is redone, and until then its candidate list holds entries
@@ -628,6 +632,25 @@ INSTANTIATE_TEST_SUITE_P(Drivers, CasesTogether,
                          ::testing::Values(TogetherDriver{"device", "uniform_grid"}, TogetherDriver{"resident", "uniform_grid"},
                                            TogetherDriver{"resident", "variable_radius"}),
                          [](const auto& info) { return std::string(info.param.driver) + "_" + info.param.broadphase; });
+
+// simulation.cuda_driver = "auto" picks by what was measured (docs/performance.md "CUDA drivers"):
+// one world device-wide, a sweep's cases resident; "resident" is honoured for one world too.
+TEST(CudaBackend, AutoPicksTheDriverAndTheSummaryNamesIt) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  const Scenario alone = test::scenarioFromToml(dir, kBusyScene);
+  EXPECT_EQ(CudaStepper(alone).driver(), "device");
+  const Scenario forced = test::scenarioFromToml(dir, kBusyScene, {"simulation.cuda_driver=\"resident\""});
+  EXPECT_EQ(CudaStepper(forced).driver(), "resident");
+  const Scenario other = test::scenarioFromToml(dir, kBusyScene, {"vessel.bollard_thrust=1e5"});
+  const auto together = CudaStepper::together({&alone, &other});
+  EXPECT_EQ(together.front()->driver(), "resident");
+  const auto log = dir.path() / "log.txt";
+  const auto scene = dir.write("run.toml", kBusyScene);
+  ASSERT_EQ(test::runGem("run " + scene.string() + " --backend cuda --out " + (dir.path() / "out").string(), log), 0)
+      << test::readFile(log);
+  EXPECT_NE(test::readFile(dir.path() / "out" / "summary.json").find("\"driver\": \"device\""), std::string::npos);
+}
 
 TEST(CudaBackend, CasesThatCannotShareADeviceStateAreRefused) {
   GEM_SKIP_WITHOUT_CUDA();
