@@ -72,6 +72,7 @@ TEST(PluginErrors, EachExitsWithStatus2NamingTheFileAndTheCause) {
       {plugin("compiler_mismatch"), "compiler TurboC 3.0.0"},
       {dir.write("text.so", "not a library\n").string(), "cannot be loaded"},
       {plugin("throws_int"), "not a std::exception"},
+      {plugin("unresolved_symbol"), "undefined symbol: gem_test_symbol_that_no_library_defines"},
   };
   for (const auto& c : cases) {
     EXPECT_EQ(gem::test::runGem("info --plugin " + c.file, log), 2) << c.file;
@@ -79,6 +80,7 @@ TEST(PluginErrors, EachExitsWithStatus2NamingTheFileAndTheCause) {
     EXPECT_TRUE(contains(text, c.file)) << text;
     EXPECT_TRUE(contains(text, c.cause)) << text;
     EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
+    EXPECT_FALSE(contains(text, "Bad file descriptor")) << "a stale errno, not the cause: " << text;
   }
 }
 

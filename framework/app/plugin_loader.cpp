@@ -94,6 +94,14 @@ const LoadedPlugin& loadLocked(LoaderState& st, const fs::path& given, bool allo
   boost::dll::shared_library library;
   try {
     library.load(path, boost::dll::load_mode::rtld_now);
+  } catch (const boost::dll::fs::system_error& e) {
+    // Boost.DLL reports dlopen's failure as dlerror()'s text followed by ": " and the message of
+    // an error code it chose (EBADF, "Bad file descriptor"), which is not the cause: drop it.
+    std::string what = e.what();
+    const std::string suffix = ": " + e.code().message();
+    if (what.size() > suffix.size() && what.compare(what.size() - suffix.size(), suffix.size(), suffix) == 0)
+      what.erase(what.size() - suffix.size());
+    throw InputError(fmt::format("plugin {}: cannot be loaded: {}", file, what));
   } catch (const std::exception& e) {
     throw InputError(fmt::format("plugin {}: cannot be loaded: {}", file, e.what()));
   }

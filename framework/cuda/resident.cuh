@@ -23,9 +23,11 @@
 namespace gem::cuda {
 
 // Threads per world: 16 warps, so that the narrowphase and the events of a thesis field (about 600
-// candidate pairs, 60 contacts) take a few rounds, and four worlds fit on one multiprocessor.
+// candidate pairs, 60 contacts) take a round or two. At 128 registers a thread (the clipping's
+// needs set the whole kernel's) one such block fills a multiprocessor's registers: one world a
+// multiprocessor at a time (docs/performance.md 4.4).
 constexpr int kResidentBlock = 512;
-// Lanes of each warp that clip contact pairs (docs/performance.md "CUDA drivers").
+// Lanes of each warp that clip contact pairs: all of them (1 and 4 were measured, 4.4).
 constexpr int kResidentClipLanes = 32;
 // The most events of each phase the kernel runs (a scenario has a handful).
 constexpr int kResidentMaxEvents = 16;
