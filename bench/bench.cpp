@@ -210,10 +210,17 @@ class Table {
 };
 
 // Times one row: the case's scenario on a backend and broadphase, with a CUDA setting changed.
+// The CPU rows' threads (gem bench --threads; 1 unless asked: the thesis's tables compare one core).
+int g_cpuThreads = 1;
+std::string cpuDeviceName() {
+  return cpuName() + (g_cpuThreads == 1 ? std::string(" (one core)") : fmt::format(" ({} threads)", g_cpuThreads));
+}
+
 Row timeRow(CaseScenarios& scenarios, const CaseKey& c, const std::string& backend, const std::string& broadphase, long steps,
             const std::string& param = "", std::optional<int> blockSize = {}, std::optional<int> copyBackEvery = {}) {
   Scenario s = scenarios.get(c);
   s.backend = backend;
+  s.threads = g_cpuThreads;
   s.broadphase = broadphase;
   if (blockSize) s.cudaBlockSize = *blockSize;
   if (copyBackEvery) s.copyBackEvery = *copyBackEvery;
@@ -230,7 +237,7 @@ Row timeRow(CaseScenarios& scenarios, const CaseKey& c, const std::string& backe
   r.floes = sim->hostWorld().count(BodyKind::Floe);
   r.dt = s.dt;
   r.seconds = timePerStep(*sim, s, steps, r.bodies);
-  r.device = backend == "cpu" ? cpuName() + " (one core)" : sim->device();
+  r.device = backend == "cpu" ? cpuDeviceName() : sim->device();
   if (large) std::fprintf(stderr, "gem bench: ... done in %.1f s\n", secondsSince(start));
   return r;
 }
@@ -498,6 +505,7 @@ void residentTable(const TableRun& run) {
     for (const std::string driver : {"resident", "device", "cpu"}) {
       Scenario s = run.scenarios.get(c);
       s.backend = driver == "cpu" ? "cpu" : "cuda";
+      s.threads = g_cpuThreads;
       if (driver != "cpu") s.cudaDriver = driver;
       s.steps = std::max<long>(s.steps, 2 * o.steps + 1000);
       std::vector<std::unique_ptr<Stepper>> sims;
@@ -505,7 +513,7 @@ void residentTable(const TableRun& run) {
       ResidentRow r;
       r.caseName = c.name, r.driver = sims.front()->driver();
       r.bodies = sims.front()->hostWorld().size(), r.floes = sims.front()->hostWorld().count(BodyKind::Floe);
-      r.device = driver == "cpu" ? cpuName() + " (one core)" : sims.front()->device();
+      r.device = driver == "cpu" ? cpuDeviceName() : sims.front()->device();
       // Whole 200-step periods (re-sorts, copy-backs) from a period's start.
       const long steps = std::max<long>(200, o.steps / 200 * 200);
       std::tie(r.seconds, r.deviceSeconds) = timeTogether(sims, 200, steps);
@@ -589,6 +597,8 @@ int runBench(const BenchOptions& o) {
   if (!o.copyBackEvery.empty() && o.table != "copyback" && o.table != "all")
     throw InputError("gem bench --copy-back: applies to --table copyback (or all)");
   for (const std::string& c : o.cases) parseCase(c);  // bad input before any timing
+  if (o.threads < 1 || o.threads > 1024) throw InputError(fmt::format("gem bench --threads {}: from 1 to 1024", o.threads));
+  g_cpuThreads = o.threads;
   for (const std::string& b : o.broadphases) Registry::global().broadphase(b);
 
   CaseScenarios scenarios;

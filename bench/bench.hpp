@@ -31,6 +31,7 @@ struct BenchOptions {
   std::vector<std::string> backends;     // "cpu", "cuda"; empty: the table's own
   std::vector<int> blockSizes;           // blocks: empty = 32, 64, 128, 256, 512, 1024
   std::vector<int> copyBackEvery;        // copyback: empty = 1, 2, 4, ..., 128
+  int threads = 1;                       // the CPU rows' threads (simulation.threads)
 };
 
 // The table names runBench accepts, in the order "all" runs them (after "step", not in "all").

@@ -32,6 +32,7 @@ namespace {
 
 struct RunArguments {
   std::string scenario, out, backend, broadphase;
+  int threads = -1;  // --threads: simulation.threads (-1: the scenario's)
   double duration = 0;
   long steps = 0;
   bool durationGiven = false, stepsGiven = false;  // set from the command line's counts
@@ -43,6 +44,7 @@ Scenario load(const RunArguments& a) {
   std::vector<std::string> overrides = a.set;
   if (!a.backend.empty()) overrides.push_back("simulation.backend=\"" + a.backend + "\"");
   if (!a.broadphase.empty()) overrides.push_back("simulation.broadphase=\"" + a.broadphase + "\"");
+  if (a.threads >= 0) overrides.push_back("simulation.threads=" + std::to_string(a.threads));
   Scenario s = loadScenario(a.scenario, overrides);
   // --duration and --steps, when given, must make a run of 1 to 2e9 steps: never silently ignored.
   if (a.durationGiven) {
@@ -154,6 +156,8 @@ int main(int argc, char** argv) {
     c->add_option("scenario", args.scenario, "scenario file (TOML)")->required();
     c->add_option("--backend", args.backend, "auto, cpu or cuda");
     c->add_option("--broadphase", args.broadphase, "broadphase strategy by name (see gem info)");
+    c->add_option("--threads", args.threads, "CPU backend: threads stepping the field (simulation.threads; 0 = every core)")
+        ->check(CLI::Range(0, 1024));
     auto* duration =
         c->add_option("--duration", args.duration, "simulated time, s")->each([&](const std::string&) { args.durationGiven = true; });
     c->add_option("--steps", args.steps, "number of steps")->excludes(duration)->each([&](const std::string&) { args.stepsGiven = true; });
@@ -193,6 +197,7 @@ int main(int argc, char** argv) {
   benchCommand->add_option("--backend", bench.backends, "backends to time: cpu, cuda (default: the table's own; step: cpu)");
   benchCommand->add_option("--broadphase", bench.broadphases, "broadphases to time (default: the table's own; step: variable_radius)");
   benchCommand->add_option("--blocks", bench.blockSizes, "blocks: block sizes (default 32 64 128 256 512 1024)");
+  benchCommand->add_option("--threads", bench.threads, "threads of the CPU rows (simulation.threads; default 1, one core)");
   benchCommand->add_option("--copy-back", bench.copyBackEvery, "copyback: intervals k (default 1 2 4 8 16 32 64 128)");
   benchCommand->add_option("--sizes", bench.sizes,
                            "intersection/triangulation: N per row (default the thesis's sizes); resident: world counts");

@@ -246,6 +246,8 @@ int runSweep(const SweepOptions& options) {
   // summary of another scenario would pass for complete if this run failed before writing its own).
   auto prepareCase = [&](size_t i) {
     Scenario s = scenarios[i];  // loaded once, before any case ran
+    // Cases that run side by side share the cores: each steps on one thread unless it says otherwise.
+    if (s.threads == 0 && (jobs > 1 || mpi.active())) s.threads = 1;
     fs::create_directories(dirs[i]);
     fs::remove(dirs[i] / "summary.json");
     writeFileAtomically(dirs[i] / "scenario.toml", texts[i]);

@@ -349,6 +349,7 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
     s.cudaBlockSize = static_cast<int>(t.getInt("cuda_block_size", s.cudaBlockSize, 32, 1024));
     if (s.cudaBlockSize % 32 != 0) t.fail("cuda_block_size", "must be a multiple of 32 (a whole number of warps)");
     s.cudaDriver = t.getChoice("cuda_driver", s.cudaDriver, {"auto", "resident", "device"});
+    s.threads = static_cast<int>(t.getInt("threads", s.threads, 0, 1024));
     t.finish();
   }
   if (const toml::table* b = top.findTable("broadphase")) readBroadphaseTables(*b, s);

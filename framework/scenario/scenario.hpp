@@ -52,6 +52,9 @@ struct Scenario {
   // The CUDA driver (docs/performance.md "CUDA drivers"): "resident" runs each world's whole step
   // in one thread block, "device" each phase as kernels over the whole field, "auto" picks by size.
   std::string cudaDriver = "auto";
+  // CPU backend: threads stepping one field (0: every core; a sweep running cases in parallel
+  // gives each case 1). Results are bit for bit those of one thread.
+  int threads = 0;
 
   // [domain]
   bool hasDomain = false;

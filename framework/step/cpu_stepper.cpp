@@ -168,52 +168,92 @@ void CpuStepper::reorderAlongCurve() {
   m_broadphase->invalidate();
 }
 
+void CpuStepper::forEachBody(int n, const std::function<void(int)>& body) {
+  const int tasks = m_pool ? std::min(n, 4 * m_pool->size()) : 1;
+  if (tasks <= 1) {
+    for (int i = 0; i < n; ++i) body(i);
+    return;
+  }
+  m_pool->run(tasks, [&](int t) {
+    const int end = static_cast<int>(static_cast<long>(n) * (t + 1) / tasks);
+    for (int i = static_cast<int>(static_cast<long>(n) * t / tasks); i < end; ++i) body(i);
+  });
+}
+
 void CpuStepper::narrowphase() {
   const int n = m_world.size();
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
   m_boxes.resize(n);
   m_vertexPose.resize(n, Pose{-1, 0, 0, 0});
   m_moved.assign(n, 0);
-  for (int i = 0; i < n; ++i) {
+  forEachBody(n, [&](int i) {
     // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
     // vertices from an earlier step are still exact, so only bodies that moved are transformed.
     const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
-    if (pose == m_vertexPose[i]) continue;
+    if (pose == m_vertexPose[i]) return;
     m_vertexPose[i] = pose;
     m_moved[i] = 1;
     Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
     m_boxes[i] = boundingBox(v, m_world.worldVertices(i, v));
-  }
+  });
+
+  // The candidates in contiguous parts, a task each; the parts' contacts joined in order are the
+  // contacts of one pass over all the pairs.
+  const int pairs = static_cast<int>(m_pairs.size());
+  const int tasks = m_pool ? std::max(1, std::min(pairs / 64, 4 * m_pool->size())) : 1;
+  m_parts.resize(static_cast<size_t>(tasks));
+  auto testPart = [&](int t) {
+    NarrowphasePart& part = m_parts[static_cast<size_t>(t)];
+    part.a.clear(), part.b.clear(), part.contacts.clear(), part.keys.clear();
+    const int end = static_cast<int>(static_cast<long>(pairs) * (t + 1) / tasks);
+    for (int p = static_cast<int>(static_cast<long>(pairs) * t / tasks); p < end; ++p) {
+      const int a = m_pairs[static_cast<size_t>(p)].a, b = m_pairs[static_cast<size_t>(p)].b;
+      // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
+      if (!mayTouch(m_world.invMass[a], m_world.invMass[b], m_boxes[a], m_boxes[b])) continue;
+      const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
+      // Two bodies that have not moved since the last step, and did not touch then, do not touch
+      // now: the same polygons give the same answer. Most of a pack rests ahead of the vessel.
+      // (A touching pair is always a candidate, whatever the broadphase, so "did not touch then"
+      // is exactly "not among the last step's contacts".)
+      const bool touchedBefore = std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
+      if (!m_moved[a] && !m_moved[b] && !touchedBefore) continue;
+      const Contact c =
+          computeContact(&m_worldVertices[static_cast<size_t>(a) * kMaxVertices], m_world.vertexCount[a], m_world.position(a),
+                         &m_worldVertices[static_cast<size_t>(b) * kMaxVertices], m_world.vertexCount[b], m_world.position(b));
+      if (!c.touching) continue;
+      part.a.push_back(a);
+      part.b.push_back(b);
+      part.contacts.push_back(PairContact{c, !touchedBefore});
+      part.keys.push_back(key);
+    }
+  };
+  if (tasks == 1)
+    testPart(0);
+  else
+    m_pool->run(tasks, testPart);
 
   m_contactA.clear();
   m_contactB.clear();
   m_contacts.clear();
   m_currentContacts.clear();
-  for (const CandidatePair& pair : m_pairs) {
-    const int a = pair.a, b = pair.b;
-    // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
-    if (!mayTouch(m_world.invMass[a], m_world.invMass[b], m_boxes[a], m_boxes[b])) continue;
-    const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
-    // Two bodies that have not moved since the last step, and did not touch then, do not touch
-    // now: the same polygons give the same answer. Most of a pack rests ahead of the vessel.
-    // (A touching pair is always a candidate, whatever the broadphase, so "did not touch then"
-    // is exactly "not among the last step's contacts".)
-    const bool touchedBefore = std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
-    if (!m_moved[a] && !m_moved[b] && !touchedBefore) continue;
-    const Contact c = computeContact(&m_worldVertices[static_cast<size_t>(a) * kMaxVertices], m_world.vertexCount[a], m_world.position(a),
-                                     &m_worldVertices[static_cast<size_t>(b) * kMaxVertices], m_world.vertexCount[b], m_world.position(b));
-    if (!c.touching) continue;
-    const bool onset = !touchedBefore;
-    m_contactA.push_back(a);
-    m_contactB.push_back(b);
-    m_contacts.push_back(PairContact{c, onset});
-    m_currentContacts.push_back(key);
+  for (const NarrowphasePart& part : m_parts) {
+    m_contactA.insert(m_contactA.end(), part.a.begin(), part.a.end());
+    m_contactB.insert(m_contactB.end(), part.b.begin(), part.b.end());
+    m_contacts.insert(m_contacts.end(), part.contacts.begin(), part.contacts.end());
+    m_currentContacts.insert(m_currentContacts.end(), part.keys.begin(), part.keys.end());
   }
   std::sort(m_currentContacts.begin(), m_currentContacts.end());
   m_previousContacts.swap(m_currentContacts);
 }
 
 void CpuStepper::step() {
+  // The pool is made by the first step: a CPU stepper that only mirrors a device's world (the
+  // CUDA backend's, one per case of a sweep) never steps and never starts threads.
+  if (!m_poolChecked) {
+    m_poolChecked = true;
+    const int threads = threadsFor(m_scenario.threads);
+    if (threads > 1) m_pool = std::make_unique<ThreadPool>(threads);
+  }
   const StepContext ctx{m_scenario.dt, m_time, m_step};
   const int n = m_world.size();
   const int vesselDof = m_scenario.vessel.dof;
@@ -224,9 +264,10 @@ void CpuStepper::step() {
 
   // 3. Two-body events write into each contact's slot.
   m_pairBodies.resize(n);
-  for (int i = 0; i < n; ++i)
+  forEachBody(n, [&](int i) {
     m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof),
                                  &m_worldVertices[static_cast<size_t>(i) * kMaxVertices], m_world.vertexCount[i]);
+  });
   const int contacts = static_cast<int>(m_contacts.size());
   m_slots.assign(contacts, PairSlot{{0, 0}});
   // Records: each stream has room for one row per contact at first; an event may push more (a

@@ -2,10 +2,12 @@
 //   1 broadphase  2 narrowphase  3 two-body events  4 solo events  5 motion  6 topology
 // (7, the observers, live in the runner). Events come from the registry by name.
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "framework/step/thread_pool.hpp"
 #include "framework/api/broadphase.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/scenario/scenario.hpp"
@@ -53,6 +55,7 @@ class CpuStepper final : public Stepper {
   const RecordStreams& recordStreams() const { return m_streams; }
   int contactCount() const override { return static_cast<int>(m_contacts.size()); }
   int candidateCount() const { return static_cast<int>(m_pairs.size()); }
+  int threads() const { return m_pool ? m_pool->size() : 1; }        // after the first step
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
   int vesselSlot() const;                                            // -1 without a vessel
 
@@ -93,6 +96,18 @@ class CpuStepper final : public Stepper {
   std::vector<VelocityChange> m_changes;
   std::vector<MotionBody> m_motionBodies;
   std::vector<std::pair<std::int64_t, std::int64_t>> m_previousContacts, m_currentContacts;
+  // simulation.threads: the pool (null for one thread) and each task's share of the narrowphase,
+  // joined in task order so that the contacts are in pair order whatever the thread count.
+  std::unique_ptr<ThreadPool> m_pool;
+  bool m_poolChecked = false;
+  struct NarrowphasePart {
+    std::vector<int> a, b;
+    std::vector<PairContact> contacts;
+    std::vector<std::pair<std::int64_t, std::int64_t>> keys;
+  };
+  std::vector<NarrowphasePart> m_parts;
+  // body(i) for every i in [0, n), in contiguous ranges over the pool's threads.
+  void forEachBody(int n, const std::function<void(int)>& body);
   RecordStreams m_streams;                               // opened by the events as their Params are parsed
   StepRecords m_records;                                 // the last step's rows
   std::vector<std::vector<unsigned char>> m_recordRows;  // per stream: the pair phase's buffer

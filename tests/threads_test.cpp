@@ -1,0 +1,102 @@
+// simulation.threads: one field stepped by several CPU threads gives, bit for bit, the run of one
+// thread (docs/architecture.md "Determinism"): each task writes its own part of a phase and the
+// parts are joined in order, so the contacts, the records and every sum are the same.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "framework/step/cpu_stepper.hpp"
+#include "framework/step/thread_pool.hpp"
+#include "test_support.hpp"
+
+namespace gem {
+namespace {
+
+struct ThreadedRun {
+  std::vector<std::int64_t> ids;
+  std::vector<Real> state;
+  long contacts = 0, impactRows = 0, broken = 0;
+};
+
+ThreadedRun runWithThreads(const Scenario& base, int threads, int steps) {
+  Scenario s = base;
+  s.threads = threads;
+  CpuStepper sim(s);
+  ThreadedRun r;
+  for (int k = 0; k < steps; ++k) {
+    sim.step();
+    r.contacts += sim.contactCount();
+    for (int q = 0; q < sim.records().streams().count(); ++q) r.impactRows += sim.records().rowCount(q);
+  }
+  EXPECT_EQ(sim.threads(), threads);
+  r.broken = sim.floesBroken();
+  const World& w = sim.world();
+  r.ids = w.id;
+  for (const std::vector<Real>* v : {&w.x, &w.y, &w.angle, &w.vx, &w.vy, &w.omega}) r.state.insert(r.state.end(), v->begin(), v->end());
+  return r;
+}
+
+void expectSame(const ThreadedRun& one, const ThreadedRun& many, int threads) {
+  SCOPED_TRACE(::testing::Message() << threads << " threads");
+  ASSERT_EQ(one.ids, many.ids);
+  ASSERT_EQ(one.state.size(), many.state.size());
+  EXPECT_EQ(0, std::memcmp(one.state.data(), many.state.data(), one.state.size() * sizeof(Real)));
+  EXPECT_EQ(one.contacts, many.contacts);
+  EXPECT_EQ(one.impactRows, many.impactRows);
+  EXPECT_EQ(one.broken, many.broken);
+}
+
+TEST(Threads, TheBusyChannelStepsBitForBitOnOneTwoAndFourThreads) {
+  test::TempDir dir;
+  const Scenario s = test::scenarioFromToml(dir, test::kBusyScene, {"simulation.steps=300"});
+  const ThreadedRun one = runWithThreads(s, 1, 300);
+  EXPECT_GT(one.contacts, 1000) << "the scene must touch a lot, or it guards nothing";
+  EXPECT_GT(one.impactRows, 0);
+  for (int threads : {2, 4}) expectSame(one, runWithThreads(s, threads, 300), threads);
+}
+
+TEST(Threads, ABrokenFieldStepsBitForBitOnThreeThreads) {
+  // Thin ice: floes break, the world changes size, the vessel pushes through (a field of its own).
+  test::TempDir dir;
+  const Scenario s = test::scenarioFromToml(dir, test::kBusyScene, {"simulation.steps=420", "field.thickness=0.25"});
+  const ThreadedRun one = runWithThreads(s, 1, 420);
+  EXPECT_GT(one.broken, 0) << "no floe broke: the test guards nothing of the topology phase";
+  expectSame(one, runWithThreads(s, 3, 420), 3);
+}
+
+TEST(ThreadPool, RunsEveryTaskOnceAndRethrowsTheFirstError) {
+  ThreadPool pool(4);
+  EXPECT_EQ(pool.size(), 4);
+  for (int round = 0; round < 200; ++round) {
+    std::vector<std::atomic<int>> seen(37);
+    pool.run(37, [&](int k) { ++seen[static_cast<size_t>(k)]; });
+    for (const auto& s : seen) ASSERT_EQ(s.load(), 1) << "round " << round;
+  }
+  EXPECT_THROW(pool.run(10,
+                        [](int k) {
+                          if (k == 7) throw std::runtime_error("task 7");
+                        }),
+               std::runtime_error);
+  std::atomic<int> after{0};
+  pool.run(5, [&](int) { ++after; });  // the pool still works after an error
+  EXPECT_EQ(after.load(), 5);
+}
+
+TEST(Threads, TheScenarioKeyAndTheCommandLineOption) {
+  test::TempDir dir;
+  EXPECT_EQ(test::scenarioFromToml(dir, test::kBusyScene).threads, 0);
+  EXPECT_EQ(test::scenarioFromToml(dir, test::kBusyScene, {"simulation.threads=3"}).threads, 3);
+  EXPECT_THROW(test::scenarioFromToml(dir, test::kBusyScene, {"simulation.threads=-1"}), InputError);
+  const auto scene = dir.write("busy.toml", test::kBusyScene);
+  const auto log = dir.path() / "log.txt";
+  ASSERT_EQ(test::runGem("run " + scene.string() + " --backend cpu --threads 2 --steps 20 --out " + (dir.path() / "out").string(), log), 0)
+      << test::readFile(log);
+  EXPECT_EQ(test::runGem("run " + scene.string() + " --threads -2 --steps 20 --out " + (dir.path() / "out2").string(), log), 2);
+}
+
+}  // namespace
+}  // namespace gem
