@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <chrono>
 #include <ctime>
+#include <thread>
 #include <tuple>
 #include <cmath>
 #include <cstdio>
@@ -37,7 +38,7 @@ std::string cpuName() {
 
 const std::vector<std::string>& benchTables() {
   static const std::vector<std::string> tables{"step",         "fields",        "blocks",   "copyback", "scaling",
-                                               "intersection", "triangulation", "resident", "all"};
+                                               "intersection", "triangulation", "resident", "cpu",      "all"};
   return tables;
 }
 
@@ -395,6 +396,38 @@ void sweepTable(const TableRun& run, const std::string& name) {
   table.finish();
 }
 
+// --table cpu: the CPU backend on one field over 1, 2, 4, 8 and every core's threads
+// (simulation.threads), the thesis fields and 10^4, 10^5 floes; each row's speed-up over one thread.
+void cpuTable(const TableRun& run) {
+  const BenchOptions& o = run.options;
+  const auto cases = casesOf(o, {"456", "824", "10000", "100000"});
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<int> threads{1};
+  for (int t : {2, 4, 8})
+    if (t < cores) threads.push_back(t);
+  if (cores > 1) threads.push_back(cores);
+  const std::vector<std::string> broadphases = o.broadphases.empty() ? std::vector<std::string>{"variable_radius"} : o.broadphases;
+  std::printf("gem bench --table cpu: threads stepping one field (simulation.threads) on %s; %d cores, %s\n", caseList(cases).c_str(),
+              cores, cpuName().c_str());
+  printTiming(o);
+  Table table("cpu", "threads", run.csvPath);
+  table.printHeader();
+  const int asked = g_cpuThreads;
+  for (const CaseKey& c : cases)
+    for (const std::string& broadphase : broadphases) {
+      double one = 0;
+      for (int t : threads) {
+        g_cpuThreads = t;
+        const Row r = timeRow(run.scenarios, c, "cpu", broadphase, o.steps, std::to_string(t));
+        table.add(r);
+        if (t == 1) one = r.seconds;
+        if (t > 1) std::printf("  %d threads: %.2fx one thread\n", t, one / r.seconds);
+      }
+    }
+  g_cpuThreads = asked;
+  table.finish();
+}
+
 // --table scaling (thesis 5.6): 10^4 to 10^6 floes per broadphase on the GPU; the CPU at 10^4 and
 // 10^5 with variable radius, for the GPU/CPU ratio.
 void scalingTable(const TableRun& run) {
@@ -566,6 +599,8 @@ void runTable(const TableRun& run, const std::string& name) {
     scalingTable(run);
   else if (name == "resident")
     residentTable(run);
+  else if (name == "cpu")
+    cpuTable(run);
   else
     geometryTable(run, name);
 }

@@ -8,6 +8,7 @@
 //   scaling   10^4, 10^5, 10^6 random floes per built-in broadphase on CUDA, the CPU at 10^4 and 10^5
 //   resident  456 and 824 as one world on each CUDA driver (and the CPU), then ensembles of 456-floe
 //             worlds run together on the resident driver, with date and commit (not in "all")
+//   cpu       456, 824, 10^4, 10^5 floes on the CPU at 1, 2, 4, 8 and every core's threads (not in "all")
 // and the geometry tables intersection | triangulation (bench/geometry_bench.hpp); "all" runs
 // fields, blocks, copyback, scaling, intersection and triangulation one after another.
 #pragma once

@@ -29,6 +29,6 @@ TEST(GemBench, UnknownTableIsBadInput) {
   TempDir dir;
   EXPECT_EQ(test::runGem("bench --table nonsense", dir.path() / "log.txt"), 2);
   EXPECT_NE(test::readFile(dir.path() / "log.txt")
-                .find("valid tables are step, fields, blocks, copyback, scaling, intersection, triangulation, resident, all"),
+                .find("valid tables are step, fields, blocks, copyback, scaling, intersection, triangulation, resident, cpu, all"),
             std::string::npos);
 }

@@ -20,6 +20,7 @@ struct ThreadedRun {
   std::vector<std::int64_t> ids;
   std::vector<Real> state;
   long contacts = 0, impactRows = 0, broken = 0;
+  int candidates = 0;  // the last step's
 };
 
 ThreadedRun runWithThreads(const Scenario& base, int threads, int steps) {
@@ -34,6 +35,7 @@ ThreadedRun runWithThreads(const Scenario& base, int threads, int steps) {
   }
   EXPECT_EQ(sim.threads(), threads);
   r.broken = sim.floesBroken();
+  r.candidates = sim.candidateCount();
   const World& w = sim.world();
   r.ids = w.id;
   for (const std::vector<Real>* v : {&w.x, &w.y, &w.angle, &w.vx, &w.vy, &w.omega}) r.state.insert(r.state.end(), v->begin(), v->end());
@@ -50,19 +52,24 @@ void expectSame(const ThreadedRun& one, const ThreadedRun& many, int threads) {
   EXPECT_EQ(one.broken, many.broken);
 }
 
-TEST(Threads, TheBusyChannelStepsBitForBitOnOneTwoAndFourThreads) {
+// A field large enough that every parallel phase runs on the pool (CpuStepper::kParallelBodies).
+TEST(Threads, ALargeFieldStepsBitForBitOnOneTwoAndFourThreads) {
   test::TempDir dir;
-  const Scenario s = test::scenarioFromToml(dir, test::kBusyScene, {"simulation.steps=300"});
-  const ThreadedRun one = runWithThreads(s, 1, 300);
-  EXPECT_GT(one.contacts, 1000) << "the scene must touch a lot, or it guards nothing";
+  const Scenario s =
+      test::scenarioFromToml(dir, test::kBusyScene, {"simulation.steps=120", "domain.x=[0.0, 700.0]", "domain.y=[-200.0, 200.0]"});
+  const ThreadedRun one = runWithThreads(s, 1, 120);
+  ASSERT_GE(one.ids.size(), static_cast<size_t>(CpuStepper::kParallelBodies)) << "the field is too small to run on the pool";
+  ASSERT_GE(one.candidates, CpuStepper::kParallelPairs) << "too few pairs for the narrowphase to run on the pool";
+  EXPECT_GT(one.contacts, 500) << "the scene must touch a lot, or it guards nothing";
   EXPECT_GT(one.impactRows, 0);
-  for (int threads : {2, 4}) expectSame(one, runWithThreads(s, threads, 300), threads);
+  for (int threads : {2, 4}) expectSame(one, runWithThreads(s, threads, 120), threads);
 }
 
 TEST(Threads, ABrokenFieldStepsBitForBitOnThreeThreads) {
-  // Thin ice: floes break, the world changes size, the vessel pushes through (a field of its own).
+  // Thin ice: floes break, the world changes size, the vessel pushes through.
   test::TempDir dir;
-  const Scenario s = test::scenarioFromToml(dir, test::kBusyScene, {"simulation.steps=420", "field.thickness=0.25"});
+  const Scenario s = test::scenarioFromToml(
+      dir, test::kBusyScene, {"simulation.steps=420", "field.thickness=0.25", "domain.x=[0.0, 700.0]", "domain.y=[-200.0, 200.0]"});
   const ThreadedRun one = runWithThreads(s, 1, 420);
   EXPECT_GT(one.broken, 0) << "no floe broke: the test guards nothing of the topology phase";
   expectSame(one, runWithThreads(s, 3, 420), 3);

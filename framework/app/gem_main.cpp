@@ -185,6 +185,7 @@ int main(int argc, char** argv) {
                            "intersection, triangulation: the geometry tables (thesis 5.2, 5.3);\n"
                            "resident: 456 and 824 floes on each CUDA driver and the CPU, then ensembles of 10, 100, 1000, "
                            "10000 456-floe worlds on the resident driver (cuda; --sizes: world counts);\n"
+                           "cpu: 456, 824, 10^4, 10^5 floes on 1, 2, 4, 8 and every core's threads;\n"
                            "all: fields, blocks, copyback, scaling, intersection, triangulation (without a CUDA device "
                            "the CUDA rows are skipped, saying so; each table its own cases and broadphases)");
   benchCommand->add_option("--csv", bench.csv,

@@ -55,7 +55,9 @@ class CpuStepper final : public Stepper {
   const RecordStreams& recordStreams() const { return m_streams; }
   int contactCount() const override { return static_cast<int>(m_contacts.size()); }
   int candidateCount() const { return static_cast<int>(m_pairs.size()); }
-  int threads() const { return m_pool ? m_pool->size() : 1; }        // after the first step
+  int threads() const { return m_pool ? m_pool->size() : 1; }  // after the first step
+  // The sizes from which a phase runs on the pool at all (docs/performance.md 3.8).
+  static constexpr int kParallelBodies = 2048, kParallelPairs = 2048;
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
   int vesselSlot() const;                                            // -1 without a vessel
 
@@ -106,8 +108,12 @@ class CpuStepper final : public Stepper {
     std::vector<std::pair<std::int64_t, std::int64_t>> keys;
   };
   std::vector<NarrowphasePart> m_parts;
-  // body(i) for every i in [0, n), in contiguous ranges over the pool's threads.
+  // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads; body(i) for
+  // every i likewise.
+  void forEachRange(int n, const std::function<void(int, int)>& range);
   void forEachBody(int n, const std::function<void(int)>& body);
+  // The gather's contacts of each body, in contact order (k x 2 + side, side 1 for b).
+  std::vector<int> m_bodyContactStart, m_bodyContactFill, m_bodyContacts;
   RecordStreams m_streams;                               // opened by the events as their Params are parsed
   StepRecords m_records;                                 // the last step's rows
   std::vector<std::vector<unsigned char>> m_recordRows;  // per stream: the pair phase's buffer
