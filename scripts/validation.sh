@@ -83,5 +83,8 @@ cut_columns() { cut -d, -f"$2" "$1"; }
   echo "Differences to expect: GEM's fields are generated (power-diagram tiling with the thesis's size"
   echo "statistics), not the digitised floes of the thesis's Figure 6.8, so floe shapes and apex angles differ;"
   echo "GEM logs an apex of 180 deg when no floe vertex entered the hull (an edge met a hull corner)."
+  echo
+  # The audit against the thesis is written by hand, not generated: it follows the tables.
+  cat "$here/docs/validation/audit-summary.md"
 } > "$here/docs/validation.md"
 echo "wrote $here/docs/validation.md"

@@ -83,6 +83,13 @@ TEST(ThreadPool, RunsEveryTaskOnceAndRethrowsTheFirstError) {
     pool.run(37, [&](int k) { ++seen[static_cast<size_t>(k)]; });
     for (const auto& s : seen) ASSERT_EQ(s.load(), 1) << "round " << round;
   }
+  // Rounds of fewer tasks than threads wake only some workers; the others must not miss a round.
+  for (int round = 0; round < 300; ++round) {
+    const int tasks = round % 6;
+    std::vector<std::atomic<int>> seen(static_cast<size_t>(tasks));
+    pool.run(tasks, [&](int k) { ++seen[static_cast<size_t>(k)]; });
+    for (const auto& s : seen) ASSERT_EQ(s.load(), 1) << "round " << round;
+  }
   EXPECT_THROW(pool.run(10,
                         [](int k) {
                           if (k == 7) throw std::runtime_error("task 7");

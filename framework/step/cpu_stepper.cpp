@@ -171,7 +171,7 @@ void CpuStepper::reorderAlongCurve() {
 void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range) {
   // Small fields stay on one thread: waking the pool costs more than their work (on 2 cores the
   // 456-hexagon field took 0.116 ms a step on 2 threads against 0.079 ms on one).
-  const int tasks = m_pool && n >= kParallelBodies ? std::min(n / 64, 4 * m_pool->size()) : 1;
+  const int tasks = m_pool && n >= kParallelBodies ? std::min(n / kGrain, 4 * m_pool->size()) : 1;
   if (tasks <= 1) {
     range(0, n);
     return;
@@ -207,7 +207,7 @@ void CpuStepper::narrowphase() {
   // The candidates in contiguous parts, a task each; the parts' contacts joined in order are the
   // contacts of one pass over all the pairs.
   const int pairs = static_cast<int>(m_pairs.size());
-  const int tasks = m_pool && pairs >= kParallelPairs ? std::min(pairs / 64, 4 * m_pool->size()) : 1;
+  const int tasks = m_pool && pairs >= kParallelPairs ? std::min(pairs / kGrain, 4 * m_pool->size()) : 1;
   m_parts.resize(static_cast<size_t>(tasks));
   auto testPart = [&](int t) {
     NarrowphasePart& part = m_parts[static_cast<size_t>(t)];

@@ -10,7 +10,7 @@ int threadsFor(int requested) {
 }
 
 ThreadPool::ThreadPool(int threads) {
-  for (int t = 1; t < threads; ++t) m_workers.emplace_back([this] { work(); });
+  for (int t = 1; t < threads; ++t) m_workers.emplace_back([this, t] { work(t - 1); });
 }
 
 ThreadPool::~ThreadPool() {
@@ -34,7 +34,7 @@ void ThreadPool::drain() {
   }
 }
 
-void ThreadPool::work() {
+void ThreadPool::work(int index) {
   long seen = 0;
   for (;;) {
     {
@@ -42,6 +42,7 @@ void ThreadPool::work() {
       m_wake.wait(lock, [&] { return m_stop || m_round != seen; });
       if (m_stop) return;
       seen = m_round;
+      if (index >= m_participants) continue;  // a round of fewer tasks than threads leaves it out
     }
     drain();
     {
@@ -65,7 +66,8 @@ void ThreadPool::run(int tasks, const std::function<void(int)>& task) {
     m_error = nullptr;
     // Every worker takes part in every round and reports its end: a round starts only once the
     // last one has ended, so no worker can still be taking tasks from it.
-    m_running = static_cast<int>(m_workers.size());
+    m_participants = std::min(static_cast<int>(m_workers.size()), tasks - 1);
+    m_running = m_participants;
     ++m_round;
   }
   m_wake.notify_all();

@@ -23,11 +23,12 @@ class ThreadPool {
   ThreadPool& operator=(const ThreadPool&) = delete;
 
   int size() const { return static_cast<int>(m_workers.size()) + 1; }
+  // Only tasks - 1 workers are woken to take part (fewer tasks than threads, fewer threads busy).
   // The first exception a task threw is rethrown here, once every task has ended.
   void run(int tasks, const std::function<void(int)>& task);
 
  private:
-  void work();
+  void work(int index);
   void drain();
 
   std::vector<std::thread> m_workers;
@@ -36,7 +37,8 @@ class ThreadPool {
   const std::function<void(int)>* m_task = nullptr;
   int m_tasks = 0;
   std::atomic<int> m_next{0};
-  int m_running = 0;  // workers that have not ended the current round
+  int m_participants = 0;  // the workers taking part in the current round: the first tasks - 1
+  int m_running = 0;       // of them, those that have not ended it
   long m_round = 0;
   bool m_stop = false;
   std::exception_ptr m_error;
