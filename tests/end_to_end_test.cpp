@@ -134,6 +134,30 @@ TEST(GemRun, WritesEveryOutputOfTheContract) {
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
 }
 
+// The terminal shows the in-ice figures the studies use (the steps with the whole hull inside the
+// domain's x range) before the whole run's, and they are summary.json's.
+TEST(GemRun, TheTerminalShowsTheInIceSpeedAndResistance) {
+  TempDir dir;
+  const auto scenario = dir.write("busy.toml", kBusyScene);
+  const auto out = dir.path() / "run";
+  ASSERT_EQ(test::runGem("run " + scenario.string() + " --steps 300 --out " + out.string() + " --set output.frame_every=0",
+                         dir.path() / "log.txt"),
+            0)
+      << test::readFile(dir.path() / "log.txt");
+  const std::string log = test::readFile(dir.path() / "log.txt");
+  const size_t inIce = log.find("  in ice         speed mean "), whole = log.find("  whole run      speed mean ");
+  ASSERT_NE(inIce, std::string::npos) << log;
+  ASSERT_NE(whole, std::string::npos) << log;
+  EXPECT_LT(inIce, whole) << log;
+  const std::string summary = test::readFile(out / "summary.json");
+  const size_t key = summary.find("\"ship_speed_in_ice\": {\"min\": ");
+  ASSERT_NE(key, std::string::npos) << summary;
+  const size_t mean = summary.find("\"mean\": ", key);
+  const double fromSummary = std::stod(summary.substr(mean + 8));
+  const double fromTerminal = std::stod(log.substr(inIce + 27));
+  EXPECT_NEAR(fromTerminal, fromSummary, 0.0005) << log << summary;
+}
+
 TEST(GemInfo, ListsEveryBuiltInEventAndBroadphase) {
   TempDir dir;
   ASSERT_EQ(test::runGem("info", dir.path() / "log.txt"), 0);

@@ -86,8 +86,16 @@ int commandRun(const RunArguments& a) {
         std::printf(", %s mean %.4g, max %.4g", t.statisticKey.c_str(), t.statistic.mean, t.statistic.max);
       std::printf("\n");
     }
+    // In ice first: the studies' figures (the steps with the whole hull inside the domain's x
+    // range); the whole run's, diluted by the open water before and after, second.
+    if (r.shipSpeedInIce.count)
+      std::printf("  in ice         speed mean %.3f m/s (min %.3f, max %.3f); resistance %.1f kN; %ld steps (%.1f s)\n",
+                  r.shipSpeedInIce.mean, r.shipSpeedInIce.min, r.shipSpeedInIce.max, r.netThrustInIce.mean / 1e3, r.shipSpeedInIce.count,
+                  static_cast<double>(r.shipSpeedInIce.count) * r.simTime / std::max<double>(static_cast<double>(r.steps), 1));
+    else if (r.shipSpeed.count)
+      std::printf("  in ice         no step with the whole hull inside the domain's x range (no in-ice statistics)\n");
     if (r.shipSpeed.count)
-      std::printf("  ship speed     mean %.3f m/s (min %.3f, max %.3f); mean net thrust %.1f kN\n", r.shipSpeed.mean, r.shipSpeed.min,
+      std::printf("  whole run      speed mean %.3f m/s (min %.3f, max %.3f); mean net thrust %.1f kN\n", r.shipSpeed.mean, r.shipSpeed.min,
                   r.shipSpeed.max, r.netThrust.mean / 1e3);
     std::printf("  wall time      %.3f s for %.1f s simulated: %.0fx real time (%.0f steps/s)\n", r.wallTime, r.simTime,
                 r.simTime / std::max(r.wallTime, 1e-9), r.steps / std::max(r.wallTime, 1e-9));
