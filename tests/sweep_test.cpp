@@ -319,7 +319,8 @@ TEST(SweepSummary, ReadsGemJson) {
   EXPECT_EQ(s.at("ship_speed.min"), "1.5");
   EXPECT_EQ(s.at("ship_speed.mean"), "");
   EXPECT_EQ(s.at("ok"), "true");
-  EXPECT_THROW(readSummaryJson(dir.write("bad.json", "{\"a\": }")), std::runtime_error);
+  EXPECT_THROW(readSummaryJson(dir.write("bad.json", "{\"a\": }")), InputError);  // bad input: exit 2
+  EXPECT_THROW(readSummaryJson(dir.write("empty.json", "")), InputError);
   // Nested 50,000 deep (a damaged file in a sweep being resumed): refused, not a stack overflow.
   std::string deep = "{\"a\": ";
   for (int k = 0; k < 50000; ++k) deep += "{\"a\": ";

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "framework/api/errors.hpp"
 #include "framework/output/atomic_file.hpp"
 #include "framework/output/csv_field.hpp"
 
@@ -32,7 +33,9 @@ class JsonReader {
 
  private:
   [[noreturn]] void fail(const std::string& what) const {
-    throw std::runtime_error(fmt::format("{}: malformed JSON at offset {}: {}", m_file, m_pos, what));
+    // Bad input like any other (exit 2): a damaged file in a sweep's folder, not an internal error.
+    throw InputError(
+        fmt::format("{}: malformed JSON at offset {}: {} (delete it, and the sweep runs that case again)", m_file, m_pos, what));
   }
   void skipSpace() {
     while (m_pos < m_text.size() && std::isspace(static_cast<unsigned char>(m_text[m_pos]))) ++m_pos;
@@ -142,7 +145,7 @@ const std::vector<std::pair<std::string, std::string>>& columnKeys() {
 
 std::map<std::string, std::string> readSummaryJson(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + file.string());
+  if (!in) throw InputError("cannot read " + file.string());
   std::string text(std::istreambuf_iterator<char>(in), {});
   return JsonReader(std::move(text), file.string()).read();
 }
