@@ -154,6 +154,25 @@ TEST(BadInputCli, NotAScenarioFileAndBadNumbersOnTheCommandLine) {
   EXPECT_LT(std::filesystem::file_size(log), 2000u) << "the message echoes the whole token";
 }
 
+// A bad value given by --set is blamed on the --set, not on the scenario file that never held it:
+// scenario keys, event parameters, unknown keys and bodies.
+TEST(BadInputCli, ABadSetValueNamesTheSet) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  const auto good = dir.write("good.toml", kSim);
+  for (const std::string set : {"simulation.dt=-1", "vessel.dof=2", "simulation.dtt=0.1", "events.drag.cd=-5", "events.drag.cdd=1",
+                                "floes=[{vertices=[[0.0,0.0],[1.0,0.0]],thickness=1.0}]"}) {
+    EXPECT_EQ(gem::test::runGem("check " + good.string() + " --set '" + set + "'", log), 2) << set;
+    const std::string text = gem::test::readFile(log);
+    EXPECT_NE(text.find("--set " + set + ": "), std::string::npos) << text;
+    EXPECT_EQ(text.find("good.toml"), std::string::npos) << "blames the file: " << text;
+  }
+  // A bad value in the file itself still names the file, line and column, with a --set beside it.
+  const auto bad = dir.write("bad.toml", "[simulation]\ndt = -0.1\nsteps = 5\n");
+  EXPECT_EQ(gem::test::runGem("check " + bad.string() + " --set simulation.seed=3", log), 2);
+  EXPECT_NE(gem::test::readFile(log).find("bad.toml:2:"), std::string::npos) << gem::test::readFile(log);
+}
+
 TEST(BadInputCli, MissingScenarioFileAndUnknownOptionExit2) {
   TempDir dir;
   EXPECT_EQ(gem::test::runGem("run " + (dir.path() / "absent.toml").string(), dir.path() / "log.txt"), 2);

@@ -33,8 +33,25 @@ void TableReader::fail(const std::string& key, const std::string& message) const
   throw InputError(m_file, 0, 0, fmt::format("{}: {}", keyPath(key), message));
 }
 
+namespace {
+thread_local const std::vector<std::string>* t_overrides = nullptr;
+}  // namespace
+
+OverrideScope::OverrideScope(const std::vector<std::string>& assignments) : m_previous(t_overrides) { t_overrides = &assignments; }
+OverrideScope::~OverrideScope() { t_overrides = m_previous; }
+
 void TableReader::failAt(const toml::node& n, const std::string& message) const {
   const auto& src = n.source();
+  // A value from --set (no source): the message starts with its key path ("a.b: ...", "a.b[0]...")
+  // or quotes it ("unknown key \"a.b\""); the last assignment of that key is the one in force.
+  if (!src.path && t_overrides) {
+    for (auto a = t_overrides->rbegin(); a != t_overrides->rend(); ++a) {
+      const std::string key = a->substr(0, a->find('='));
+      const bool named = message.rfind(key + ":", 0) == 0 || message.rfind(key + "[", 0) == 0 || message.rfind(key + ".", 0) == 0 ||
+                         message.find("\"" + key + "\"") != std::string::npos || message.find("\"" + key + ".") != std::string::npos;
+      if (named) throw InputError(fmt::format("--set {}: {}", *a, message));
+    }
+  }
   throw InputError(m_file, static_cast<int>(src.begin.line), static_cast<int>(src.begin.column), message);
 }
 

@@ -14,6 +14,20 @@
 
 namespace gem {
 
+// While one is alive on this thread, an error about a value that came from `--set KEY=VALUE` (a
+// node with no place in any file: toml++ does not copy a node's source) names "--set KEY=VALUE",
+// not the scenario file. loadScenario and the CPU stepper's event parsing hold one.
+class OverrideScope {
+ public:
+  explicit OverrideScope(const std::vector<std::string>& assignments);
+  ~OverrideScope();
+  OverrideScope(const OverrideScope&) = delete;
+  OverrideScope& operator=(const OverrideScope&) = delete;
+
+ private:
+  const std::vector<std::string>* m_previous;
+};
+
 class TableReader {
  public:
   // table may be null (section absent): every get returns its default. path is the dotted name

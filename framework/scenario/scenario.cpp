@@ -151,7 +151,12 @@ void readFloes(const toml::array& floes, TableReader& parent, Scenario& s) {
     spec.velocity = t.findVec2("velocity").value_or(Vec2{0, 0});
     spec.angularVelocity = t.getReal("angular_velocity", 0);
     const auto& src = ft->source();
-    spec.origin = fmt::format("{}:{}:{}: floes[{}]", s.fileName, src.begin.line, src.begin.column, k);
+    // Where the floe was written: its line in the file, or the --set that gave the floes.
+    std::string setBy;
+    for (const std::string& o : s.overrides)
+      if (o.rfind("floes=", 0) == 0) setBy = o;
+    spec.origin = src.path ? fmt::format("{}:{}:{}: floes[{}]", s.fileName, src.begin.line, src.begin.column, k)
+                           : fmt::format("--set {}: floes[{}]", setBy.empty() ? std::string("floes=...") : setBy, k);
     t.finish();
     s.floes.push_back(std::move(spec));
   }
@@ -311,6 +316,7 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
   }
   for (const std::string& o : overrides) applyOverride(s.root, o);
   s.overrides = overrides;
+  const OverrideScope blameSet(s.overrides);  // an error in a --set value names the --set
   if (s.root.empty())
     throw InputError(fmt::format("{}: nothing in it: a scenario needs at least a [simulation] table or bodies", s.fileName));
 

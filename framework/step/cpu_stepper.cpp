@@ -129,6 +129,7 @@ CpuStepper::CpuStepper(const Scenario& scenario) : CpuStepper(scenario, buildWor
 CpuStepper::CpuStepper(const Scenario& scenario, World world) : m_scenario(scenario), m_world(std::move(world)) { setUp(); }
 
 void CpuStepper::setUp() {
+  const OverrideScope blameSet(m_scenario.overrides);  // an error in a --set value names the --set
   m_broadphase = Registry::global().broadphase(m_scenario.broadphase).make(m_scenario.broadphaseSettings);
   for (const EventEntry* entry : Registry::global().events()) {
     auto it = m_scenario.events.find(entry->name);
