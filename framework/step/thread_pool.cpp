@@ -64,8 +64,9 @@ void ThreadPool::run(int tasks, const std::function<void(int)>& task) {
     m_tasks = tasks;
     m_next = 0;
     m_error = nullptr;
-    // Every worker takes part in every round and reports its end: a round starts only once the
-    // last one has ended, so no worker can still be taking tasks from it.
+    // The round's participants (the first tasks - 1 workers) each report its end, and the next
+    // round starts only once the last has: no worker can still be taking tasks from an old round.
+    // The others skip it (they may wake late; they only note the round).
     m_participants = std::min(static_cast<int>(m_workers.size()), tasks - 1);
     m_running = m_participants;
     ++m_round;
