@@ -5,11 +5,15 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <set>
 #include <sstream>
 #include <string>
 
+#include "framework/analysis/sweep_summary.hpp"
+#include "framework/app/runner.hpp"
 #include "framework/field/ice_file.hpp"
 #include "framework/api/plugin_api.hpp"
 #include "framework/api/registry.hpp"
@@ -241,33 +245,49 @@ TEST(GemRun, ARunFolderInUseIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(out / ".gem-run.lock"));
 }
 
-// SIGTERM (as Ctrl-C) stops a run between two steps: exit 128 + 15, a message, the CSVs whole under
-// their final names, no temporary left behind, no summary.json.
-TEST(GemRun, SigtermKeepsTheFilesWholeAndSaysSo) {
+// SIGTERM and Ctrl-C stop a run between two steps: exit 128 + the signal, a message, the CSVs whole
+// under their final names, no temporary left behind, and a summary.json of the steps run that says
+// the run did not complete (and why); gem.log records the exit status.
+class GemRunSignal : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(GemRunSignal, KeepsTheFilesWholeAndSaysSo) {
+  const std::string signal = GetParam();
+  const int number = signal == "INT" ? 2 : 15;
   test::TempDir dir;
   const auto scenario = dir.write("busy.toml", test::kBusyScene);
   const auto out = dir.path() / "out";
   const std::string gem = std::string(std::getenv("GEM_BINARY_DIR") ? std::getenv("GEM_BINARY_DIR") : GEM_BINARY_DIR) + "/gem";
   const std::string command = "bash -c '" + gem + " run " + scenario.string() +
                               " --quiet --steps 2000000 --set output.frame_every=0 --out " + out.string() + " > " +
-                              (dir.path() / "log").string() + " 2>&1 & p=$!; sleep 1; kill -TERM $p; wait $p; exit $?'";
+                              (dir.path() / "log").string() + " 2>&1 & p=$!; sleep 1; kill -" + signal + " $p; wait $p; exit $?'";
   const int status = std::system(command.c_str());
   ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 128 + 15) << test::readFile(dir.path() / "log");
+  EXPECT_EQ(WEXITSTATUS(status), 128 + number) << test::readFile(dir.path() / "log");
   const std::string log = test::readFile(dir.path() / "log");
-  EXPECT_NE(log.find("interrupted (SIGTERM)"), std::string::npos) << log;
+  EXPECT_NE(log.find(signal == "INT" ? "interrupted (Ctrl-C)" : "interrupted (SIGTERM)"), std::string::npos) << log;
   const std::string series = test::readFile(out / "timeseries.csv");
   EXPECT_EQ(series.rfind("t,", 0), 0u);
   EXPECT_EQ(series.back(), '\n');  // whole rows
   EXPECT_TRUE(std::filesystem::exists(out / "impacts.csv"));
-  EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
+  EXPECT_TRUE(std::filesystem::exists(out / "state.csv"));
+  const auto summary = readSummaryJson(out / "summary.json");
+  EXPECT_EQ(summary.at("completed"), "false");
+  EXPECT_EQ(summary.at("stop_reason"), "SIG" + signal);
+  const long steps = std::stol(summary.at("steps"));
+  EXPECT_GT(steps, 0);
+  EXPECT_LT(steps, 2000000);
+  // The time series holds a row per step run (timeseries_every = 1): the summary counts them.
+  EXPECT_EQ(std::count(series.begin(), series.end(), '\n'), steps + 1);
+  EXPECT_NE(test::readFile(out / "gem.log").find("exit status " + std::to_string(128 + number)), std::string::npos);
   for (const auto& entry : std::filesystem::directory_iterator(out))
     EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
 }
 
+INSTANTIATE_TEST_SUITE_P(Signals, GemRunSignal, ::testing::Values("TERM", "INT"));
+
 // A reused run folder describes only its last run: a re-run with frames off leaves none of the
-// earlier run's frames; the folder records the scenario as read (gem-run.toml, overrides applied,
-// with its seed), and running that record repeats the run.
+// earlier run's frames; the folder records the scenario as read (scenario.toml, overrides applied,
+// with its seed) and the run's report (gem.log), and running that record repeats the run.
 TEST(GemRun, AReusedRunFolderHoldsOnlyItsLastRunAndRecordsItsScenario) {
   test::TempDir dir;
   const auto scenario = dir.write("busy.toml", test::kBusyScene);
@@ -280,11 +300,15 @@ TEST(GemRun, AReusedRunFolderHoldsOnlyItsLastRunAndRecordsItsScenario) {
   EXPECT_FALSE(std::filesystem::exists(out / "frames.pvd"));
   EXPECT_FALSE(std::filesystem::exists(out / "frames.ice"));
   EXPECT_FALSE(std::filesystem::exists(out / "frames"));
-  const std::string record = test::readFile(out / "gem-run.toml");
+  const std::string record = test::readFile(out / "scenario.toml");
   EXPECT_NE(record.find("# --set output.frame_every=0"), std::string::npos) << record;
   EXPECT_NE(record.find("seed = 3"), std::string::npos) << record;
+  EXPECT_NE(record.find("broadphase = "), std::string::npos) << record;  // a default, resolved
+  const std::string gemLog = test::readFile(out / "gem.log");
+  EXPECT_NE(gemLog.find("--set output.frame_every=0"), std::string::npos) << gemLog;  // the command line
+  EXPECT_NE(gemLog.find("exit status 0"), std::string::npos) << gemLog;
   ASSERT_EQ(
-      test::runGem("run " + (out / "gem-run.toml").string() + " --quiet --out " + (dir.path() / "again").string(), dir.path() / "log"), 0)
+      test::runGem("run " + (out / "scenario.toml").string() + " --quiet --out " + (dir.path() / "again").string(), dir.path() / "log"), 0)
       << test::readFile(dir.path() / "log");
   EXPECT_EQ(test::readFile(dir.path() / "again" / "state.csv"), test::readFile(out / "state.csv"));
 }
@@ -295,4 +319,111 @@ TEST(GemCli, VersionNamesTheVersionRealTypeAndPluginAbi) {
   const std::string text = test::readFile(dir.path() / "log");
   EXPECT_NE(text.find(std::string("gem ") + GEM_VERSION), std::string::npos) << text;
   EXPECT_NE(text.find("plugin ABI " + std::to_string(GEM_PLUGIN_ABI_VERSION)), std::string::npos) << text;
+}
+
+// simulation.stop_when: a vessel in open water crosses a 40 m field (the domain, no floes).
+namespace {
+
+constexpr const char* kCrossing = R"(
+[simulation]
+dt = 0.1
+steps = 3000
+[domain]
+x = [0.0, 40.0]
+y = [-30.0, 30.0]
+[vessel]
+position = [-60.0, 0.0]
+open_water_speed = 5.0
+[output]
+frame_every = 0
+)";
+
+// The vessel's centroid x after each step, from timeseries.csv.
+std::vector<double> shipX(const std::filesystem::path& dir) {
+  std::istringstream in(test::readFile(dir / "timeseries.csv"));
+  std::vector<double> x;
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) x.push_back(std::stod(test::csvCells(line)[1]));
+  return x;
+}
+
+}  // namespace
+
+TEST(StopRule, VesselLeftFieldStopsOnceTheHullIsClearOfTheField) {
+  test::TempDir dir;
+  Scenario s = test::scenarioFromToml(dir, kCrossing, {"simulation.stop_when=\"vessel_left_field\""});
+  s.output.dir = dir.path() / "out";
+  const RunSummary r = runScenario(s, RunOptions{true, false});
+  EXPECT_EQ(r.stopReason, "vessel_left_field");
+  EXPECT_TRUE(r.completed);
+  const std::vector<double> x = shipX(s.output.dir);
+  ASSERT_EQ(static_cast<long>(x.size()), r.steps);
+  ASSERT_LT(r.steps, 3000);
+  // The hull's reach from its centroid (its farthest vertex, from state.csv): the rule fires at the
+  // first step with the centroid past x = 40 + reach.
+  double reach = 0;
+  std::istringstream state(test::readFile(s.output.dir / "state.csv"));
+  for (std::string line; std::getline(state, line);) {
+    const std::vector<std::string> cells = test::csvCells(line);
+    if (cells[1] != "vessel") continue;
+    std::istringstream vertices(cells[11]);
+    for (double vx, vy; vertices >> vx >> vy;) reach = std::max(reach, std::hypot(vx - std::stod(cells[2]), vy - std::stod(cells[3])));
+  }
+  ASSERT_GT(reach, 50.0);  // the 100 m hull
+  EXPECT_GT(x.back(), 40.0 + reach);
+  EXPECT_LE(x[x.size() - 2], 40.0 + reach + 1e-6);
+  const auto summary = readSummaryJson(s.output.dir / "summary.json");
+  EXPECT_EQ(summary.at("stop_reason"), "vessel_left_field");
+  EXPECT_EQ(summary.at("steps"), std::to_string(r.steps));
+}
+
+TEST(StopRule, DistanceStopsAtTheFirstStepPastIt) {
+  test::TempDir dir;
+  Scenario s = test::scenarioFromToml(dir, kCrossing, {"simulation.stop_when=\"distance\"", "simulation.stop_distance=20.0"});
+  s.output.dir = dir.path() / "out";
+  const RunSummary r = runScenario(s, RunOptions{true, false});
+  EXPECT_EQ(r.stopReason, "distance");
+  const std::vector<double> x = shipX(s.output.dir);
+  ASSERT_GE(x.size(), 2u);
+  EXPECT_GE(x.back() - -60.0, 20.0);
+  EXPECT_LT(x[x.size() - 2] - -60.0, 20.0);
+}
+
+TEST(StopRule, DurationRunsEveryStepAndBadSettingsAreRefused) {
+  test::TempDir dir;
+  Scenario s = test::scenarioFromToml(dir, kCrossing, {"simulation.steps=50"});
+  s.output.dir = dir.path() / "out";
+  const RunSummary r = runScenario(s, RunOptions{true, false});
+  EXPECT_EQ(r.steps, 50);
+  EXPECT_EQ(r.stopReason, "duration");
+  auto refused = [&](const std::vector<std::string>& overrides, const std::string& expected) {
+    try {
+      test::scenarioFromToml(dir, kCrossing, overrides);
+      ADD_FAILURE() << "accepted: " << overrides.front();
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused({"simulation.stop_when=\"distance\""}, "simulation.stop_when");  // no stop_distance
+  refused({"simulation.stop_distance=5.0"}, "simulation.stop_distance");   // without stop_when = "distance"
+  refused({"simulation.stop_when=\"harbour\""}, "simulation.stop_when");
+  try {
+    test::scenarioFromToml(dir, "[simulation]\nsteps = 10\nstop_when = \"vessel_left_field\"\n");
+    ADD_FAILURE() << "a stop rule that follows the vessel was accepted without a vessel";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no [vessel]"), std::string::npos) << e.what();
+  }
+}
+
+// A scenario kept in its run folder as scenario.toml is the user's file: the run's record never
+// overwrites it.
+TEST(GemRun, AScenarioInItsOwnRunFolderIsNotOverwritten) {
+  test::TempDir dir;
+  const std::string text = std::string("# my notes\n") + kCrossing;
+  const auto scenario = dir.write("scenario.toml", text);
+  ASSERT_EQ(test::runGem("run " + scenario.string() + " --quiet --steps 5 --out " + dir.path().string(), dir.path() / "log"), 0)
+      << test::readFile(dir.path() / "log");
+  EXPECT_EQ(test::readFile(scenario), text);
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "summary.json"));
 }

@@ -141,14 +141,17 @@ TEST(Sweep, RunsEveryCaseWritesScenariosAndGathers) {
 
   const fs::path caseDir = out / "cases" / "bollard_thrust=46000,concentration=0.3";
   ASSERT_TRUE(fs::exists(caseDir / "summary.json"));
-  // The case's scenario is the whole base with its overrides, and runs where it lies.
-  const toml::table written = toml::parse_file((caseDir / "scenario.toml").string());
+  // The case as the sweep wrote it (case.toml) is the whole base with its overrides, and runs where
+  // it lies; the run's own record (scenario.toml) repeats it.
+  const toml::table written = toml::parse_file((caseDir / "case.toml").string());
   EXPECT_EQ(written["vessel"]["bollard_thrust"].value<double>(), 46e3);
   EXPECT_EQ(written["field"]["concentration"].value<double>(), 0.3);
   EXPECT_EQ(written["simulation"]["steps"].value<int64_t>(), 30);
   EXPECT_EQ(written["vessel"]["mass"].value<double>(), 5e5);
+  EXPECT_EQ(loadScenario(caseDir / "case.toml").output.dir.lexically_normal(), fs::absolute(caseDir).lexically_normal() / "");
   const Scenario reloaded = loadScenario(caseDir / "scenario.toml");
-  EXPECT_EQ(reloaded.output.dir.lexically_normal(), fs::absolute(caseDir).lexically_normal() / "");
+  EXPECT_TRUE(fs::equivalent(reloaded.output.dir, caseDir));
+  EXPECT_EQ(reloaded.steps, 30);
 
   const std::vector<std::string> csv = lines(out / "summary.csv");
   ASSERT_EQ(csv.size(), 5u);
@@ -195,11 +198,18 @@ TEST(Sweep, ResumeRunsOnlyIncompleteOrChangedCases) {
   for (const auto& s : summaries) times.push_back(fs::last_write_time(s));
   fs::remove(summaries[1]);
   fs::remove(out / "summary.csv");
+  // A case a signal stopped (its summary says "completed": false) is not complete either.
+  std::string stopped = test::readFile(summaries[2]);
+  ASSERT_NE(stopped.find("\"completed\": true"), std::string::npos) << stopped;
+  stopped.replace(stopped.find("\"completed\": true"), 17, "\"completed\": false");
+  dir.write(fs::relative(summaries[2], dir.path()).string(), stopped);
+  times[2] = fs::last_write_time(summaries[2]);
 
   ASSERT_EQ(sweep(file, out), 0);
+  EXPECT_EQ(readSummaryJson(summaries[2]).at("completed"), "true");
   for (size_t i = 0; i < summaries.size(); ++i) {
     ASSERT_TRUE(fs::exists(summaries[i]));
-    if (i != 1) {
+    if (i != 1 && i != 2) {
       EXPECT_EQ(fs::last_write_time(summaries[i]), times[i]) << summaries[i] << " ran again";
     }
   }
@@ -319,6 +329,10 @@ TEST(SweepSummary, ReadsGemJson) {
   EXPECT_EQ(s.at("ship_speed.min"), "1.5");
   EXPECT_EQ(s.at("ship_speed.mean"), "");
   EXPECT_EQ(s.at("ok"), "true");
+  // Escapes read as JSON says (a device name may hold any character).
+  const auto escaped = readSummaryJson(dir.write("escaped.json", R"({"device": "A\u00e9\r\"b\"", "n": 1e3})"));
+  EXPECT_EQ(escaped.at("device"), "A\u00e9\r\"b\"");
+  EXPECT_EQ(std::stod(escaped.at("n")), 1000.0);
   EXPECT_THROW(readSummaryJson(dir.write("bad.json", "{\"a\": }")), InputError);  // bad input: exit 2
   EXPECT_THROW(readSummaryJson(dir.write("empty.json", "")), InputError);
   // Nested 50,000 deep (a damaged file in a sweep being resumed): refused, not a stack overflow.

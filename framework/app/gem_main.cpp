@@ -18,6 +18,7 @@
 #include "framework/app/interrupt.hpp"
 #include "framework/app/plugin_loader.hpp"
 #include "framework/api/registry.hpp"
+#include "framework/app/run_log.hpp"
 #include "framework/app/runner.hpp"
 #include "framework/scenario/scenario.hpp"
 #include "framework/step/cpu_stepper.hpp"
@@ -38,6 +39,7 @@ struct RunArguments {
   bool durationGiven = false, stepsGiven = false;  // set from the command line's counts
   std::vector<std::string> set;
   bool quiet = false;
+  std::string commandLine;  // for gem.log
 };
 
 Scenario load(const RunArguments& a) {
@@ -66,43 +68,66 @@ Scenario load(const RunArguments& a) {
   return s;
 }
 
+// The closing report of a run (also kept in its gem.log).
+void reportRun(RunLog& log, const RunSummary& r) {
+  log.say(fmt::format("  floes          {} at start, {} at end ({} broken, {:.4g} kg rubble)", r.floesInitial, r.floesFinal, r.floesBroken,
+                      r.rubbleMass));
+  // The record streams' totals, under the names their events give them (ship_impact: impacts).
+  for (const RecordTotals& t : r.records) {
+    if (t.countKey.empty()) continue;
+    std::string line = fmt::format("  {:<14} {}", t.countKey, t.count);
+    if (!t.statisticKey.empty() && t.statistic.count)
+      line += fmt::format(", {} mean {:.4g}, max {:.4g}", t.statisticKey, t.statistic.mean, t.statistic.max);
+    log.say(line);
+  }
+  // In ice first: the studies' figures (the steps with the whole hull inside the domain's x
+  // range); the whole run's, diluted by the open water before and after, second.
+  if (r.shipSpeedInIce.count)
+    log.say(fmt::format("  in ice         speed mean {:.3f} m/s (min {:.3f}, max {:.3f}); resistance {:.1f} kN; {} steps ({:.1f} s)",
+                        r.shipSpeedInIce.mean, r.shipSpeedInIce.min, r.shipSpeedInIce.max, r.netThrustInIce.mean / 1e3,
+                        r.shipSpeedInIce.count,
+                        static_cast<double>(r.shipSpeedInIce.count) * r.simTime / std::max<double>(static_cast<double>(r.steps), 1)));
+  else if (r.shipSpeed.count)
+    log.say("  in ice         no step with the whole hull inside the domain's x range (no in-ice statistics)");
+  if (r.shipSpeed.count)
+    log.say(fmt::format("  whole run      speed mean {:.3f} m/s (min {:.3f}, max {:.3f}); mean net thrust {:.1f} kN", r.shipSpeed.mean,
+                        r.shipSpeed.min, r.shipSpeed.max, r.netThrust.mean / 1e3));
+  if (r.stopReason != "duration") log.say(fmt::format("  stopped        after {} steps: {}", r.steps, r.stopReason));
+  log.say(fmt::format("  wall time      {:.3f} s for {:.1f} s simulated: {:.0f}x real time ({:.0f} steps/s)", r.wallTime, r.simTime,
+                      r.simTime / std::max(r.wallTime, 1e-9), r.steps / std::max(r.wallTime, 1e-9)));
+  log.say(
+      fmt::format("  outputs        {}/ (summary.json, timeseries.csv, impacts.csv, state.csv, frames.pvd, frames.ice, "
+                  "scenario.toml, gem.log)",
+                  r.outputDir));
+}
+
 int commandRun(const RunArguments& a) {
   const Scenario s = load(a);
   RunOptions options;
   options.quiet = a.quiet;
   options.progress = isatty(fileno(stderr));
-  if (!a.quiet)
-    std::printf("gem run %s: %ld steps of %.3g s, backend %s, broadphase %s\n", a.scenario.c_str(), s.steps, static_cast<double>(s.dt),
-                resolveBackend(s.backend).c_str(), s.broadphase.c_str());
-  const RunSummary r = runScenario(s, options);
-  if (!a.quiet) {
-    std::printf("  floes          %d at start, %d at end (%ld broken, %.4g kg rubble)\n", r.floesInitial, r.floesFinal, r.floesBroken,
-                r.rubbleMass);
-    // The record streams' totals, under the names their events give them (ship_impact: impacts).
-    for (const RecordTotals& t : r.records) {
-      if (t.countKey.empty()) continue;
-      std::printf("  %-14s %ld", t.countKey.c_str(), t.count);
-      if (!t.statisticKey.empty() && t.statistic.count)
-        std::printf(", %s mean %.4g, max %.4g", t.statisticKey.c_str(), t.statistic.mean, t.statistic.max);
-      std::printf("\n");
-    }
-    // In ice first: the studies' figures (the steps with the whole hull inside the domain's x
-    // range); the whole run's, diluted by the open water before and after, second.
-    if (r.shipSpeedInIce.count)
-      std::printf("  in ice         speed mean %.3f m/s (min %.3f, max %.3f); resistance %.1f kN; %ld steps (%.1f s)\n",
-                  r.shipSpeedInIce.mean, r.shipSpeedInIce.min, r.shipSpeedInIce.max, r.netThrustInIce.mean / 1e3, r.shipSpeedInIce.count,
-                  static_cast<double>(r.shipSpeedInIce.count) * r.simTime / std::max<double>(static_cast<double>(r.steps), 1));
-    else if (r.shipSpeed.count)
-      std::printf("  in ice         no step with the whole hull inside the domain's x range (no in-ice statistics)\n");
-    if (r.shipSpeed.count)
-      std::printf("  whole run      speed mean %.3f m/s (min %.3f, max %.3f); mean net thrust %.1f kN\n", r.shipSpeed.mean, r.shipSpeed.min,
-                  r.shipSpeed.max, r.netThrust.mean / 1e3);
-    std::printf("  wall time      %.3f s for %.1f s simulated: %.0fx real time (%.0f steps/s)\n", r.wallTime, r.simTime,
-                r.simTime / std::max(r.wallTime, 1e-9), r.steps / std::max(r.wallTime, 1e-9));
-    std::printf("  outputs        %s/ (summary.json, timeseries.csv, impacts.csv, state.csv, frames.pvd, frames.ice)\n",
-                r.outputDir.c_str());
+  RunLog log(a.commandLine, a.quiet);
+  log.say(fmt::format("gem run {}: {} steps of {:.3g} s, backend {}, broadphase {}", a.scenario, s.steps, static_cast<double>(s.dt),
+                      resolveBackend(s.backend), s.broadphase));
+  try {
+    const RunSummary r = runScenario(s, options);
+    log.note(fmt::format("  device         {} ({} driver)", r.device, r.driver));
+    reportRun(log, r);
+    log.write(s.output.dir, 0);
+    return 0;
+  } catch (const InputError& e) {
+    log.note(fmt::format("gem: error: {}", e.what()));
+    log.write(s.output.dir, 2);
+    throw;
+  } catch (const Interrupted& e) {
+    log.note(fmt::format("gem: {}", e.what()));
+    log.write(s.output.dir, 128 + e.signal());
+    throw;
+  } catch (const std::exception& e) {
+    log.note(fmt::format("gem: failed: {}", e.what()));
+    log.write(s.output.dir, 1);
+    throw;
   }
-  return 0;
 }
 
 int commandCheck(const RunArguments& a) {
@@ -160,6 +185,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("gem ") + GEM_VERSION + " (real type " + GEM_REAL_NAME + ", plugin ABI " +
                                         std::to_string(GEM_PLUGIN_ABI_VERSION) + ")");
   RunArguments args;
+  args.commandLine = commandLineText(argc, argv);
   auto addRunOptions = [&](CLI::App* c) {
     c->add_option("scenario", args.scenario, "scenario file (TOML)")->required();
     c->add_option("--backend", args.backend, "auto, cpu or cuda");

@@ -21,8 +21,10 @@ int interruptSignal() { return g_signal; }
 void stopIfInterrupted(long step) {
   const int signal = g_signal;
   if (signal == 0) return;
-  throw Interrupted(signal, fmt::format("interrupted ({}) after step {}: the files written so far are kept, whole; no summary.json",
-                                        signal == SIGINT ? "Ctrl-C" : "SIGTERM", step));
+  throw Interrupted(
+      signal,
+      fmt::format("interrupted ({}) after step {}: the files written so far are kept, whole; summary.json says \"completed\": false",
+                  signal == SIGINT ? "Ctrl-C" : "SIGTERM", step));
 }
 
 }  // namespace gem

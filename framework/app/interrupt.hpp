@@ -1,6 +1,7 @@
 // Ctrl-C and SIGTERM: a run stops at the end of the step it is in, keeps every file it wrote whole
 // under its final name, says so, and gem exits 128 + the signal's number (130, 143). The handler
-// only sets a flag; the run loops read it between steps.
+// only sets a flag; the run loops read it between steps, and the run writes its summary.json with
+// "completed": false.
 #pragma once
 #include <stdexcept>
 #include <string>

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -80,17 +81,18 @@ static std::string recordTotalsJson(const RunSummary& s) {
 std::string summaryJson(const RunSummary& s) {
   return fmt::format(
       "{{\n"
-      "  \"gem_version\": \"{}\",\n  \"steps\": {},\n  \"sim_time_s\": {},\n  \"wall_time_s\": {},\n"
+      "  \"gem_version\": \"{}\",\n  \"completed\": {},\n  \"stop_reason\": \"{}\",\n  \"steps\": {},\n  \"sim_time_s\": {},\n  "
+      "\"wall_time_s\": {},\n"
       "  \"real_time_factor\": {},\n  \"backend\": \"{}\",\n  \"driver\": \"{}\",\n  \"broadphase\": \"{}\",\n  \"device\": \"{}\",\n"
       "  \"floes_initial\": {},\n  \"floes_final\": {},\n  \"floes_broken\": {},\n"
       "  \"ice_mass_initial_kg\": {},\n  \"ice_mass_final_kg\": {},\n  \"rubble_mass_kg\": {},\n"
       "  \"cases_on_device\": {},\n{}  \"ship_speed\": {},\n  \"net_thrust_n\": {},\n"
       "  \"resistance_mean_n\": {},\n  \"ship_speed_in_ice\": {},\n  \"resistance_in_ice_n\": {}\n}}\n",
-      GEM_VERSION, s.steps, jsonNumber(s.simTime), jsonNumber(s.wallTime), jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY),
-      s.backend, s.driver, s.broadphase, s.device, s.floesInitial, s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial),
-      jsonNumber(s.iceMassFinal), jsonNumber(s.rubbleMass), s.casesOnDevice, recordTotalsJson(s), jsonStats(s.shipSpeed),
-      jsonStats(s.netThrust), s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null", jsonStats(s.shipSpeedInIce),
-      s.netThrustInIce.count ? jsonNumber(s.netThrustInIce.mean) : "null");
+      GEM_VERSION, s.completed ? "true" : "false", s.stopReason, s.steps, jsonNumber(s.simTime), jsonNumber(s.wallTime),
+      jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY), s.backend, s.driver, s.broadphase, s.device, s.floesInitial,
+      s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial), jsonNumber(s.iceMassFinal), jsonNumber(s.rubbleMass), s.casesOnDevice,
+      recordTotalsJson(s), jsonStats(s.shipSpeed), jsonStats(s.netThrust), s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null",
+      jsonStats(s.shipSpeedInIce), s.netThrustInIce.count ? jsonNumber(s.netThrustInIce.mean) : "null");
 }
 
 namespace {
@@ -135,6 +137,41 @@ class ScenarioRun {
     m_thrust = Propulsion::Params{vessel.bollardThrust,
                                   vessel.bollardThrust / (vessel.openWaterSpeed * vessel.openWaterSpeed * vessel.openWaterSpeed)};
     if (m_frames) writeFrames();
+    // The stop rule's starting point: the field's extent (the domain, else the floes' bounding
+    // box) and the vessel's reach about its centroid (its bounding radius).
+    const World& w = sim.hostWorld();
+    if (scenario.hasDomain) {
+      m_fieldLow = {scenario.domain.x0, scenario.domain.y0};
+      m_fieldHigh = {scenario.domain.x1, scenario.domain.y1};
+    } else {
+      for (int i = 0; i < w.size(); ++i) {
+        if (w.kind[i] == BodyKind::Vessel) continue;
+        m_fieldLow = {std::min(m_fieldLow.x, w.x[i] - w.radius[i]), std::min(m_fieldLow.y, w.y[i] - w.radius[i])};
+        m_fieldHigh = {std::max(m_fieldHigh.x, w.x[i] + w.radius[i]), std::max(m_fieldHigh.y, w.y[i] + w.radius[i])};
+      }
+    }
+    for (int i = 0; i < w.size(); ++i)
+      if (w.kind[i] == BodyKind::Vessel) m_vesselReach = w.radius[i];
+    m_lastVesselPosition = sim.vessel().position;
+  }
+
+  // The scenario's stop rule (simulation.stop_when) after the step just recorded: the reason the
+  // run ends here, or nullptr to go on.
+  const char* stopRuleReached() {
+    if (m_scenario.stopWhen == "duration") return nullptr;
+    const VesselSample v = m_stepper->vessel();
+    if (!v.present) return nullptr;
+    if (m_scenario.stopWhen == "distance") {
+      m_travelled += norm(v.position - m_lastVesselPosition);  // the path, step by step
+      m_lastVesselPosition = v.position;
+      return m_travelled >= m_scenario.stopDistance ? "distance" : nullptr;
+    }
+    // vessel_left_field: the hull's bounding circle overlaps the field's box, then no longer does.
+    // A vessel that starts in open water before the field has not yet reached it, so it runs on.
+    const bool overField = v.position.x + m_vesselReach >= m_fieldLow.x && v.position.x - m_vesselReach <= m_fieldHigh.x &&
+                           v.position.y + m_vesselReach >= m_fieldLow.y && v.position.y - m_vesselReach <= m_fieldHigh.y;
+    if (overField) m_reachedField = true;
+    return m_reachedField && !overField ? "vessel_left_field" : nullptr;
   }
 
   // The outputs of step k (0-based), which sim().step() has just run.
@@ -201,11 +238,14 @@ class ScenarioRun {
                         k + 1, sim.time(), w.id[i], bodyKindName(w.kind[i]), w.x[i], w.y[i], w.vx[i], w.vy[i]));
   }
 
-  // The run is complete: the last files and summary.json (last of all).
-  RunSummary finish(double wallTime) {
+  // The run ends after stepsRun steps, for the reason given (the duration, a stop rule, or a
+  // signal: then completed is false): the last files, state.csv, and summary.json last of all.
+  RunSummary finish(double wallTime, long stepsRun, const std::string& reason = "duration", bool completed = true) {
     Stepper& sim = *m_stepper;
     m_summary.wallTime = wallTime;
-    m_summary.steps = m_scenario.steps;
+    m_summary.steps = stepsRun;
+    m_summary.stopReason = reason;
+    m_summary.completed = completed;
     m_summary.simTime = sim.time();
     const World& world = sim.hostWorld();
     m_summary.floesFinal = world.count(BodyKind::Floe);
@@ -261,7 +301,18 @@ class ScenarioRun {
   std::vector<RecordFile> m_recordFiles;
   Propulsion::Params m_thrust{};
   Accumulator m_speed, m_netThrust, m_speedInIce, m_netThrustInIce;
+  // The stop rule's state (stopRuleReached).
+  Vec2 m_fieldLow{INFINITY, INFINITY}, m_fieldHigh{-INFINITY, -INFINITY};
+  Real m_vesselReach = 0;
+  bool m_reachedField = false;
+  Vec2 m_lastVesselPosition{0, 0};
+  double m_travelled = 0;
 };
+
+// "SIGINT", "SIGTERM": the stop reason of a run a signal ended.
+std::string signalName(int signal) {
+  return signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : fmt::format("signal {}", signal);
+}
 
 }  // namespace
 
@@ -271,14 +322,19 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   Stepper& sim = *stepper;
   const auto start = std::chrono::steady_clock::now();
   auto lastProgress = start;
+  auto wallSeconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  long stepsRun = 0;
+  const char* reason = "duration";
   try {
     for (long k = 0; k < scenario.steps; ++k) {
       stopIfInterrupted(k);
       sim.step();
       run.record(k);
+      stepsRun = k + 1;
+      const char* stop = run.stopRuleReached();
       if (options.progress && !options.quiet) {
         const auto now = std::chrono::steady_clock::now();
-        if (now - lastProgress > std::chrono::milliseconds(250) || k + 1 == scenario.steps) {
+        if (now - lastProgress > std::chrono::milliseconds(250) || k + 1 == scenario.steps || stop) {
           lastProgress = now;
           const double wall = std::chrono::duration<double>(now - start).count();
           const double rate = (k + 1) / std::max(wall, 1e-9);
@@ -287,13 +343,22 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
           std::fflush(stderr);
         }
       }
+      if (stop) {
+        reason = stop;
+        break;
+      }
     }
+  } catch (const Interrupted& e) {
+    // Ctrl-C or SIGTERM between two steps: every file closed whole, and a summary of the steps run
+    // that says it is not the whole run.
+    run.finish(wallSeconds(), stepsRun, signalName(e.signal()), false);
+    throw;
   } catch (...) {
     run.abandon();
     throw;
   }
   if (options.progress && !options.quiet) std::fprintf(stderr, "\n");
-  return run.finish(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return run.finish(wallSeconds(), stepsRun, reason);
 }
 
 std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>& scenarios, std::vector<std::unique_ptr<Stepper>> steppers,
@@ -316,41 +381,57 @@ std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>
   // A stepper left without its run (its outputs could not be opened) is still stepped: it shares
   // the others' steps.
   const auto start = std::chrono::steady_clock::now();
+  auto wallSeconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  // A case whose stop rule fired is finished there (its files and summary written) and is still
+  // stepped with the others, its outputs no longer recorded.
+  std::vector<char> done(count, 0);
+  auto finishCase = [&](size_t i, long stepsRun, const std::string& reason, bool completed) {
+    try {
+      runs[i]->summary().casesOnDevice = static_cast<int>(count);
+      runs[i]->finish(wallSeconds(), stepsRun, reason, completed);
+    } catch (const std::exception& e) {
+      failures[i] = e.what();
+    }
+    done[i] = 1;
+  };
+  auto running = [&](size_t i) { return runs[i] && failures[i].empty() && !done[i]; };
   long k = 0;
   try {
     for (; k < steps; ++k) {
+      stopIfInterrupted(k);
       // Every case's step k before any case's step k + 1; then each one's outputs.
       for (size_t i = 0; i < count; ++i) steppers[i]->step();
+      bool anyRunning = false;
       for (size_t i = 0; i < count; ++i) {
-        if (!runs[i] || !failures[i].empty()) continue;
+        if (!running(i)) continue;
         try {
           runs[i]->record(k);
+          if (const char* stop = runs[i]->stopRuleReached()) finishCase(i, k + 1, stop, true);
         } catch (const std::exception& e) {
           failures[i] = e.what();
           runs[i]->abandon();
         }
+        anyRunning = anyRunning || running(i);
       }
       if (progress) progress(k + 1, steps);
+      if (!anyRunning) break;
     }
+  } catch (const Interrupted& e) {
+    // Every case still running keeps its whole files and a summary saying it did not complete.
+    for (size_t i = 0; i < count; ++i)
+      if (running(i)) finishCase(i, k, signalName(e.signal()), false);
+    throw;
   } catch (const std::exception& e) {
     // The shared device state failed: every case that was still running fails with it.
     for (size_t i = 0; i < count; ++i) {
-      if (!failures[i].empty()) continue;
+      if (!running(i)) continue;
       failures[i] = fmt::format("step {} of cases run together on one device: {}", k, e.what());
-      if (runs[i]) runs[i]->abandon();
+      runs[i]->abandon();
     }
     return failures;
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (size_t i = 0; i < count; ++i) {
-    if (!runs[i] || !failures[i].empty()) continue;
-    try {
-      runs[i]->summary().casesOnDevice = static_cast<int>(count);
-      runs[i]->finish(wall);
-    } catch (const std::exception& e) {
-      failures[i] = e.what();
-    }
-  }
+  for (size_t i = 0; i < count; ++i)
+    if (running(i)) finishCase(i, steps, "duration", true);
   return failures;
 }
 

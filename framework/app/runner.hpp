@@ -31,7 +31,12 @@ struct RecordTotals {
 };
 
 struct RunSummary {
-  long steps = 0;
+  long steps = 0;  // the steps run: fewer than the scenario's when a stop rule or a signal ended it
+  // false when a signal (Ctrl-C, SIGTERM) stopped the run: its files are whole but it is not the
+  // scenario's run (a sweep runs such a case again).
+  bool completed = true;
+  // Why the run ended: "duration" (every step), "vessel_left_field", "distance", "SIGINT", "SIGTERM".
+  std::string stopReason = "duration";
   double simTime = 0, wallTime = 0;
   std::string backend, driver, broadphase, device;
   int floesInitial = 0, floesFinal = 0;

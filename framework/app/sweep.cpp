@@ -21,6 +21,7 @@
 
 #include "framework/output/atomic_file.hpp"
 #include "framework/api/errors.hpp"
+#include "framework/app/interrupt.hpp"
 #include "framework/app/runner.hpp"
 #include "framework/scenario/scenario.hpp"
 #include "framework/step/stepper.hpp"
@@ -86,6 +87,19 @@ std::string scenarioText(const SweepDefinition& sweep, const SweepCase& c, const
   for (const SweepOverride& o : c.overrides) out << "# set " << o.key << " = " << o.toml << "\n";
   out << "\n" << toml::toml_formatter{s.root, toml::toml_formatter::default_flags & ~toml::format_flags::indentation} << "\n";
   return out.str();
+}
+
+// A case ran to its end: its summary.json exists, reads, and does not say "completed": false (a
+// run a signal stopped). Anything else runs again.
+bool caseCompleted(const fs::path& dir) {
+  if (!fs::exists(dir / "summary.json")) return false;
+  try {
+    const auto summary = readSummaryJson(dir / "summary.json");
+    const auto completed = summary.find("completed");
+    return completed == summary.end() || completed->second != "false";
+  } catch (const InputError&) {
+    return false;
+  }
 }
 
 std::string readText(const fs::path& file) {
@@ -201,8 +215,8 @@ int runSweep(const SweepOptions& options) {
   std::vector<size_t> todo;
   size_t skipped = 0, stale = 0;
   for (size_t i : selected) {
-    if (fs::exists(dirs[i] / "summary.json")) {
-      if (readText(dirs[i] / "scenario.toml") == texts[i]) {
+    if (caseCompleted(dirs[i])) {
+      if (readText(dirs[i] / "case.toml") == texts[i]) {
         ++skipped;
         continue;
       }
@@ -241,7 +255,11 @@ int runSweep(const SweepOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   // Under mpirun the ranks share one counter (units go to whichever rank is free); alone, the
   // threads of this process share theirs.
-  auto claim = [&]() { return mpi.active() ? mpi.next(units.size()) : state.next++; };
+  // After Ctrl-C or SIGTERM no new case starts; the running ones stop at their next step.
+  auto claim = [&]() -> size_t {
+    if (interruptSignal()) return units.size();
+    return mpi.active() ? mpi.next(units.size()) : state.next++;
+  };
   // A case's folder, ready for its run: the old summary goes first (a scenario.toml beside a
   // summary of another scenario would pass for complete if this run failed before writing its own).
   auto prepareCase = [&](size_t i) {
@@ -250,7 +268,8 @@ int runSweep(const SweepOptions& options) {
     if (s.threads == 0 && (jobs > 1 || mpi.active())) s.threads = 1;
     fs::create_directories(dirs[i]);
     fs::remove(dirs[i] / "summary.json");
-    writeFileAtomically(dirs[i] / "scenario.toml", texts[i]);
+    // The case as this sweep wrote it, for the next resume (the run records its own scenario.toml).
+    writeFileAtomically(dirs[i] / "case.toml", texts[i]);
     return s;
   };
   auto finished = [&](size_t i, const std::string& failure, double seconds, size_t with) {
@@ -345,7 +364,7 @@ int runSweep(const SweepOptions& options) {
   for (size_t t = 0; t < jobs && t < units.size(); ++t) threads.emplace_back(worker, t);
   if (terminal && !todo.empty() && !mpi.active()) {
     std::unique_lock lock(state.mutex);
-    while (state.finished < todo.size()) {
+    while (state.finished < todo.size() && !(interruptSignal() && state.running == 0)) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       // Cases running together count by how far their steps are.
       double done = static_cast<double>(state.finished);
@@ -369,6 +388,10 @@ int runSweep(const SweepOptions& options) {
   const fs::path csv = outDir / "summary.csv";
   const int rows = writeSweepSummary(sweep, csv, dirs);
   if (!options.quiet) std::printf("  summary %s (%d of %zu cases complete)\n", csv.string().c_str(), rows, count);
+  // Interrupted: the gathered table holds the cases that completed; `gem sweep` again resumes.
+  if (const int signal = interruptSignal())
+    throw Interrupted(signal,
+                      fmt::format("sweep interrupted; {} of {} cases complete, the others run when the sweep is run again", rows, count));
   return failures == 0 ? 0 : 1;
 }
 

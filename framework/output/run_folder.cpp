@@ -20,7 +20,9 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
     const std::string name = p.filename().string();
     return name.find(".tmp-") != std::string::npos && name.substr(name.size() - std::min(name.size(), own.size())) != own;
   };
-  std::vector<std::string> files{"summary.json", "state.csv", "timeseries.csv", "frames.pvd", "frames.ice"};
+  // gem-run.toml: GEM 0.2's name for scenario.toml. scenario.toml itself is not removed: it is
+  // rewritten whole by recordScenario (and may be the very file this run reads).
+  std::vector<std::string> files{"summary.json", "state.csv", "timeseries.csv", "frames.pvd", "frames.ice", "gem.log", "gem-run.toml"};
   files.insert(files.end(), recordFiles.begin(), recordFiles.end());
   for (const std::string& f : files) fs::remove(dir / f, ec);
   const fs::path frames = dir / "frames";
@@ -34,6 +36,7 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
 }
 
 void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) {
+  namespace fs = std::filesystem;
   toml::table root = scenario.root;
   auto table = [&](const char* name) -> toml::table& {
     if (!root.contains(name)) root.insert(name, toml::table{});
@@ -43,14 +46,27 @@ void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) 
   // The steps this run takes, whatever set them (duration, --steps, --duration).
   table("simulation").erase("duration");
   table("simulation").insert_or_assign("steps", static_cast<std::int64_t>(scenario.steps));
+  // The [simulation] keys as they resolved, defaults included ("auto" stays "auto": the backend it
+  // picked is in summary.json and gem.log).
+  toml::table& sim = table("simulation");
+  sim.insert_or_assign("dt", static_cast<double>(scenario.dt));
+  sim.insert_or_assign("backend", scenario.backend);
+  sim.insert_or_assign("broadphase", scenario.broadphase);
+  sim.insert_or_assign("threads", static_cast<std::int64_t>(scenario.threads));
+  sim.insert_or_assign("cuda_driver", scenario.cudaDriver);
+  sim.insert_or_assign("stop_when", scenario.stopWhen);
+  if (scenario.stopWhen == "distance") sim.insert_or_assign("stop_distance", static_cast<double>(scenario.stopDistance));
   table("output").insert_or_assign("dir", scenario.output.dir.string());
   if (scenario.fieldKind == "file") table("field").insert_or_assign("file", scenario.fieldFile.lexically_normal().string());
   std::ostringstream out;
   out << "# The scenario of this run as gem read it: " << scenario.file.string() << "\n";
   for (const std::string& o : scenario.overrides) out << "# --set " << o << "\n";
-  out << "# gem " << GEM_VERSION << "; `gem run gem-run.toml` repeats the run.\n\n";
+  out << "# gem " << GEM_VERSION << "; `gem run scenario.toml` repeats the run.\n\n";
   out << toml::toml_formatter{root, toml::toml_formatter::default_flags & ~toml::format_flags::indentation} << "\n";
-  writeFileAtomically(dir / "gem-run.toml", out.str());
+  // A scenario kept in its own run folder under this name is the user's file: never overwritten.
+  std::error_code ec;
+  if (fs::equivalent(dir / "scenario.toml", scenario.file, ec)) return;
+  writeFileAtomically(dir / "scenario.toml", out.str());
 }
 
 }  // namespace gem

@@ -1,5 +1,5 @@
 // A run folder that can be trusted: a run starts by removing what an earlier run of GEM left there
-// (its summary, CSVs, frames, temporaries: a re-run with frames off must not leave the old frames
+// (its summary, CSVs, frames, gem.log, temporaries: a re-run with frames off must not leave the old frames
 // beside the new summary), and records the scenario it read, overrides applied, with its seed.
 #pragma once
 #include <filesystem>
@@ -16,9 +16,11 @@ namespace gem {
 // the folder's lock (RunFolderLock): no other run of GEM is writing there.
 void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles);
 
-// Writes dir/gem-run.toml: the scenario as this run read it (every --set applied, its seed and its
-// step count, the field file and output folder by absolute path), so that `gem run
-// dir/gem-run.toml` repeats it.
+// Writes dir/scenario.toml: the scenario as this run read it (every --set applied, the [simulation]
+// keys resolved with their defaults, its seed and step count, the field file and output folder by
+// absolute path), so that `gem run dir/scenario.toml` repeats it. Other tables keep the keys the
+// file gave (an event's defaults are its own; `gem info` lists them). Skipped when dir/scenario.toml
+// is the scenario file itself.
 void recordScenario(const std::filesystem::path& dir, const Scenario& scenario);
 
 }  // namespace gem

@@ -356,6 +356,11 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
     if (s.cudaBlockSize % 32 != 0) t.fail("cuda_block_size", "must be a multiple of 32 (a whole number of warps)");
     s.cudaDriver = t.getChoice("cuda_driver", s.cudaDriver, {"auto", "resident", "device"});
     s.threads = static_cast<int>(t.getInt("threads", s.threads, 0, 1024));
+    s.stopWhen = t.getChoice("stop_when", s.stopWhen, {"duration", "vessel_left_field", "distance"});
+    if (s.stopWhen == "distance" && !t.has("stop_distance"))
+      t.fail("stop_when", "stop_when = \"distance\" needs simulation.stop_distance (m)");
+    if (s.stopWhen != "distance" && t.has("stop_distance")) t.fail("stop_distance", "only read with stop_when = \"distance\"");
+    s.stopDistance = t.getPositive("stop_distance", Real(1));
     t.finish();
   }
   if (const toml::table* b = top.findTable("broadphase")) readBroadphaseTables(*b, s);
@@ -399,6 +404,9 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
   }
   top.finish();
 
+  if (s.stopWhen != "duration" && !s.vessel.present)
+    TableReader(top.findTable("simulation"), "simulation", s.fileName)
+        .fail("stop_when", fmt::format("stop_when = \"{}\" follows the vessel, and this scenario has no [vessel]", s.stopWhen));
   if (s.fieldKind != "none" && s.fieldKind != "file" && !s.hasDomain)
     throw InputError(fmt::format("{}: a generated [field] needs a [domain] with x = [x0, x1] and y = [y0, y1]", s.fileName));
   // The field was read before [domain] may have been: bind the generators to the final domain.

@@ -55,6 +55,11 @@ struct Scenario {
   // CPU backend: threads stepping one field (0: every core; a sweep running cases in parallel
   // gives each case 1). Results are bit for bit those of one thread.
   int threads = 0;
+  // When a run stops before its last step (docs/scenario.md "Stop rules"): "duration" runs every
+  // step; "vessel_left_field" stops once the vessel, having reached the field, is clear of it again;
+  // "distance" once the vessel has travelled stop_distance metres (its path, not its displacement).
+  std::string stopWhen = "duration";
+  Real stopDistance = 0;  // m, stop_when = "distance" only
 
   // [domain]
   bool hasDomain = false;
