@@ -11,8 +11,8 @@ namespace gem {
 
 // The flat numbers and strings of a summary.json (the subset of JSON GEM writes: objects, numbers,
 // strings, true/false/null; arrays are skipped), nested objects flattened to "ship_speed.mean".
-// Numbers keep their text as written; null is "". Throws InputError (the file and the offset) if
-// malformed or nested more than 64 deep.
+// Numbers are written back in their shortest exact form ("1e3" reads as "1000.0"); null is "". Throws InputError (the file and the offset)
+// if malformed or nested more than 64 deep.
 std::map<std::string, std::string> readSummaryJson(const std::filesystem::path& file);
 
 // The summary quantities of summary.csv, after name and the varied keys.
