@@ -4,7 +4,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <zlib.h>
+
 #include <atomic>
+#include <cstring>
+#include <fstream>
+#include <iterator>
 #include <pugixml.hpp>
 #include <sstream>
 
@@ -129,6 +134,111 @@ TEST(VtkSeriesWriter, EmptyWorldIsAValidFrame) {
   pugi::xml_document vtp;
   ASSERT_TRUE(vtp.load_file((dir.path() / "frames" / "frame_000000.vtp").c_str()));
   EXPECT_EQ(vtp.child("VTKFile").child("PolyData").child("Piece").attribute("NumberOfPolys").as_int(), 0);
+}
+
+// The cell data a ParaView user asks for: GlobalIds to follow a floe, speed as the default
+// colouring, the kind by name, area and mass, and which cells are pieces of a break.
+TEST(VtkSeriesWriter, CellDataNamesIdsKindsAndBrokenPieces) {
+  TempDir dir;
+  World w;
+  BodySpec square;
+  square.vertices = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+  square.thickness = 0.5;
+  square.velocity = {3, 4};
+  w.addBody(square);
+  VtkSeriesWriter writer(dir.path());
+  writer.addFrame(w, 0.0);
+  BodySpec piece = square;
+  piece.vertices = {{5, 0}, {6, 0}, {6, 1}};
+  w.addBody(piece);  // a new id, as a split's piece has
+  writer.addFrame(w, 1.0);
+
+  pugi::xml_document vtp;
+  ASSERT_TRUE(vtp.load_file((dir.path() / "frames" / "frame_000001.vtp").c_str()));
+  pugi::xml_node piece1 = vtp.child("VTKFile").child("PolyData").child("Piece");
+  pugi::xml_node cells = piece1.child("CellData");
+  EXPECT_STREQ(cells.attribute("GlobalIds").value(), "id");
+  EXPECT_STREQ(cells.attribute("Scalars").value(), "speed");
+  EXPECT_DOUBLE_EQ(numbers(cellArray(piece1, "speed"))[0], 5.0);
+  EXPECT_DOUBLE_EQ(numbers(cellArray(piece1, "area"))[0], 4.0);
+  EXPECT_DOUBLE_EQ(numbers(cellArray(piece1, "mass"))[0], w.mass[0]);
+  EXPECT_GT(w.mass[0], 0);
+  EXPECT_EQ(numbers(cellArray(piece1, "broken")), (std::vector<double>{0, 1}));
+  // "floe" twice, as character codes each ended by 0.
+  EXPECT_EQ(numbers(cellArray(piece1, "kind_name")), (std::vector<double>{102, 108, 111, 101, 0, 102, 108, 111, 101, 0}));
+}
+
+// output.vtk_encoding = "binary": the same arrays as the ASCII file, as zlib blocks in the
+// appended section (decoded here as VTK's reader does).
+TEST(VtkSeriesWriter, BinaryFramesHoldTheAsciiValues) {
+  TempDir ascii, binary;
+  World w;
+  for (int k = 0; k < 3000; ++k) {  // over one 64 KiB block for the points
+    BodySpec b;
+    const double x = 3.0 * (k % 60), y = 3.0 * (k / 60);
+    b.vertices = {{x, y}, {x + 2, y}, {x + 2, y + 1.5}, {x + 0.5, y + 2}};
+    b.velocity = {0.01 * k, -0.5};
+    b.thickness = 0.3 + 0.001 * k;
+    w.addBody(b);
+  }
+  VtkSeriesWriter(ascii.path(), false).addFrame(w, 2.5);
+  VtkSeriesWriter(binary.path(), true).addFrame(w, 2.5);
+  pugi::xml_document text;
+  ASSERT_TRUE(text.load_file((ascii.path() / "frames" / "frame_000000.vtp").c_str()));
+
+  std::ifstream in(binary.path() / "frames" / "frame_000000.vtp", std::ios::binary);
+  const std::string file((std::istreambuf_iterator<char>(in)), {});
+  const std::string marker = "<AppendedData encoding=\"raw\">\n   _";
+  const std::size_t at = file.find(marker);
+  ASSERT_NE(at, std::string::npos);
+  pugi::xml_document head;  // the XML before the raw section, closed
+  ASSERT_TRUE(head.load_string((file.substr(0, at) + "</VTKFile>").c_str()));
+  EXPECT_STREQ(head.child("VTKFile").attribute("compressor").value(), "vtkZLibDataCompressor");
+  const unsigned char* appended = reinterpret_cast<const unsigned char*>(file.data() + at + marker.size());
+
+  // Every DataArray of the ASCII file, by its place in the document, against the binary one's.
+  std::vector<pugi::xml_node> textArrays, binaryArrays;
+  for (pugi::xpath_node n : text.select_nodes("//Piece//DataArray")) textArrays.push_back(n.node());
+  for (pugi::xpath_node n : head.select_nodes("//Piece//DataArray")) binaryArrays.push_back(n.node());
+  ASSERT_EQ(textArrays.size(), binaryArrays.size());
+  int decoded = 0;
+  for (std::size_t a = 0; a < textArrays.size(); ++a) {
+    const pugi::xml_node t = textArrays[a], b = binaryArrays[a];
+    EXPECT_STREQ(t.attribute("Name").value(), b.attribute("Name").value());
+    if (std::string(b.attribute("format").value()) != "appended") continue;  // kind_name stays text
+    const std::uint64_t* header = reinterpret_cast<const std::uint64_t*>(appended + b.attribute("offset").as_ullong());
+    const std::uint64_t blocks = header[0], blockSize = header[1], lastSize = header[2];
+    std::vector<unsigned char> raw;
+    const unsigned char* data = reinterpret_cast<const unsigned char*>(header + 3 + blocks);
+    for (std::uint64_t k = 0; k < blocks; ++k) {
+      uLongf size = (k + 1 == blocks && lastSize) ? lastSize : blockSize;
+      std::vector<unsigned char> block(size);
+      ASSERT_EQ(uncompress(block.data(), &size, data, static_cast<uLong>(header[3 + k])), Z_OK);
+      raw.insert(raw.end(), block.begin(), block.begin() + static_cast<std::ptrdiff_t>(size));
+      data += header[3 + k];
+    }
+    const std::string type = b.attribute("type").value();
+    std::vector<double> values;
+    auto read = [&](auto zero) {
+      using T = decltype(zero);
+      for (std::size_t k = 0; k + sizeof(T) <= raw.size(); k += sizeof(T)) {
+        T v;
+        std::memcpy(&v, raw.data() + k, sizeof(T));
+        values.push_back(static_cast<double>(v));
+      }
+    };
+    if (type == "Float64") read(0.0);
+    if (type == "Float32") read(0.0f);
+    if (type == "Int64") read(std::int64_t{0});
+    if (type == "Int32") read(std::int32_t{0});
+    if (type == "UInt8") read(std::uint8_t{0});
+    const std::vector<double> expected = numbers(t);
+    ASSERT_EQ(values.size(), expected.size()) << t.attribute("Name").value();
+    for (std::size_t k = 0; k < values.size(); ++k) ASSERT_DOUBLE_EQ(values[k], expected[k]) << t.attribute("Name").value() << " " << k;
+    ++decoded;
+  }
+  EXPECT_GE(decoded, 11);  // points, 9 cell arrays (kind_name aside), connectivity, offsets
+  EXPECT_LT(file.size(), std::filesystem::file_size(ascii.path() / "frames" / "frame_000000.vtp") / 2);
 }
 
 }  // namespace

@@ -123,7 +123,7 @@ class ScenarioRun {
     const OutputSpec& out = scenario.output;
     m_frames = out.frameEvery > 0;
     auto has = [&](const char* f) { return std::find(out.formats.begin(), out.formats.end(), f) != out.formats.end(); };
-    if (m_frames && has("vtk")) m_vtk = std::make_unique<VtkSeriesWriter>(m_dir);
+    if (m_frames && has("vtk")) m_vtk = std::make_unique<VtkSeriesWriter>(m_dir, out.vtkBinary);
     if (m_frames && has("ice")) m_ice = std::make_unique<IceFileWriter>(m_dir / "frames.ice");
     m_timeseries.stream() << "t,ship_x,ship_y,ship_heading,ship_speed,net_thrust,ice_force_x,contacts\n";
     // The record streams' files, from the events that own them (ship_impact: impacts.csv).

@@ -1,9 +1,17 @@
 #include "framework/output/vtk_writer.hpp"
 
+#include <zlib.h>
+
 #include <charconv>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <functional>
+#include <type_traits>
 #include <stdexcept>
 #include <system_error>
+
+#include <fmt/format.h>
 
 #include "framework/output/atomic_file.hpp"
 #include "framework/output/number_text.hpp"
@@ -14,44 +22,111 @@ namespace {
 
 // VTK's name for the engine's floating-point type: a float build writes Float32 arrays.
 constexpr const char* kRealType = sizeof(Real) == 8 ? "Float64" : "Float32";
+// The uncompressed size of one zlib block of an appended array (VTK's own writer uses 32 KiB).
+constexpr std::size_t kBlockBytes = 1 << 16;
 
-void openArray(std::string& out, const char* type, const char* name, int components) {
-  out += "        <DataArray type=\"";
-  out += type;
-  out += '"';
-  if (name) {
-    out += " Name=\"";
-    out += name;
-    out += '"';
-  }
-  if (components > 1) {
-    out += " NumberOfComponents=\"";
-    appendNumber(out, components);
-    out += '"';
-  }
-  out += " format=\"ascii\">\n";
+template <class T>
+constexpr const char* vtkTypeOf() {
+  if constexpr (std::is_same_v<T, double>) return "Float64";
+  if constexpr (std::is_same_v<T, float>) return "Float32";
+  if constexpr (std::is_same_v<T, std::int64_t>) return "Int64";
+  if constexpr (std::is_same_v<T, std::int32_t>) return "Int32";
+  if constexpr (std::is_same_v<T, std::uint8_t>) return "UInt8";
 }
 
-void closeArray(std::string& out) { out += "\n        </DataArray>\n"; }
+// One file's DataArrays, written either inline as text (ASCII: the files diff and grep) or, for
+// large fields, as zlib blocks in the file's appended section (output.vtk_encoding = "binary"):
+// each array there is VTK's compression header (UInt64 block count, block size, size of a
+// partial last block or 0, each block's compressed size) followed by the compressed blocks.
+class ArrayWriter {
+ public:
+  explicit ArrayWriter(bool binary) : m_binary(binary) {}
 
-// Values of one array, a bounded number per line so that large fields stay readable in an editor.
-template <class T, class F>
-void appendValues(std::string& out, int count, F&& valueOf) {
-  for (int i = 0; i < count; ++i) {
-    out += (i == 0) ? "          " : (i % 16 == 0 ? "\n          " : " ");
-    appendNumber(out, static_cast<T>(valueOf(i)));
+  // count values of type T, given by valueOf(i), as an array of `components` components.
+  template <class T, class F>
+  void add(std::string& out, const char* name, int components, std::size_t count, F&& valueOf) {
+    out += "        <DataArray type=\"";
+    out += vtkTypeOf<T>();
+    out += '"';
+    if (name) out += fmt::format(" Name=\"{}\"", name);
+    if (components > 1) out += fmt::format(" NumberOfComponents=\"{}\"", components);
+    if (m_binary) {
+      out += fmt::format(" format=\"appended\" offset=\"{}\"/>\n", m_appended.size());
+      std::vector<T> values(count);
+      for (std::size_t i = 0; i < count; ++i) values[i] = static_cast<T>(valueOf(i));
+      appendCompressed(reinterpret_cast<const unsigned char*>(values.data()), values.size() * sizeof(T));
+      return;
+    }
+    out += " format=\"ascii\">\n";
+    // A bounded number per line, so that large fields stay readable in an editor.
+    const std::size_t perLine = components > 1 ? 8 * static_cast<std::size_t>(components) : 16;
+    for (std::size_t i = 0; i < count; ++i) {
+      out += (i == 0) ? "          " : (i % perLine == 0 ? "\n          " : " ");
+      appendNumber(out, static_cast<T>(valueOf(i)));
+    }
+    out += "\n        </DataArray>\n";
   }
-}
 
-std::string polyData(const World& world, double time) {
-  const int n = world.size();
-  int points = 0;
-  for (int i = 0; i < n; ++i) points += world.vertexCount[i];
+  // A string per cell, always as text: VTK writes a string as its character codes, each ended by 0.
+  void addStrings(std::string& out, const char* name, std::size_t count, const std::function<const char*(std::size_t)>& valueOf) {
+    out += fmt::format("        <DataArray type=\"String\" Name=\"{}\" NumberOfTuples=\"{}\" format=\"ascii\">\n", name, count);
+    for (std::size_t i = 0; i < count; ++i) {
+      out += (i == 0) ? "          " : "\n          ";
+      for (const char* c = valueOf(i); *c; ++c) out += fmt::format("{} ", static_cast<int>(static_cast<unsigned char>(*c)));
+      out += '0';
+    }
+    out += "\n        </DataArray>\n";
+  }
 
+  // The appended section, after every array was added ("_" then the raw bytes), or "".
+  std::string appendedSection() const {
+    if (!m_binary) return "";
+    std::string out = "  <AppendedData encoding=\"raw\">\n   _";
+    out.append(m_appended.begin(), m_appended.end());
+    out += "\n  </AppendedData>\n";
+    return out;
+  }
+
+ private:
+  void appendCompressed(const unsigned char* data, std::size_t bytes) {
+    const std::size_t blocks = (bytes + kBlockBytes - 1) / kBlockBytes;
+    std::vector<std::uint64_t> header{blocks, kBlockBytes, bytes % kBlockBytes};
+    std::vector<unsigned char> compressed;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const std::size_t size = std::min(kBlockBytes, bytes - b * kBlockBytes);
+      uLongf length = compressBound(static_cast<uLong>(size));
+      const std::size_t at = compressed.size();
+      compressed.resize(at + length);
+      if (compress2(compressed.data() + at, &length, data + b * kBlockBytes, static_cast<uLong>(size), Z_BEST_SPEED) != Z_OK)
+        throw std::runtime_error("zlib could not compress a frame's array");
+      compressed.resize(at + length);
+      header.push_back(length);
+    }
+    const auto* h = reinterpret_cast<const unsigned char*>(header.data());
+    m_appended.insert(m_appended.end(), h, h + header.size() * sizeof(std::uint64_t));
+    m_appended.insert(m_appended.end(), compressed.begin(), compressed.end());
+  }
+
+  bool m_binary;
+  std::vector<unsigned char> m_appended;
+};
+
+std::string polyData(const World& world, double time, bool binary, const std::unordered_set<std::int64_t>& firstIds) {
+  const std::size_t n = static_cast<std::size_t>(world.size());
+  std::vector<Vec2> points;  // every body's world vertices, one after the other
+  std::vector<std::int64_t> offsets;
+  Vec2 vertices[kMaxVertices];
+  for (std::size_t i = 0; i < n; ++i) {
+    const int count = world.worldVertices(static_cast<int>(i), vertices);
+    points.insert(points.end(), vertices, vertices + count);
+    offsets.push_back(static_cast<std::int64_t>(points.size()));
+  }
+  ArrayWriter arrays(binary);
   std::string out;
-  out.reserve(512 + static_cast<size_t>(points) * 48 + static_cast<size_t>(n) * 96);
+  out.reserve(512 + (binary ? 0 : points.size() * 48 + n * 160));
   out += "<?xml version=\"1.0\"?>\n";
-  out += "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n";
+  out += "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"";
+  out += binary ? " compressor=\"vtkZLibDataCompressor\">\n" : ">\n";
   out += "  <PolyData>\n";
   // TimeValue lets ParaView show the time of a .vtp opened on its own, without the .pvd.
   out += "    <FieldData>\n";
@@ -59,81 +134,52 @@ std::string polyData(const World& world, double time) {
   appendNumber(out, time);
   out += "</DataArray>\n";
   out += "    </FieldData>\n";
-  out += "    <Piece NumberOfPoints=\"";
-  appendNumber(out, points);
-  out += "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"";
-  appendNumber(out, n);
-  out += "\">\n";
+  out +=
+      fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{}\">\n",
+                  points.size(), n);
 
   out += "      <Points>\n";
-  openArray(out, kRealType, nullptr, 3);
-  Vec2 vertices[kMaxVertices];
-  bool first = true;
-  for (int i = 0; i < n; ++i) {
-    const int count = world.worldVertices(i, vertices);
-    out += first ? "          " : "\n          ";  // one polygon per line
-    first = false;
-    for (int k = 0; k < count; ++k) {
-      if (k > 0) out += ' ';
-      appendNumber(out, vertices[k].x);
-      out += ' ';
-      appendNumber(out, vertices[k].y);
-      out += " 0";
-    }
-  }
-  closeArray(out);
+  arrays.add<Real>(out, nullptr, 3, points.size() * 3, [&](std::size_t k) {
+    const Vec2 p = points[k / 3];
+    return k % 3 == 0 ? p.x : k % 3 == 1 ? p.y : Real(0);
+  });
   out += "      </Points>\n";
 
-  out += "      <CellData Scalars=\"thickness\" Vectors=\"velocity\">\n";
-  openArray(out, "Int64", "id", 1);
-  appendValues<long long>(out, n, [&](int i) { return world.id[i]; });
-  closeArray(out);
-  openArray(out, "Int32", "kind", 1);
-  appendValues<int>(out, n, [&](int i) { return static_cast<int>(world.kind[i]); });
-  closeArray(out);
-  openArray(out, kRealType, "thickness", 1);
-  appendValues<Real>(out, n, [&](int i) { return world.thickness[i]; });
-  closeArray(out);
-  openArray(out, kRealType, "velocity", 3);
-  for (int i = 0; i < n; ++i) {
-    out += (i == 0) ? "          " : (i % 8 == 0 ? "\n          " : " ");
-    appendNumber(out, world.vx[i]);
-    out += ' ';
-    appendNumber(out, world.vy[i]);
-    out += " 0";
-  }
-  closeArray(out);
-  openArray(out, kRealType, "angular_velocity", 1);
-  appendValues<Real>(out, n, [&](int i) { return world.omega[i]; });
-  closeArray(out);
+  // speed is the active scalar, so ParaView colours by it on opening; id is the GlobalIds
+  // attribute, so a floe can be followed (and selected) across frames whatever its cell order.
+  out += "      <CellData Scalars=\"speed\" Vectors=\"velocity\" GlobalIds=\"id\">\n";
+  auto at = [](std::size_t i) { return static_cast<int>(i); };
+  arrays.add<std::int64_t>(out, "id", 1, n, [&](std::size_t i) { return world.id[i]; });
+  arrays.add<std::int32_t>(out, "kind", 1, n, [&](std::size_t i) { return static_cast<std::int32_t>(world.kind[i]); });
+  arrays.addStrings(out, "kind_name", n, [&](std::size_t i) { return bodyKindName(world.kind[at(i)]); });
+  arrays.add<Real>(out, "speed", 1, n, [&](std::size_t i) { return std::hypot(world.vx[i], world.vy[i]); });
+  arrays.add<Real>(out, "velocity", 3, n * 3, [&](std::size_t k) {
+    const std::size_t i = k / 3;
+    return k % 3 == 0 ? world.vx[i] : k % 3 == 1 ? world.vy[i] : Real(0);
+  });
+  arrays.add<Real>(out, "angular_velocity", 1, n, [&](std::size_t i) { return world.omega[i]; });
+  arrays.add<Real>(out, "thickness", 1, n, [&](std::size_t i) { return world.thickness[i]; });
+  arrays.add<Real>(out, "area", 1, n, [&](std::size_t i) { return world.area[i]; });
+  arrays.add<Real>(out, "mass", 1, n, [&](std::size_t i) { return world.mass[i]; });
+  // 1 for a piece that a break made (an id the series' first frame did not have).
+  arrays.add<std::uint8_t>(out, "broken", 1, n, [&](std::size_t i) { return firstIds.count(world.id[i]) ? 0 : 1; });
   out += "      </CellData>\n";
 
   // Polys: connectivity lists each polygon's point indices; offsets[i] is the end of polygon i.
   out += "      <Polys>\n";
-  openArray(out, "Int64", "connectivity", 1);
-  long long next = 0;
-  for (int i = 0; i < n; ++i) {
-    out += (i == 0) ? "          " : "\n          ";
-    for (int k = 0; k < world.vertexCount[i]; ++k) {
-      if (k > 0) out += ' ';
-      appendNumber(out, next++);
-    }
-  }
-  closeArray(out);
-  openArray(out, "Int64", "offsets", 1);
-  long long end = 0;
-  appendValues<long long>(out, n, [&](int i) { return end += world.vertexCount[i]; });
-  closeArray(out);
+  arrays.add<std::int64_t>(out, "connectivity", 1, points.size(), [](std::size_t k) { return static_cast<std::int64_t>(k); });
+  arrays.add<std::int64_t>(out, "offsets", 1, n, [&](std::size_t i) { return offsets[i]; });
   out += "      </Polys>\n";
   out += "    </Piece>\n";
   out += "  </PolyData>\n";
+  out += arrays.appendedSection();
   out += "</VTKFile>\n";
   return out;
 }
 
 }  // namespace
 
-VtkSeriesWriter::VtkSeriesWriter(std::filesystem::path runDir) : m_runDir(std::move(runDir)) {
+VtkSeriesWriter::VtkSeriesWriter(std::filesystem::path runDir, bool binary) : m_runDir(std::move(runDir)), m_binary(binary) {
   std::error_code ec;
   std::filesystem::create_directories(m_runDir / "frames", ec);
   if (ec) throw std::runtime_error("cannot create " + (m_runDir / "frames").string() + ": " + ec.message());
@@ -144,7 +190,8 @@ void VtkSeriesWriter::addFrame(const World& world, double time) {
   char name[32];
   std::snprintf(name, sizeof name, "frame_%06d.vtp", frameCount());
   const std::string relative = std::string("frames/") + name;
-  writeFileAtomically(m_runDir / "frames" / name, polyData(world, time));
+  if (m_entries.empty()) m_firstIds.insert(world.id.begin(), world.id.end());
+  writeFileAtomically(m_runDir / "frames" / name, polyData(world, time, m_binary, m_firstIds));
   m_entries.push_back({time, relative});
 
   // The whole collection each time: O(frames) per frame, small next to the frame itself, and the

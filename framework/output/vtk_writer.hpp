@@ -1,12 +1,17 @@
 // ParaView output (docs/scenario.md "Outputs"): one VTK XML PolyData file per frame,
 // runDir/frames/frame_NNNNNN.vtp, and the time series runDir/frames.pvd that lists them.
-// Each body is one polygon cell; points are its world vertices (z = 0). Cell data: id (Int64),
-// kind (Int32: 0 floe, 1 vessel, 2 wall), thickness (m), velocity (m/s, 3 components, z = 0),
-// angular_velocity (rad/s). ASCII, so the files diff and grep; every file is written atomically
-// and frames.pvd is rewritten after each frame, so a run that dies leaves a series that opens.
+// Each body is one polygon cell; points are its world vertices (z = 0). Cell data: id (Int64, the
+// GlobalIds), kind (Int32: 0 floe, 1 vessel, 2 wall) and kind_name (its name), speed (m/s, the
+// active scalar ParaView colours by), velocity (m/s, 3 components, z = 0), angular_velocity
+// (rad/s), thickness (m), area (m^2), mass (kg), broken (1 for a piece a break made). ASCII, so
+// the files diff and grep, or binary: zlib-compressed appended data for large fields. Every file is
+// written atomically and frames.pvd is rewritten after each frame, so a run that dies leaves a
+// series that opens.
 #pragma once
 #include <filesystem>
+#include <cstdint>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "framework/world/world.hpp"
@@ -16,7 +21,8 @@ namespace gem {
 class VtkSeriesWriter {
  public:
   // Creates runDir/frames (and runDir) if needed; throws std::runtime_error when it cannot.
-  explicit VtkSeriesWriter(std::filesystem::path runDir);
+  // binary: appended, zlib-compressed arrays (output.vtk_encoding = "binary"), else ASCII.
+  explicit VtkSeriesWriter(std::filesystem::path runDir, bool binary = false);
 
   // Writes the next frame_NNNNNN.vtp for simulation time `time` (s) and rewrites frames.pvd.
   void addFrame(const World& world, double time);
@@ -32,6 +38,8 @@ class VtkSeriesWriter {
   };
   std::filesystem::path m_runDir;
   std::vector<Entry> m_entries;
+  bool m_binary = false;
+  std::unordered_set<std::int64_t> m_firstIds;  // the bodies of frame 0: any other id is a piece
   bool m_finished = false;
 };
 

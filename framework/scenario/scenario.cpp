@@ -219,6 +219,7 @@ void readOutput(TableReader& t, Scenario& s) {
       o.formats.push_back(*name);
     }
   }
+  o.vtkBinary = t.getChoice("vtk_encoding", "ascii", {"ascii", "binary"}) == "binary";
   t.finish();
 }
 

@@ -22,6 +22,7 @@ struct OutputSpec {
   int frameEvery = 10;        // steps between frames; 0 = no frames
   int timeseriesEvery = 1;    // steps between time-series rows
   std::vector<std::string> formats{"vtk", "ice"};
+  bool vtkBinary = false;  // output.vtk_encoding = "binary": zlib-compressed appended arrays
 };
 
 struct PluginSpec {
