@@ -1,4 +1,5 @@
-// The gem command (docs/scenario.md "Command line"): run, check, info, bench.
+// The gem command (docs/scenario.md "Command line"): run, check, info, bench, sweep, analyze, plot,
+// movie.
 // Exit status: 0 success; 2 bad input (with file, line and column or key); 1 any other failure.
 #include <unistd.h>
 
@@ -12,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "framework/analysis/analyze.hpp"
+#include "framework/analysis/run_plots.hpp"
 #include "bench/bench.hpp"
 #include "framework/app/calibration.hpp"
 #include "framework/api/errors.hpp"
@@ -38,6 +40,7 @@ struct RunArguments {
   bool durationGiven = false, stepsGiven = false;  // set from the command line's counts
   std::vector<std::string> set;
   bool quiet = false;
+  bool noPlots = false;  // gem run --no-plots
 };
 
 Scenario load(const RunArguments& a) {
@@ -64,6 +67,16 @@ Scenario load(const RunArguments& a) {
   }
   if (!a.out.empty()) s.output.dir = fs::absolute(a.out);
   return s;
+}
+
+// gem plot, and the end of gem run: the run folder's plots, each file named as written.
+int commandPlot(const fs::path& dir, bool quiet) {
+  const RunPlots plots = writeRunPlots(dir);
+  if (quiet) return 0;
+  std::printf("gem plot %s: %zu files in %s\n", dir.c_str(), plots.files.size(), (dir / "plots").c_str());
+  for (const fs::path& f : plots.files) std::printf("  %s\n", f.filename().c_str());
+  for (const std::string& note : plots.notes) std::printf("  note: %s\n", note.c_str());
+  return 0;
 }
 
 int commandRun(const RunArguments& a) {
@@ -102,6 +115,7 @@ int commandRun(const RunArguments& a) {
     std::printf("  outputs        %s/ (summary.json, timeseries.csv, impacts.csv, state.csv, frames.pvd, frames.ice)\n",
                 r.outputDir.c_str());
   }
+  if (!a.noPlots) commandPlot(r.outputDir, a.quiet);
   return 0;
 }
 
@@ -175,6 +189,7 @@ int main(int argc, char** argv) {
   addRunOptions(run);
   run->add_option("--out", args.out, "run folder (default: output.dir of the scenario, else runs/NAME)");
   run->add_flag("--quiet", args.quiet, "no progress line and no summary");
+  run->add_flag("--no-plots", args.noPlots, "do not write RUN/plots/ at the end (gem plot RUN writes them later)");
   CLI::App* check = app.add_subcommand("check", "load and validate a scenario without running it");
   addRunOptions(check);
   check->add_flag("--quiet", args.quiet, "print nothing when the scenario is valid");
@@ -223,6 +238,12 @@ int main(int argc, char** argv) {
   analyzeCommand->add_option("--groups", analyze.groups, "case-name prefixes to analyse, e.g. 121,004,040,400")->delimiter(',');
   analyzeCommand->add_flag("--quiet", analyze.quiet, "print nothing but errors");
 
+  std::string plotDir;
+  bool plotQuiet = false;
+  CLI::App* plotCommand = app.add_subcommand("plot", "PNG and SVG plots of a run folder: time series and impact loads, in RUN/plots/");
+  plotCommand->add_option("dir", plotDir, "run folder")->required();
+  plotCommand->add_flag("--quiet", plotQuiet, "print nothing but errors");
+
   SweepOptions sweep;
   CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
   sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
@@ -253,6 +274,7 @@ int main(int argc, char** argv) {
     if (*benchCommand) return runBench(bench);
     if (*sweepCommand) return runSweep(sweep);
     if (*analyzeCommand) return runAnalyze(analyze);
+    if (*plotCommand) return commandPlot(plotDir, plotQuiet);
     if (*calibrateCommand) return runCalibration(calibrationFile, calibrationOut, false) <= 0.02 ? 0 : 1;
     return commandInfo(infoPlugins);
   } catch (const InputError& e) {
