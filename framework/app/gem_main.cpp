@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "framework/analysis/analyze.hpp"
+#include "framework/analysis/movie.hpp"
 #include "framework/analysis/run_plots.hpp"
 #include "bench/bench.hpp"
 #include "framework/app/calibration.hpp"
@@ -244,6 +245,16 @@ int main(int argc, char** argv) {
   plotCommand->add_option("dir", plotDir, "run folder")->required();
   plotCommand->add_flag("--quiet", plotQuiet, "print nothing but errors");
 
+  MovieOptions movie;
+  std::string movieOut;
+  CLI::App* movieCommand = app.add_subcommand("movie", "an MP4 of a run's frames (frames.ice) through ffmpeg, or one frame as a PNG");
+  movieCommand->add_option("dir", movie.runDir, "run folder")->required();
+  movieCommand->add_option("--out", movieOut, "movie file (default RUN/movie.mp4); with --still, the PNG");
+  movieCommand->add_option("--fps", movie.fps, "frames per second (default 10: one movie frame per saved frame)");
+  movieCommand->add_option("--color", movie.color, "what colours the floes: speed (default), thickness or id");
+  movieCommand->add_option("--size", movie.size, "WxH in pixels, each even (default 1280x720)");
+  movieCommand->add_option("--still", movie.still, "write frame K (0-based) as a PNG to --out instead of the movie");
+
   SweepOptions sweep;
   CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
   sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
@@ -275,6 +286,13 @@ int main(int argc, char** argv) {
     if (*sweepCommand) return runSweep(sweep);
     if (*analyzeCommand) return runAnalyze(analyze);
     if (*plotCommand) return commandPlot(plotDir, plotQuiet);
+    if (*movieCommand) {
+      movie.out = movieOut;
+      const MovieResult m = writeMovie(movie);
+      std::printf("gem movie %s: %s (%zu frame%s, %d x %d)\n", movie.runDir.c_str(), m.file.c_str(), m.frames, m.frames == 1 ? "" : "s",
+                  m.width, m.height);
+      return 0;
+    }
     if (*calibrateCommand) return runCalibration(calibrationFile, calibrationOut, false) <= 0.02 ? 0 : 1;
     return commandInfo(infoPlugins);
   } catch (const InputError& e) {
