@@ -98,7 +98,7 @@ TEST(Movie, StillShowsTheFloesAndTwoFramesDiffer) {
   ASSERT_EQ(b.argb.size(), a.argb.size());
   EXPECT_GT(a.count(kThinnest, 8), 5000) << "no floes drawn";
   EXPECT_GT(a.count(kWater), 5000) << "no open water drawn";
-  EXPECT_GT(a.count(kVessel), 300) << "no vessel drawn";
+  EXPECT_GT(b.count(kVessel), 300) << "no vessel drawn";  // at frame 0 its bow only enters the view
   long differing = 0;
   for (size_t i = 0; i < a.argb.size(); ++i) differing += a.argb[i] != b.argb[i];
   EXPECT_GT(differing, 2000) << "frames 0 and 25 look alike: the vessel has moved 15 s between them";

@@ -70,9 +70,13 @@ FramePainter::FramePainter(const std::vector<FrameState>& frames, FrameColor col
   std::vector<double> values;
   for (size_t k = 0; k < frames.size(); ++k)
     for (const FrameBody& b : frames[k].bodies) {
-      if ((k == 0 && b.kind == BodyKind::Floe) || b.kind == BodyKind::Vessel) cover(b);
+      if (k == 0 && b.kind == BodyKind::Floe) cover(b);
       if (b.kind == BodyKind::Floe) values.push_back(color == FrameColor::Thickness ? double(b.thickness) : speedOf(b));
     }
+  if (!(x1 > x0 && y1 > y0))  // no ice at the start: the vessel's track and the walls instead
+    for (const FrameState& frame : frames)
+      for (const FrameBody& b : frame.bodies)
+        if (b.kind != BodyKind::Floe) cover(b);
   if (!(x1 > x0)) x0 = -1, x1 = 1;
   if (!(y1 > y0)) y0 = -1, y1 = 1;
   const double pad = 0.03 * std::max(x1 - x0, y1 - y0);  // the walls along a channel's sides stay in view

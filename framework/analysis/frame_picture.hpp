@@ -1,7 +1,7 @@
 // One frame of a run as a picture (gem movie, its stills): the floes filled by a colour key
 // (speed, thickness or id) with a colour bar, the vessel in red, walls grey, broken pieces outlined
-// in black, and the time written on it; the view is fitted once to the whole series, so the camera
-// stands still while the vessel crosses the field.
+// in black, and the time written on it; the view is fitted once to the field (frame 0's floes), so
+// the camera stands still while the vessel crosses it.
 #pragma once
 #include <string>
 #include <vector>
@@ -21,9 +21,10 @@ Rgb viridis(double u);
 
 class FramePainter {
  public:
-  // Fits the view and the colour range to the series: frame 0's floes and the vessel in every
-  // frame (walls run on beyond the field; they are cut at the view's edge); the floes' speeds (up to their 99th percentile, so one flung
-  // piece does not wash out the rest) or thicknesses over every frame.
+  // Fits the view to frame 0's floes (the vessel before and after the field, and walls running on
+  // beyond it, are cut at the view's edge) and the colour range to the series: the floes' speeds
+  // (up to their 99th percentile, so one flung piece does not wash out the rest) or thicknesses
+  // over every frame.
   FramePainter(const std::vector<FrameState>& frames, FrameColor color, int width, int height);
 
   void draw(PlotCanvas& canvas, const FrameState& frame, std::size_t index) const;
