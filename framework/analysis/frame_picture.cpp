@@ -18,6 +18,7 @@ constexpr double kBarSpace = 96;  // px right of the field: the colour bar and i
 constexpr const char* kWater = "#CFE2F3";
 constexpr const char* kVessel = "#C0392B";
 constexpr const char* kWall = "#8C8C8C";
+constexpr size_t kMaxValues = 1 << 20;  // floe values kept for the colour range: about 1 % of a percent off at worst
 
 double speedOf(const FrameBody& b) { return std::hypot(double(b.velocity.x), double(b.velocity.y)); }
 
@@ -60,43 +61,57 @@ Rgb viridis(double u) {
   return {a.r + w * (b.r - a.r), a.g + w * (b.g - a.g), a.b + w * (b.b - a.b)};
 }
 
-FramePainter::FramePainter(const std::vector<FrameState>& frames, FrameColor color, int width, int height)
-    : m_color(color), m_width(width), m_height(height), m_frameCount(frames.size()) {
-  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-  auto cover = [&](const FrameBody& b) {
-    for (const Vec2& v : b.vertices)
-      x0 = std::min(x0, double(v.x)), x1 = std::max(x1, double(v.x)), y0 = std::min(y0, double(v.y)), y1 = std::max(y1, double(v.y));
-  };
-  std::vector<double> values;
-  for (size_t k = 0; k < frames.size(); ++k)
-    for (const FrameBody& b : frames[k].bodies) {
-      if (k == 0 && b.kind == BodyKind::Floe) cover(b);
-      if (b.kind == BodyKind::Floe) values.push_back(color == FrameColor::Thickness ? double(b.thickness) : speedOf(b));
+FramePainter::FramePainter(FrameColor color, int width, int height) : m_color(color), m_width(width), m_height(height) {}
+
+void FramePainter::Box::cover(const FrameBody& b) {
+  for (const Vec2& v : b.vertices)
+    x0 = std::min(x0, double(v.x)), x1 = std::max(x1, double(v.x)), y0 = std::min(y0, double(v.y)), y1 = std::max(y1, double(v.y));
+}
+
+void FramePainter::survey(const FrameState& frame) {
+  for (const FrameBody& b : frame.bodies) {
+    if (b.kind != BodyKind::Floe) {
+      m_others.cover(b);
+      continue;
     }
-  if (!(x1 > x0 && y1 > y0))  // no ice at the start: the vessel's track and the walls instead
-    for (const FrameState& frame : frames)
-      for (const FrameBody& b : frame.bodies)
-        if (b.kind != BodyKind::Floe) cover(b);
-  if (!(x1 > x0)) x0 = -1, x1 = 1;
-  if (!(y1 > y0)) y0 = -1, y1 = 1;
-  const double pad = 0.03 * std::max(x1 - x0, y1 - y0);  // the walls along a channel's sides stay in view
-  x0 -= pad, x1 += pad, y0 -= pad, y1 += pad;
-  const double right = color == FrameColor::Id ? kMargin : kBarSpace;
-  const double areaW = width - kMargin - right, areaH = height - kHeader - kMargin;
+    if (m_frameCount == 0) m_field.cover(b);
+    if (m_seen++ % m_stride) continue;
+    m_values.push_back(m_color == FrameColor::Thickness ? double(b.thickness) : speedOf(b));
+    if (m_values.size() >= kMaxValues) {  // thin the sample to every other value, and keep every other from now on
+      for (size_t i = 0; 2 * i < m_values.size(); ++i) m_values[i] = m_values[2 * i];
+      m_values.resize((m_values.size() + 1) / 2);
+      m_stride *= 2;
+    }
+  }
+  ++m_frameCount;
+}
+
+void FramePainter::fit() {
+  m_fitted = true;
+  Box box = m_field;
+  if (!(box.x1 > box.x0 && box.y1 > box.y0)) box = m_others;  // no ice at the start: the vessel's track and the walls
+  if (!(box.x1 > box.x0)) box.x0 = -1, box.x1 = 1;
+  if (!(box.y1 > box.y0)) box.y0 = -1, box.y1 = 1;
+  const double pad = 0.03 * std::max(box.x1 - box.x0, box.y1 - box.y0);  // the walls along a channel's sides stay in view
+  const double x0 = box.x0 - pad, x1 = box.x1 + pad, y0 = box.y0 - pad, y1 = box.y1 + pad;
+  const double right = m_color == FrameColor::Id ? kMargin : kBarSpace;
+  const double areaW = m_width - kMargin - right, areaH = m_height - kHeader - kMargin;
   m_scale = std::max(1e-9, std::min(areaW / (x1 - x0), areaH / (y1 - y0)));
   m_x0 = x0, m_y1 = y1;
   m_left = kMargin + 0.5 * (areaW - m_scale * (x1 - x0));
   m_top = kHeader + 0.5 * (areaH - m_scale * (y1 - y0));
 
+  std::vector<double>& values = m_values;
   values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }), values.end());
   std::sort(values.begin(), values.end());
-  if (color == FrameColor::Speed) {
+  if (m_color == FrameColor::Speed) {
     m_lo = 0;
     m_hi = values.empty() ? 0 : values[std::min(values.size() - 1, size_t(0.99 * double(values.size())))];
   } else if (!values.empty()) {
     m_lo = values.front(), m_hi = values.back();
   }
-  if (!(m_hi > m_lo)) m_hi = m_lo + (color == FrameColor::Speed ? 0.1 : 0.1 * std::max(m_lo, 1.0));
+  if (!(m_hi > m_lo)) m_hi = m_lo + (m_color == FrameColor::Speed ? 0.1 : 0.1 * std::max(m_lo, 1.0));
+  values = {};
 }
 
 std::pair<double, double> FramePainter::pixel(Vec2 p) const {
@@ -126,7 +141,8 @@ void FramePainter::drawColorBar(PlotCanvas& canvas) const {
   }
 }
 
-void FramePainter::draw(PlotCanvas& canvas, const FrameState& frame, std::size_t index) const {
+void FramePainter::draw(PlotCanvas& canvas, const FrameState& frame, std::size_t index) {
+  if (!m_fitted) fit();
   canvas.rect(0, 0, m_width, m_height, {.fill = "#F7F7F7"});
   canvas.text(kMargin, 26, fmt::format("t = {:.1f} s", frame.time), {.size = 18, .bold = true});
   const char* key = m_color == FrameColor::Speed       ? "floes by speed"

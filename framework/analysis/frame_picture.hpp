@@ -3,6 +3,7 @@
 // in black, and the time written on it; the view is fitted once to the field (frame 0's floes), so
 // the camera stands still while the vessel crosses it.
 #pragma once
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -21,15 +22,20 @@ Rgb viridis(double u);
 
 class FramePainter {
  public:
-  // Fits the view to frame 0's floes (the vessel before and after the field, and walls running on
-  // beyond it, are cut at the view's edge) and the colour range to the series: the floes' speeds
-  // (up to their 99th percentile, so one flung piece does not wash out the rest) or thicknesses
-  // over every frame.
-  FramePainter(const std::vector<FrameState>& frames, FrameColor color, int width, int height);
+  FramePainter(FrameColor color, int width, int height);
 
-  void draw(PlotCanvas& canvas, const FrameState& frame, std::size_t index) const;
+  // Shown every frame of the series, in order, before the first draw(): the view is fitted to
+  // frame 0's floes (the vessel before and after the field, and walls running on beyond it, are
+  // cut at the view's edge) and the colour range to the floes' speeds (up to their 99th
+  // percentile, so one flung piece does not wash out the rest) or thicknesses over every frame.
+  // Only a bounding box and a thinned sample of values are kept, never the frames.
+  void survey(const FrameState& frame);
+  std::size_t frameCount() const { return m_frameCount; }
+
+  void draw(PlotCanvas& canvas, const FrameState& frame, std::size_t index);
 
  private:
+  void fit();  // at the first draw()
   // Pixel coordinates of a world point.
   std::pair<double, double> pixel(Vec2 p) const;
   std::string floeColor(const FrameBody& body) const;
@@ -37,7 +43,14 @@ class FramePainter {
 
   FrameColor m_color;
   int m_width, m_height;
-  std::size_t m_frameCount;
+  std::size_t m_frameCount = 0;
+  bool m_fitted = false;
+  struct Box {
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    void cover(const FrameBody& b);
+  } m_field, m_others;           // frame 0's floes; the vessel and walls in every frame (a field without ice)
+  std::vector<double> m_values;  // every m_stride-th floe speed or thickness seen
+  std::size_t m_seen = 0, m_stride = 1;
   double m_x0 = 0, m_y1 = 0, m_scale = 1, m_left = 0, m_top = 0;  // world (m_x0, m_y1) sits at pixel (m_left, m_top)
   double m_lo = 0, m_hi = 1;                                      // colour range of the key
 };

@@ -3,7 +3,9 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
+#include <cstring>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -64,7 +66,7 @@ std::string lastLines(const fs::path& file) {
   return text.size() > 600 ? "..." + text.substr(text.size() - 600) : text;
 }
 
-void encode(const std::vector<FrameState>& frames, const FramePainter& painter, CairoCanvas& canvas, int fps, const fs::path& out) {
+void encode(const fs::path& ice, FramePainter& painter, CairoCanvas& canvas, int fps, const fs::path& out) {
   if (!onPath("ffmpeg"))
     throw std::runtime_error(
         "ffmpeg not found on PATH: gem movie encodes with it (Debian: apt-get install ffmpeg; scripts/setup.sh installs it)");
@@ -82,11 +84,20 @@ void encode(const std::vector<FrameState>& frames, const FramePainter& painter, 
     FILE* pipe = ::popen(command.c_str(), "w");
     if (!pipe) throw std::runtime_error(fmt::format("cannot start ffmpeg: {}", std::strerror(errno)));
     const size_t row = size_t(canvas.width()) * 4;
-    for (size_t k = 0; k < frames.size() && written; ++k) {
-      painter.draw(canvas, frames[k], k);
-      const std::uint8_t* pixels = canvas.pixels();
-      for (int y = 0; y < canvas.height() && written; ++y)
-        written = std::fwrite(pixels + size_t(y) * size_t(canvas.stride()), 1, row, pipe) == row;
+    size_t k = 0;
+    try {
+      forEachFrame(ice, [&](const FrameState& frame) {
+        if (!written) return;  // ffmpeg has stopped reading: nothing more to draw
+        painter.draw(canvas, frame, k++);
+        const std::uint8_t* pixels = canvas.pixels();
+        for (int y = 0; y < canvas.height() && written; ++y)
+          written = std::fwrite(pixels + size_t(y) * size_t(canvas.stride()), 1, row, pipe) == row;
+      });
+    } catch (...) {
+      ::pclose(pipe);
+      fs::remove(temp, ec);
+      fs::remove(log, ec);
+      throw;
     }
     status = ::pclose(pipe);
   }
@@ -118,24 +129,30 @@ MovieResult writeMovie(const MovieOptions& o) {
   if (!fs::exists(ice))
     throw InputError(
         fmt::format("{}: no frames.ice to draw (run with output.frame_every > 0 and \"ice\" in output.formats)", o.runDir.string()));
-  const std::vector<FrameState> frames = readFrameSeries(ice);
-  if (frames.empty()) throw InputError(ice.string() + ": holds no frame");
-  const FramePainter painter(frames, color, width, height);
+  // Two passes over the file: one to fit the view and the colour range, one to draw; a large run's
+  // frames never sit in memory together.
+  FramePainter painter(color, width, height);
+  forEachFrame(ice, [&](const FrameState& frame) { painter.survey(frame); });
+  const size_t frames = painter.frameCount();
+  if (frames == 0) throw InputError(ice.string() + ": holds no frame");
   CairoCanvas canvas(width, height);
   MovieResult result{o.out, 0, width, height};
   if (o.still) {
     const long k = *o.still;
-    if (k < 0 || size_t(k) >= frames.size())
-      throw InputError(fmt::format("--still {}: {} holds frames 0 to {}", k, ice.string(), frames.size() - 1));
+    if (k < 0 || size_t(k) >= frames) throw InputError(fmt::format("--still {}: {} holds frames 0 to {}", k, ice.string(), frames - 1));
     if (o.out.empty() || o.out.extension() != ".png") throw InputError("--still needs --out FILE.png: where to write the picture");
-    painter.draw(canvas, frames[size_t(k)], size_t(k));
+    size_t index = 0;
+    forEachFrame(ice, [&](const FrameState& frame) {
+      if (index == size_t(k)) painter.draw(canvas, frame, index);
+      ++index;
+    });
     canvas.writePng(o.out);
     result.frames = 1;
     return result;
   }
   if (result.file.empty()) result.file = o.runDir / kMovieFile;
-  encode(frames, painter, canvas, o.fps, result.file);
-  result.frames = frames.size();
+  encode(ice, painter, canvas, o.fps, result.file);
+  result.frames = frames;
   return result;
 }
 
