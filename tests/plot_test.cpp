@@ -2,6 +2,8 @@
 // PNG from one drawing; gem run makes them unless --no-plots, and a re-run removes the old ones.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -114,4 +116,22 @@ TEST(Plot, SvgAndPngComeFromOneDrawing) {
   ASSERT_EQ(png.width, 800);
   EXPECT_GT(png.count(0xFF0000, 30), 300);  // a 1.6 px zigzag across the plot area
   EXPECT_EQ(png.count(0x00FF00, 60), 0);    // and nothing it was not asked to draw
+}
+
+TEST(Plot, LongSeriesAreReducedKeepingTheirSpikes) {
+  // A long run's time series: 10^5 rows, one spike, one gap.
+  std::vector<double> t, v;
+  for (int i = 0; i < 100000; ++i)
+    t.push_back(0.1 * i), v.push_back(i == 31415 ? 50.0 : i >= 60000 && i < 60010 ? NAN : std::sin(i * 1e-3));
+  envelopeLine(t, v, 4000);
+  EXPECT_LE(t.size(), 4000u);
+  EXPECT_GE(t.size(), 3000u);
+  EXPECT_TRUE(std::is_sorted(t.begin(), t.end()));
+  EXPECT_EQ(*std::max_element(v.begin(), v.end()), 50.0);
+  EXPECT_NE(std::find(t.begin(), t.end(), 0.1 * 31415), t.end());
+  // Scatter points: every k-th, at most the number asked for.
+  std::vector<double> x(12001, 1.0), y(12001, 2.0);
+  EXPECT_EQ(thinPoints(x, y, 5000), 3u);
+  EXPECT_LE(x.size(), 5000u);
+  EXPECT_EQ(x.size(), y.size());
 }

@@ -198,15 +198,7 @@ std::vector<double> logSpaced(double lo, double hi, int n) {
   return v;
 }
 
-// Every k-th point so that at most kMaxScatterPoints remain; returns k.
-size_t thin(std::vector<double>& x, std::vector<double>& y) {
-  const size_t k = (x.size() + kMaxScatterPoints - 1) / kMaxScatterPoints;
-  if (k <= 1) return 1;
-  size_t j = 0;
-  for (size_t i = 0; i < x.size(); i += k, ++j) x[j] = x[i], y[j] = y[i];
-  x.resize(j), y.resize(j);
-  return k;
-}
+size_t thin(std::vector<double>& x, std::vector<double>& y) { return thinPoints(x, y, kMaxScatterPoints); }
 
 // Groups drawn as separate series: the prefix groups, or "all" alone when it is the only one.
 std::vector<size_t> drawnGroups(const std::vector<Group>& groups) {

@@ -22,19 +22,23 @@ std::vector<double> scaled(std::vector<double> v, double factor) {
   return v;
 }
 
-// "mean M, max X UNIT" over the finite values; "" when there are none.
-std::string meanAndMax(const std::vector<double>& v, const char* unit) {
-  double sum = 0, max = -INFINITY;
+// "mean M UNIT, from LO to HI UNIT" over the finite values; "" when there are none. Both ends: the
+// ice force is negative (it resists), so its largest load is its minimum.
+std::string meanAndRange(const std::vector<double>& v, const char* unit) {
+  double sum = 0, lo = INFINITY, hi = -INFINITY;
   size_t n = 0;
   for (double x : v)
-    if (std::isfinite(x)) sum += x, max = std::max(max, x), ++n;
-  return n ? fmt::format("mean {:.4g} {}, max {:.4g} {}", sum / double(n), unit, max, unit) : "";
+    if (std::isfinite(x)) sum += x, lo = std::min(lo, x), hi = std::max(hi, x), ++n;
+  return n ? fmt::format("mean {:.4g}{}, from {:.4g} to {:.4g}{}", sum / double(n), unit, lo, hi, unit) : "";
 }
 
 // The value below which a fraction q of the sorted values lie (nearest rank).
 double quantile(const std::vector<double>& sorted, double q) {
   return sorted[std::min(sorted.size() - 1, size_t(q * double(sorted.size())))];
 }
+
+// More points than a plot 800 px wide can show: long runs are reduced (envelopeLine, thinPoints).
+constexpr size_t kMaxLinePoints = 4000, kMaxScatterPoints = 5000;
 
 struct Writer {
   fs::path dir;
@@ -46,32 +50,32 @@ struct Writer {
   }
 };
 
+// One quantity against t: its line (reduced to kMaxLinePoints) and, above it, its mean and range
+// over every row.
+void plotAgainstTime(Writer& write, const std::string& name, const std::string& title, const std::string& yLabel, const char* unit,
+                     std::vector<double> t, std::vector<double> v, std::size_t color) {
+  SvgPlot plot(title, "time t [s]", yLabel);
+  plot.addNote(meanAndRange(v, unit));
+  envelopeLine(t, v, kMaxLinePoints);
+  plot.addLine("", std::move(t), std::move(v), plotColor(color));
+  write(plot, name);
+}
+
 void plotTimeSeries(const fs::path& runDir, Writer& write, RunPlots& result) {
   const fs::path file = runDir / "timeseries.csv";
   const auto c = readColumns(file, {"t", "ship_speed", "net_thrust", "ice_force_x", "contacts"}, true);
   const std::vector<double>& t = c[0];
   const bool vessel = std::any_of(c[1].begin(), c[1].end(), [](double v) { return std::isfinite(v); });
   if (vessel) {
-    SvgPlot speed("Ship speed", "time t [s]", "surge speed [m/s]");
-    speed.addLine("", t, c[1], plotColor(0));
-    speed.addNote(meanAndMax(c[1], "m/s"));
-    write(speed, "ship_speed");
+    plotAgainstTime(write, "ship_speed", "Ship speed", "surge speed [m/s]", " m/s", t, c[1], 0);
     // Thrust left over after open-water resistance: what the ice resists with, on average.
-    SvgPlot thrust("Net thrust (thrust less open-water resistance)", "time t [s]", "net thrust [kN]");
-    thrust.addLine("", t, scaled(c[2], 1e-3), plotColor(1));
-    thrust.addNote(meanAndMax(scaled(c[2], 1e-3), "kN"));
-    write(thrust, "net_thrust");
-    SvgPlot ice("Ice force on the ship, along x", "time t [s]", "ice force x [kN]");
-    ice.addLine("", t, scaled(c[3], 1e-3), plotColor(2));
-    ice.addNote(meanAndMax(scaled(c[3], 1e-3), "kN"));
-    write(ice, "ice_force");
+    plotAgainstTime(write, "net_thrust", "Net thrust (thrust less open-water resistance)", "net thrust [kN]", " kN", t, scaled(c[2], 1e-3),
+                    1);
+    plotAgainstTime(write, "ice_force", "Ice force on the ship, along x", "ice force x [kN]", " kN", t, scaled(c[3], 1e-3), 2);
   } else {
     result.notes.push_back("no vessel in this run: no ship speed, net thrust or ice force plots");
   }
-  SvgPlot contacts("Contacts", "time t [s]", "contacts in the step");
-  contacts.addLine("", t, c[4], plotColor(3));
-  contacts.addNote(meanAndMax(c[4], ""));
-  write(contacts, "contacts");
+  plotAgainstTime(write, "contacts", "Contacts", "contacts in the step", "", t, c[4], 3);
 }
 
 void plotImpacts(const fs::path& runDir, Writer& write, RunPlots& result) {
@@ -113,16 +117,20 @@ void plotImpacts(const fs::path& runDir, Writer& write, RunPlots& result) {
     (c[4][i] != 0 ? xBroke : xIntact).push_back(c[1][i]);
     (c[4][i] != 0 ? fBroke : fIntact).push_back(fn[i]);
   }
+  const size_t every = std::max(thinPoints(xIntact, fIntact, kMaxScatterPoints), thinPoints(xBroke, fBroke, kMaxScatterPoints));
+  const std::string shown = every > 1 ? fmt::format(" (every {}th shown)", every) : "";
   SvgPlot along("Impact positions along the hull", "distance from stem x [m]", "impact force fn [kN]");
   along.addScatter("floe stayed whole", xIntact, fIntact, plotColor(0), 2.5);
   along.addScatter("floe broke", xBroke, fBroke, plotColor(1), 2.5);
   along.setLegendRight(true);
-  along.addNote(summary);
+  along.addNote(summary + shown);
   write(along, "impact_positions");
 
+  std::vector<double> t = c[0], f = fn;
+  const size_t everyT = thinPoints(t, f, kMaxScatterPoints);
   SvgPlot vsTime("Impact forces over the run", "time t [s]", "impact force fn [kN]");
-  vsTime.addScatter("", c[0], fn, plotColor(2), 2.5);
-  vsTime.addNote(summary);
+  vsTime.addScatter("", t, f, plotColor(2), 2.5);
+  vsTime.addNote(summary + (everyT > 1 ? fmt::format(" (every {}th shown)", everyT) : ""));
   write(vsTime, "impact_force_vs_time");
 }
 

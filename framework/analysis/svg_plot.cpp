@@ -93,6 +93,31 @@ std::string plotColor(std::size_t i) {
   return kPalette[i % (sizeof(kPalette) / sizeof(kPalette[0]))];
 }
 
+std::size_t thinPoints(std::vector<double>& x, std::vector<double>& y, std::size_t maxPoints) {
+  const size_t k = (x.size() + maxPoints - 1) / std::max<size_t>(maxPoints, 1);
+  if (k <= 1) return 1;
+  size_t j = 0;
+  for (size_t i = 0; i < x.size(); i += k, ++j) x[j] = x[i], y[j] = y[i];
+  x.resize(j), y.resize(j);
+  return k;
+}
+
+void envelopeLine(std::vector<double>& x, std::vector<double>& y, std::size_t maxPoints) {
+  const size_t n = std::min(x.size(), y.size()), runs = std::max<size_t>(maxPoints / 2, 1);
+  if (n <= maxPoints) return;
+  std::vector<double> ex, ey;
+  for (size_t r = 0; r < runs; ++r) {
+    const size_t from = r * n / runs, to = (r + 1) * n / runs;
+    size_t lo = from, hi = from;
+    for (size_t i = from; i < to; ++i) {  // NaN compares false: a gap stays a gap only if all of the run is one
+      if (y[i] < y[lo] || std::isnan(y[lo])) lo = i;
+      if (y[i] > y[hi] || std::isnan(y[hi])) hi = i;
+    }
+    for (size_t i : {std::min(lo, hi), std::max(lo, hi)}) ex.push_back(x[i]), ey.push_back(y[i]);
+  }
+  x = std::move(ex), y = std::move(ey);
+}
+
 SvgPlot::SvgPlot(std::string title, std::string xLabel, std::string yLabel) : m_title(std::move(title)) {
   m_x.label = std::move(xLabel);
   m_y.label = std::move(yLabel);

@@ -25,6 +25,13 @@ enum class AxisScale {
 // The i-th colour of a fixed, colour-blind-friendly palette (cycles).
 std::string plotColor(std::size_t i);
 
+// Every k-th point so that at most maxPoints remain; returns k (1: none dropped). For scatter
+// plots: tens of thousands of circles make an SVG slow to open without showing more.
+std::size_t thinPoints(std::vector<double>& x, std::vector<double>& y, std::size_t maxPoints);
+// A line of more than maxPoints points reduced to the lowest and highest point of each run of
+// consecutive ones, in order: it looks the same (every spike kept) at a fraction of the size.
+void envelopeLine(std::vector<double>& x, std::vector<double>& y, std::size_t maxPoints);
+
 class SvgPlot {
  public:
   SvgPlot(std::string title, std::string xLabel, std::string yLabel);
