@@ -102,6 +102,14 @@ TEST(Movie, StillShowsTheFloesAndTwoFramesDiffer) {
   long differing = 0;
   for (size_t i = 0; i < a.argb.size(); ++i) differing += a.argb[i] != b.argb[i];
   EXPECT_GT(differing, 2000) << "frames 0 and 25 look alike: the vessel has moved 15 s between them";
+  // Coloured by id, the floes take many colours and the thickness scale's is gone (no colour bar).
+  const fs::path byId = dir.path() / "id.png";
+  ASSERT_EQ(test::runGem("movie " + run.string() + " --still 0 --color id --size 640x360 --out " + byId.string(), dir.path() / "still.log"),
+            0)
+      << test::readFile(dir.path() / "still.log");
+  const test::Picture c = test::readPng(byId);
+  EXPECT_LT(c.count(kThinnest, 8), 50);
+  EXPECT_GT(c.count(kWater), 5000);
 }
 
 TEST(Movie, AFolderWithoutFramesIsRefusedByName) {

@@ -124,6 +124,8 @@ MovieResult writeMovie(const MovieOptions& o) {
   const auto [width, height] = parseSize(o.size);
   if (o.fps < 1 || o.fps > 240) throw InputError(fmt::format("--fps {}: expected 1 to 240 frames per second", o.fps));
   const FrameColor color = parseFrameColor(o.color);
+  if (o.still && (o.out.empty() || o.out.extension() != ".png"))
+    throw InputError("--still needs --out FILE.png: where to write the picture");
   if (!fs::is_directory(o.runDir)) throw InputError(o.runDir.string() + ": no such run folder");
   const fs::path ice = o.runDir / "frames.ice";
   if (!fs::exists(ice))
@@ -140,7 +142,6 @@ MovieResult writeMovie(const MovieOptions& o) {
   if (o.still) {
     const long k = *o.still;
     if (k < 0 || size_t(k) >= frames) throw InputError(fmt::format("--still {}: {} holds frames 0 to {}", k, ice.string(), frames - 1));
-    if (o.out.empty() || o.out.extension() != ".png") throw InputError("--still needs --out FILE.png: where to write the picture");
     size_t index = 0;
     forEachFrame(ice, [&](const FrameState& frame) {
       if (index == size_t(k)) painter.draw(canvas, frame, index);
