@@ -254,6 +254,9 @@ TEST(Sweep, CaseIndexRunsExactlyOne) {
   for (const auto& entry : fs::directory_iterator(out / "cases")) complete += fs::exists(entry.path() / "summary.json");
   EXPECT_EQ(complete, 1);
   EXPECT_TRUE(fs::exists(out / "cases" / "bollard_thrust=92000,concentration=0.25" / "summary.json"));
+  // Unlike gem run, a sweep's case makes no plots: they would slow a large sweep for figures
+  // nobody looks at case by case (gem plot draws one when wanted).
+  EXPECT_FALSE(fs::exists(out / "cases" / "bollard_thrust=92000,concentration=0.25" / "plots"));
   EXPECT_EQ(lines(out / "summary.csv").size(), 2u);
   EXPECT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --case-index 4", log), 2);
 }

@@ -17,6 +17,7 @@
 #include "framework/output/atomic_file.hpp"
 #include "framework/output/csv_field.hpp"
 #include "framework/api/errors.hpp"
+#include "framework/analysis/csv_columns.hpp"
 #include "framework/analysis/statistics.hpp"
 #include "framework/analysis/svg_plot.hpp"
 
@@ -73,69 +74,6 @@ struct GroupStatistics {
   LognormalFit mass;
   PowerLawFit vsStem, vsVn, vsShipSpeed;
 };
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> cells;
-  std::stringstream in(line);
-  std::string cell;
-  while (std::getline(in, cell, ',')) cells.push_back(cell);
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
-}
-
-double parseNumber(const std::string& text, const fs::path& file, int line, const std::string& column) {
-  std::string s = text;
-  while (!s.empty() && (s.back() == '\r' || s.back() == ' ')) s.pop_back();
-  double v = 0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size() || s.empty())
-    throw InputError(file.string(), line, 0, fmt::format("column {}: \"{}\" is not a number", column, text));
-  return v;
-}
-
-// The values a column of GEM's own files can hold: an edited file outside them is refused (naming
-// the line) rather than plotted (an apex of 1e7 deg made a 5-degree histogram of 150 MB).
-struct ColumnRange {
-  const char* column;
-  double lo, hi;
-  const char* why;
-};
-constexpr ColumnRange kColumnRanges[] = {
-    {"apex_deg", 0, 180, "an apex angle is 0 to 180 degrees"},
-    {"y_from_centerline", -1e4, 1e4, "no hull is 20 km wide"},
-    {"x_from_stem", -1e5, 1e5, "no hull is 100 km long"},
-};
-
-// A CSV with a header row, as numbers by column name (only the columns asked for).
-std::vector<std::vector<double>> readColumns(const fs::path& file, const std::vector<std::string>& wanted) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string() + ": cannot be opened");
-  std::string line;
-  if (!std::getline(in, line)) throw InputError(file.string(), 1, 0, "empty file: expected a header row");
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  const std::vector<std::string> header = splitCsv(line);
-  std::vector<size_t> index;
-  for (const std::string& w : wanted) {
-    const auto it = std::find(header.begin(), header.end(), w);
-    if (it == header.end()) throw InputError(file.string(), 1, 0, fmt::format("no column \"{}\" in the header", w));
-    index.push_back(size_t(it - header.begin()));
-  }
-  std::vector<std::vector<double>> columns(wanted.size());
-  for (int lineNo = 2; std::getline(in, line); ++lineNo) {
-    if (line.empty() || line == "\r") continue;
-    const std::vector<std::string> cells = splitCsv(line);
-    if (cells.size() != header.size())
-      throw InputError(file.string(), lineNo, 0, fmt::format("{} cells, the header has {}", cells.size(), header.size()));
-    for (size_t c = 0; c < wanted.size(); ++c) {
-      const double v = parseNumber(cells[index[c]], file, lineNo, wanted[c]);
-      for (const ColumnRange& r : kColumnRanges)
-        if (wanted[c] == r.column && std::isfinite(v) && !(v >= r.lo && v <= r.hi))
-          throw InputError(file.string(), lineNo, 0, fmt::format("column {}: {} is outside {} to {} ({})", r.column, v, r.lo, r.hi, r.why));
-      columns[c].push_back(v);
-    }
-  }
-  return columns;
-}
 
 // One run folder: its impacts, with the ship speed at each impact interpolated from timeseries.csv
 // (thesis Figure 6.36 plots force against ship speed, which impacts.csv does not hold).
@@ -260,15 +198,7 @@ std::vector<double> logSpaced(double lo, double hi, int n) {
   return v;
 }
 
-// Every k-th point so that at most kMaxScatterPoints remain; returns k.
-size_t thin(std::vector<double>& x, std::vector<double>& y) {
-  const size_t k = (x.size() + kMaxScatterPoints - 1) / kMaxScatterPoints;
-  if (k <= 1) return 1;
-  size_t j = 0;
-  for (size_t i = 0; i < x.size(); i += k, ++j) x[j] = x[i], y[j] = y[i];
-  x.resize(j), y.resize(j);
-  return k;
-}
+size_t thin(std::vector<double>& x, std::vector<double>& y) { return thinPoints(x, y, kMaxScatterPoints); }
 
 // Groups drawn as separate series: the prefix groups, or "all" alone when it is the only one.
 std::vector<size_t> drawnGroups(const std::vector<Group>& groups) {

@@ -6,34 +6,12 @@
 
 #include <fmt/format.h>
 
+#include "framework/analysis/cairo_canvas.hpp"
 #include "framework/output/atomic_file.hpp"
 
 namespace gem {
 
 namespace {
-
-std::string escapeXml(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 // Data value -> axis coordinate (before the affine map to pixels); NaN when not drawable.
 double transform(AxisScale scale, double v) {
@@ -115,6 +93,31 @@ std::string plotColor(std::size_t i) {
   return kPalette[i % (sizeof(kPalette) / sizeof(kPalette[0]))];
 }
 
+std::size_t thinPoints(std::vector<double>& x, std::vector<double>& y, std::size_t maxPoints) {
+  const size_t k = (x.size() + maxPoints - 1) / std::max<size_t>(maxPoints, 1);
+  if (k <= 1) return 1;
+  size_t j = 0;
+  for (size_t i = 0; i < x.size(); i += k, ++j) x[j] = x[i], y[j] = y[i];
+  x.resize(j), y.resize(j);
+  return k;
+}
+
+void envelopeLine(std::vector<double>& x, std::vector<double>& y, std::size_t maxPoints) {
+  const size_t n = std::min(x.size(), y.size()), runs = std::max<size_t>(maxPoints / 2, 1);
+  if (n <= maxPoints) return;
+  std::vector<double> ex, ey;
+  for (size_t r = 0; r < runs; ++r) {
+    const size_t from = r * n / runs, to = (r + 1) * n / runs;
+    size_t lo = from, hi = from;
+    for (size_t i = from; i < to; ++i) {  // NaN compares false: a gap stays a gap only if all of the run is one
+      if (y[i] < y[lo] || std::isnan(y[lo])) lo = i;
+      if (y[i] > y[hi] || std::isnan(y[hi])) hi = i;
+    }
+    for (size_t i : {std::min(lo, hi), std::max(lo, hi)}) ex.push_back(x[i]), ey.push_back(y[i]);
+  }
+  x = std::move(ex), y = std::move(ey);
+}
+
 SvgPlot::SvgPlot(std::string title, std::string xLabel, std::string yLabel) : m_title(std::move(title)) {
   m_x.label = std::move(xLabel);
   m_y.label = std::move(yLabel);
@@ -135,7 +138,7 @@ void SvgPlot::addSteps(std::string label, std::vector<double> edges, std::vector
   m_series.push_back({Kind::Steps, std::move(label), color.empty() ? nextColor() : std::move(color), std::move(edges), std::move(values)});
 }
 
-std::string SvgPlot::render(int width, int height) const {
+void SvgPlot::draw(PlotCanvas& canvas, int width, int height) const {
   // Data ranges in transformed coordinates over every drawable point.
   double xLo = INFINITY, xHi = -INFINITY, yLo = INFINITY, yHi = -INFINITY;
   for (const Series& s : m_series) {
@@ -174,66 +177,51 @@ std::string SvgPlot::render(int width, int height) const {
   auto px = [&](double t) { return left + (t - xLo) / (xHi - xLo) * (right - left); };
   auto py = [&](double t) { return bottom - (t - yLo) / (yHi - yLo) * (bottom - top); };
 
-  std::string svg = fmt::format(
-      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} {1}\" "
-      "font-family=\"DejaVu Sans, Arial, sans-serif\" font-size=\"12\">\n"
-      "<rect x=\"0\" y=\"0\" width=\"{0}\" height=\"{1}\" fill=\"white\"/>\n"
-      "<defs><clipPath id=\"plot-area\"><rect x=\"{2:.2f}\" y=\"{3:.2f}\" width=\"{4:.2f}\" height=\"{5:.2f}\"/>"
-      "</clipPath></defs>\n",
-      width, height, left, top, right - left, bottom - top);
-  svg += fmt::format("<text x=\"{:.1f}\" y=\"24\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">{}</text>\n",
-                     0.5 * (left + right), escapeXml(m_title));
+  canvas.rect(0, 0, width, height, {.fill = "#FFFFFF"});
+  canvas.text(0.5 * (left + right), 24, m_title, {.size = 15, .bold = true, .anchor = TextAnchor::Middle});
   for (size_t i = 0; i < m_notes.size(); ++i)
-    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"11\" fill=\"#444\">{}</text>\n",
-                       0.5 * (left + right), 40.0 + 14.0 * double(i), escapeXml(m_notes[i]));
+    canvas.text(0.5 * (left + right), 40.0 + 14.0 * double(i), m_notes[i], {.size = 11, .anchor = TextAnchor::Middle, .color = "#444444"});
 
   // Grid and ticks.
-  svg += "<g stroke=\"#e4e4e4\" stroke-width=\"1\">\n";
   const std::vector<Tick> xTicks = makeTicks(m_x.scale, xLo, xHi), yTicks = makeTicks(m_y.scale, yLo, yHi);
-  for (const Tick& t : xTicks)
-    svg += fmt::format("<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{0:.2f}\" y2=\"{2:.2f}\"/>\n", px(t.t), top, bottom);
-  for (const Tick& t : yTicks)
-    svg += fmt::format("<line x1=\"{1:.2f}\" y1=\"{0:.2f}\" x2=\"{2:.2f}\" y2=\"{0:.2f}\"/>\n", py(t.t), left, right);
-  svg += "</g>\n<g stroke=\"black\" stroke-width=\"1\">\n";
-  for (const Tick& t : xTicks)
-    svg += fmt::format("<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{0:.2f}\" y2=\"{2:.2f}\"/>\n", px(t.t), bottom, bottom + 5);
-  for (const Tick& t : yTicks)
-    svg += fmt::format("<line x1=\"{1:.2f}\" y1=\"{0:.2f}\" x2=\"{2:.2f}\" y2=\"{0:.2f}\"/>\n", py(t.t), left - 5, left);
-  svg += "</g>\n";
-  for (const Tick& t : xTicks)
-    svg += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" text-anchor=\"middle\">{}</text>\n", px(t.t), bottom + 18, escapeXml(t.label));
-  for (const Tick& t : yTicks)
-    svg += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" text-anchor=\"end\">{}</text>\n", left - 8, py(t.t) + 4, escapeXml(t.label));
-  svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"13\">{}</text>\n", 0.5 * (left + right),
-                     double(height) - 14, escapeXml(m_x.label));
-  svg +=
-      fmt::format("<text x=\"18\" y=\"{0:.1f}\" text-anchor=\"middle\" font-size=\"13\" transform=\"rotate(-90 18 {0:.1f})\">{1}</text>\n",
-                  0.5 * (top + bottom), escapeXml(m_y.label));
+  std::vector<PixelPath> grid, marks;
+  for (const Tick& t : xTicks) {
+    grid.push_back({{px(t.t), top}, {px(t.t), bottom}});
+    marks.push_back({{px(t.t), bottom}, {px(t.t), bottom + 5}});
+  }
+  for (const Tick& t : yTicks) {
+    grid.push_back({{left, py(t.t)}, {right, py(t.t)}});
+    marks.push_back({{left - 5, py(t.t)}, {left, py(t.t)}});
+  }
+  canvas.path(grid, false, {.stroke = "#E4E4E4"});
+  canvas.path(marks, false, {.stroke = "#000000"});
+  for (const Tick& t : xTicks) canvas.text(px(t.t), bottom + 18, t.label, {.anchor = TextAnchor::Middle});
+  for (const Tick& t : yTicks) canvas.text(left - 8, py(t.t) + 4, t.label, {.anchor = TextAnchor::End});
+  canvas.text(0.5 * (left + right), double(height) - 14, m_x.label, {.size = 13, .anchor = TextAnchor::Middle});
+  canvas.text(18, 0.5 * (top + bottom), m_y.label, {.size = 13, .anchor = TextAnchor::Middle, .vertical = true});
 
   // Series, clipped to the plot area (fixed ranges may cut them).
-  svg += "<g clip-path=\"url(#plot-area)\">\n";
+  canvas.clipTo(left, top, right - left, bottom - top);
   for (const Series& s : m_series) {
     if (s.kind == Kind::Scatter) {
-      svg += fmt::format("<g fill=\"{}\" fill-opacity=\"0.6\" stroke=\"none\">\n", s.color);
       const size_t n = std::min(s.x.size(), s.y.size());
       for (size_t i = 0; i < n; ++i) {
         const double tx = transform(m_x.scale, s.x[i]), ty = transform(m_y.scale, s.y[i]);
         if (std::isnan(tx) || std::isnan(ty)) continue;
-        svg += fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"{:.1f}\"/>\n", px(tx), py(ty), s.radius);
+        canvas.circle(px(tx), py(ty), s.radius, {.fill = s.color, .fillOpacity = 0.6});
       }
-      svg += "</g>\n";
       continue;
     }
     // Lines and steps: one path, broken where a point cannot be drawn.
-    std::string d;
+    std::vector<PixelPath> pieces;
     bool pen = false;
     auto point = [&](double tx, double ty) {
       if (std::isnan(tx) || std::isnan(ty)) {
         pen = false;
         return;
       }
-      d += fmt::format("{}{:.2f},{:.2f} ", pen ? "L" : "M", px(tx), py(ty));
+      if (!pen) pieces.emplace_back();
+      pieces.back().emplace_back(px(tx), py(ty));
       pen = true;
     };
     if (s.kind == Kind::Line) {
@@ -249,18 +237,14 @@ std::string SvgPlot::render(int width, int height) const {
         point(tx1, ty);
       }
       if (baseline && !s.y.empty() && s.x.size() > s.y.size()) point(transform(m_x.scale, s.x[s.y.size()]), 0.0);
-      if (baseline && !d.empty()) svg += fmt::format("<path d=\"{}Z\" fill=\"{}\" fill-opacity=\"0.12\" stroke=\"none\"/>\n", d, s.color);
+      if (baseline && !pieces.empty()) canvas.path(pieces, true, {.fill = s.color, .fillOpacity = 0.12});
     }
-    if (!d.empty())
-      svg += fmt::format("<path d=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1.6\"{}/>\n", d, s.color,
-                         s.dashed ? " stroke-dasharray=\"6 4\"" : "");
+    if (!pieces.empty()) canvas.path(pieces, false, {.stroke = s.color, .strokeWidth = 1.6, .dashed = s.dashed});
   }
-  svg += "</g>\n";
-  svg += fmt::format("<rect x=\"{:.2f}\" y=\"{:.2f}\" width=\"{:.2f}\" height=\"{:.2f}\" fill=\"none\" stroke=\"black\"/>\n", left, top,
-                     right - left, bottom - top);
+  canvas.clearClip();
+  canvas.rect(left, top, right - left, bottom - top, {.stroke = "#000000"});
   if (empty)
-    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"14\" fill=\"#888\">no data</text>\n",
-                       0.5 * (left + right), 0.5 * (top + bottom));
+    canvas.text(0.5 * (left + right), 0.5 * (top + bottom), "no data", {.size = 14, .anchor = TextAnchor::Middle, .color = "#888888"});
 
   // Legend, in a top corner inside the plot area.
   std::vector<const Series*> labelled;
@@ -271,24 +255,34 @@ std::string SvgPlot::render(int width, int height) const {
     for (const Series* s : labelled) longest = std::max(longest, s->label.size());
     const double w = 40 + 6.8 * double(longest), h = 8 + 16.0 * double(labelled.size());
     const double lx = m_legendRight ? right - 10 - w : left + 10, ly = top + 10;
-    svg += fmt::format(
-        "<g font-size=\"11\">\n<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"white\" "
-        "fill-opacity=\"0.85\" stroke=\"#999\"/>\n",
-        lx, ly, w, h);
+    canvas.rect(lx, ly, w, h, {.fill = "#FFFFFF", .fillOpacity = 0.85, .stroke = "#999999"});
     for (size_t i = 0; i < labelled.size(); ++i) {
       const Series& s = *labelled[i];
       const double y = ly + 14 + 16.0 * double(i);
       if (s.kind == Kind::Scatter)
-        svg += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"3\" fill=\"{}\"/>\n", lx + 16, y - 4, s.color);
+        canvas.circle(lx + 16, y - 4, 3, {.fill = s.color});
       else
-        svg += fmt::format("<path d=\"M{:.1f},{:.1f} L{:.1f},{:.1f}\" stroke=\"{}\" stroke-width=\"2\"{}/>\n", lx + 6, y - 4, lx + 26,
-                           y - 4, s.color, s.dashed ? " stroke-dasharray=\"6 4\"" : "");
-      svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n", lx + 32, y, escapeXml(s.label));
+        canvas.path({{{lx + 6, y - 4}, {lx + 26, y - 4}}}, false, {.stroke = s.color, .strokeWidth = 2, .dashed = s.dashed});
+      canvas.text(lx + 32, y, s.label, {.size = 11});
     }
-    svg += "</g>\n";
   }
-  svg += "</svg>\n";
-  return svg;
+}
+
+std::string SvgPlot::render(int width, int height) const {
+  SvgCanvas canvas(width, height);
+  draw(canvas, width, height);
+  return canvas.finish();
+}
+
+void SvgPlot::writePng(const std::filesystem::path& path, int width, int height) const {
+  CairoCanvas canvas(width, height);
+  draw(canvas, width, height);
+  canvas.writePng(path);
+}
+
+void SvgPlot::writeSvgAndPng(const std::filesystem::path& stem) const {
+  write(stem.string() + ".svg");
+  writePng(stem.string() + ".png");
 }
 
 void SvgPlot::write(const std::filesystem::path& path) const { writeFileAtomically(path, render()); }

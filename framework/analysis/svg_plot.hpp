@@ -1,13 +1,15 @@
 // A small hand-written SVG plotter for the figures of `gem analyze` (thesis Figures 6.31 to 6.38):
 // one plot area with linear, log or Weibull-probability axes, ticks and labels, scatter, lines,
-// histogram steps, a legend and a title. No external tools: the output is plain SVG 1.1 text that
-// any browser shows, so a run folder's plots need nothing installed beyond gem itself.
+// histogram steps, a legend and a title. The plot is drawn once on a PlotCanvas: as plain SVG 1.1
+// text that any browser shows, or through Cairo as a PNG.
 #pragma once
 #include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "framework/analysis/plot_canvas.hpp"
 
 namespace gem {
 
@@ -22,6 +24,13 @@ enum class AxisScale {
 
 // The i-th colour of a fixed, colour-blind-friendly palette (cycles).
 std::string plotColor(std::size_t i);
+
+// Every k-th point so that at most maxPoints remain; returns k (1: none dropped). For scatter
+// plots: tens of thousands of circles make an SVG slow to open without showing more.
+std::size_t thinPoints(std::vector<double>& x, std::vector<double>& y, std::size_t maxPoints);
+// A line of more than maxPoints points reduced to the lowest and highest point of each run of
+// consecutive ones, in order: it looks the same (every spike kept) at a fraction of the size.
+void envelopeLine(std::vector<double>& x, std::vector<double>& y, std::size_t maxPoints);
 
 class SvgPlot {
  public:
@@ -43,9 +52,15 @@ class SvgPlot {
   // A histogram outline: edges has one more entry than values.
   void addSteps(std::string label, std::vector<double> edges, std::vector<double> values, std::string color = "");
 
+  // Draws the plot on any canvas: the SVG text and the PNG come from this one drawing.
+  void draw(PlotCanvas& canvas, int width, int height) const;
   std::string render(int width = 800, int height = 520) const;
   // Writes render() through writeFileAtomically.
   void write(const std::filesystem::path& path) const;
+  // The same plot as a PNG through Cairo, written atomically.
+  void writePng(const std::filesystem::path& path, int width = 800, int height = 520) const;
+  // STEM.svg and STEM.png.
+  void writeSvgAndPng(const std::filesystem::path& stem) const;
 
  private:
   enum class Kind { Scatter, Line, Steps };

@@ -1,4 +1,5 @@
-// The gem command (docs/scenario.md "Command line"): run, check, info, bench.
+// The gem command (docs/scenario.md "Command line"): run, check, info, bench, sweep, analyze, plot,
+// movie.
 // Exit status: 0 success; 2 bad input (with file, line and column or key); 1 any other failure.
 #include <unistd.h>
 
@@ -12,6 +13,8 @@
 #include <fmt/format.h>
 
 #include "framework/analysis/analyze.hpp"
+#include "framework/analysis/movie.hpp"
+#include "framework/analysis/run_plots.hpp"
 #include "bench/bench.hpp"
 #include "framework/app/calibration.hpp"
 #include "framework/api/errors.hpp"
@@ -40,6 +43,7 @@ struct RunArguments {
   std::vector<std::string> set;
   bool quiet = false;
   std::string commandLine;  // for gem.log
+  bool noPlots = false;     // gem run --no-plots
 };
 
 Scenario load(const RunArguments& a) {
@@ -101,6 +105,16 @@ void reportRun(RunLog& log, const RunSummary& r) {
                   r.outputDir));
 }
 
+// gem plot, and the end of gem run: the run folder's plots, each file named as written.
+int commandPlot(const fs::path& dir, bool quiet) {
+  const RunPlots plots = writeRunPlots(dir);
+  if (quiet) return 0;
+  std::printf("gem plot %s: %zu files in %s\n", dir.c_str(), plots.files.size(), (dir / "plots").c_str());
+  for (const fs::path& f : plots.files) std::printf("  %s\n", f.filename().c_str());
+  for (const std::string& note : plots.notes) std::printf("  note: %s\n", note.c_str());
+  return 0;
+}
+
 int commandRun(const RunArguments& a) {
   const Scenario s = load(a);
   RunOptions options;
@@ -113,6 +127,7 @@ int commandRun(const RunArguments& a) {
     const RunSummary r = runScenario(s, options);
     log.note(fmt::format("  device         {} ({} driver)", r.device, r.driver));
     reportRun(log, r);
+    if (!a.noPlots) commandPlot(r.outputDir, a.quiet);
     log.write(s.output.dir, 0);
     return 0;
   } catch (const InputError& e) {
@@ -201,6 +216,7 @@ int main(int argc, char** argv) {
   addRunOptions(run);
   run->add_option("--out", args.out, "run folder (default: output.dir of the scenario, else runs/NAME)");
   run->add_flag("--quiet", args.quiet, "no progress line and no summary");
+  run->add_flag("--no-plots", args.noPlots, "do not write RUN/plots/ at the end (gem plot RUN writes them later)");
   CLI::App* check = app.add_subcommand("check", "load and validate a scenario without running it");
   addRunOptions(check);
   check->add_flag("--quiet", args.quiet, "print nothing when the scenario is valid");
@@ -249,6 +265,22 @@ int main(int argc, char** argv) {
   analyzeCommand->add_option("--groups", analyze.groups, "case-name prefixes to analyse, e.g. 121,004,040,400")->delimiter(',');
   analyzeCommand->add_flag("--quiet", analyze.quiet, "print nothing but errors");
 
+  std::string plotDir;
+  bool plotQuiet = false;
+  CLI::App* plotCommand = app.add_subcommand("plot", "PNG and SVG plots of a run folder: time series and impact loads, in RUN/plots/");
+  plotCommand->add_option("dir", plotDir, "run folder")->required();
+  plotCommand->add_flag("--quiet", plotQuiet, "print nothing but errors");
+
+  MovieOptions movie;
+  std::string movieOut;
+  CLI::App* movieCommand = app.add_subcommand("movie", "an MP4 of a run's frames (frames.ice) through ffmpeg, or one frame as a PNG");
+  movieCommand->add_option("dir", movie.runDir, "run folder")->required();
+  movieCommand->add_option("--out", movieOut, "movie file (default RUN/movie.mp4); with --still, the PNG");
+  movieCommand->add_option("--fps", movie.fps, "frames per second (default 10: one movie frame per saved frame)");
+  movieCommand->add_option("--color", movie.color, "what colours the floes: speed (default), thickness or id");
+  movieCommand->add_option("--size", movie.size, "WxH in pixels, each even (default 1280x720)");
+  movieCommand->add_option("--still", movie.still, "write frame K (0-based) as a PNG to --out instead of the movie");
+
   SweepOptions sweep;
   CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
   sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
@@ -279,6 +311,14 @@ int main(int argc, char** argv) {
     if (*benchCommand) return runBench(bench);
     if (*sweepCommand) return runSweep(sweep);
     if (*analyzeCommand) return runAnalyze(analyze);
+    if (*plotCommand) return commandPlot(plotDir, plotQuiet);
+    if (*movieCommand) {
+      movie.out = movieOut;
+      const MovieResult m = writeMovie(movie);
+      std::printf("gem movie %s: %s (%zu frame%s, %d x %d)\n", movie.runDir.c_str(), m.file.c_str(), m.frames, m.frames == 1 ? "" : "s",
+                  m.width, m.height);
+      return 0;
+    }
     if (*calibrateCommand) return runCalibration(calibrationFile, calibrationOut, false) <= 0.02 ? 0 : 1;
     return commandInfo(infoPlugins);
   } catch (const InputError& e) {

@@ -22,7 +22,8 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
   };
   // gem-run.toml: GEM 0.2's name for scenario.toml. scenario.toml itself is not removed: it is
   // rewritten whole by recordScenario (and may be the very file this run reads).
-  std::vector<std::string> files{"summary.json", "state.csv", "timeseries.csv", "frames.pvd", "frames.ice", "gem.log", "gem-run.toml"};
+  std::vector<std::string> files{"summary.json", "state.csv", "timeseries.csv", "frames.pvd",
+                                 "frames.ice",   "gem.log",   "gem-run.toml",   kMovieFile};
   files.insert(files.end(), recordFiles.begin(), recordFiles.end());
   for (const std::string& f : files) fs::remove(dir / f, ec);
   const fs::path frames = dir / "frames";
@@ -30,6 +31,15 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
     for (const auto& entry : fs::directory_iterator(frames, ec))
       if (entry.path().extension() == ".vtp" || staleTemporary(entry.path())) fs::remove(entry.path(), ec);
     if (fs::is_empty(frames, ec)) fs::remove(frames, ec);
+  }
+  // The old plots describe the old run: gone, whether or not this run makes new ones (--no-plots).
+  const fs::path plots = dir / "plots";
+  if (fs::is_directory(plots, ec)) {
+    for (const char* name : kRunPlotNames)
+      for (const char* extension : {".svg", ".png"}) fs::remove(plots / (std::string(name) + extension), ec);
+    for (const auto& entry : fs::directory_iterator(plots, ec))
+      if (staleTemporary(entry.path())) fs::remove(entry.path(), ec);
+    if (fs::is_empty(plots, ec)) fs::remove(plots, ec);
   }
   for (const auto& entry : fs::directory_iterator(dir, ec))
     if (entry.is_regular_file() && staleTemporary(entry.path())) fs::remove(entry.path(), ec);

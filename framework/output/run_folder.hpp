@@ -10,10 +10,17 @@
 
 namespace gem {
 
+// The plots `gem plot` writes into RUN/plots/, each as NAME.svg and NAME.png (run_plots.hpp), and
+// the movie `gem movie` writes by default: listed here so that a re-run removes them.
+inline constexpr const char* kRunPlotNames[] = {"ship_speed",        "net_thrust",       "ice_force",           "contacts",
+                                                "impact_force_hist", "impact_positions", "impact_force_vs_time"};
+inline constexpr const char* kMovieFile = "movie.mp4";
+
 // Removes GEM's own outputs of an earlier run from dir (never other files): summary.json,
 // state.csv, timeseries.csv, the record streams' files (`recordFiles`), frames.pvd, frames.ice,
-// frames/*.vtp (and frames/ when that leaves it empty), and *.tmp-PID temporaries. Call it holding
-// the folder's lock (RunFolderLock): no other run of GEM is writing there.
+// frames/*.vtp (and frames/ when that leaves it empty), the plots (kRunPlotNames, and plots/ when
+// that leaves it empty), movie.mp4, and *.tmp-PID temporaries. Call it holding the folder's lock
+// (RunFolderLock): no other run of GEM is writing there.
 void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles);
 
 // Writes dir/scenario.toml: the scenario as this run read it (every --set applied, the [simulation]
