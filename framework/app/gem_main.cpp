@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "framework/analysis/analyze.hpp"
+#include "framework/analysis/view_page.hpp"
 #include "bench/bench.hpp"
 #include "framework/app/calibration.hpp"
 #include "framework/api/errors.hpp"
@@ -223,6 +224,14 @@ int main(int argc, char** argv) {
   analyzeCommand->add_option("--groups", analyze.groups, "case-name prefixes to analyse, e.g. 121,004,040,400")->delimiter(',');
   analyzeCommand->add_flag("--quiet", analyze.quiet, "print nothing but errors");
 
+  ViewOptions view;
+  CLI::App* viewCommand = app.add_subcommand("view", "one self-contained HTML page that plays a run's frames in a browser");
+  viewCommand->add_option("dir", view.dir, "run folder (with frames.ice)")->required();
+  viewCommand->add_option("--out", view.out, "the page (default DIR/view.html)");
+  viewCommand->add_option("--every", view.every, "keep every N-th frame and the last (default: all, thinned above 300 MB)")
+      ->check(CLI::PositiveNumber);
+  viewCommand->add_flag("--quiet", view.quiet, "print nothing but errors");
+
   SweepOptions sweep;
   CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
   sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
@@ -253,6 +262,7 @@ int main(int argc, char** argv) {
     if (*benchCommand) return runBench(bench);
     if (*sweepCommand) return runSweep(sweep);
     if (*analyzeCommand) return runAnalyze(analyze);
+    if (*viewCommand) return runView(view);
     if (*calibrateCommand) return runCalibration(calibrationFile, calibrationOut, false) <= 0.02 ? 0 : 1;
     return commandInfo(infoPlugins);
   } catch (const InputError& e) {
