@@ -13,6 +13,7 @@
 #endif
 
 #include "framework/analysis/frame_series.hpp"
+#include "framework/analysis/view_page.hpp"
 #include "test_support.hpp"
 
 using namespace gem;
@@ -161,6 +162,22 @@ TEST(View, EveryNthFrameKeepsTheLast) {
   ASSERT_EQ(test::runGem("view " + r.run.string() + " --every 5 --out " + (dir.path() / "thin.html").string(), dir.path() / "log"), 0);
   // Frames 0, 5, 10 and the last, 12.
   EXPECT_NE(test::readFile(dir.path() / "thin.html").find("<meta name=\"gem-frames\" content=\"4\">"), std::string::npos);
+}
+
+TEST(View, TooLargeAPageIsThinned) {
+  const ViewedRun& r = sharedRun();
+  ASSERT_EQ(r.status, 0) << r.log;
+  TempDir dir;
+  ViewOptions options;
+  options.dir = r.run.string();
+  options.out = (dir.path() / "thin.html").string();
+  options.quiet = true;
+  options.maxBytes = 1;  // any page is too large: every frame but the first and the last goes
+  EXPECT_EQ(runView(options), 0);
+  const std::string html = test::readFile(dir.path() / "thin.html");
+  EXPECT_NE(html.find("<meta name=\"gem-frames\" content=\"2\">"), std::string::npos);
+  EXPECT_NE(html.find("<meta name=\"gem-frame-every\" content=\""), std::string::npos);
+  EXPECT_EQ(html.find("<meta name=\"gem-frame-every\" content=\"1\">"), std::string::npos);
 }
 
 TEST(View, FolderWithoutFramesIsRefused) {

@@ -122,7 +122,8 @@ ViewPack packFrames(const std::filesystem::path& iceFile, int every) {
       for (const Vec2& p : b.vertices) minX = std::min(minX, double(p.x)), maxX = std::max(maxX, double(p.x));
       for (const Vec2& p : b.vertices) minY = std::min(minY, double(p.y)), maxY = std::max(maxY, double(p.y));
       if (b.kind == BodyKind::Floe) {
-        if (floeSpeeds.size() < 4000000) floeSpeeds.push_back(float(speed));
+        // Floes at rest would pull the scale to zero in a large still field: only moving ones count.
+        if (speed > 1e-3 && floeSpeeds.size() < 4000000) floeSpeeds.push_back(float(speed));
         minT = std::min(minT, double(b.thickness)), maxT = std::max(maxT, double(b.thickness));
       }
     }
@@ -145,7 +146,7 @@ ViewPack packFrames(const std::filesystem::path& iceFile, int every) {
   if (!floeSpeeds.empty()) {
     const size_t k = floeSpeeds.size() * 99 / 100;
     std::nth_element(floeSpeeds.begin(), floeSpeeds.begin() + long(k), floeSpeeds.end());
-    pack.speedScale = std::max(double(floeSpeeds[k]), 1e-3);
+    pack.speedScale = std::max(double(floeSpeeds[k]), 1e-2);
   }
   return pack;
 }

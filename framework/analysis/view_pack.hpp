@@ -33,7 +33,7 @@ struct ViewPack {
   std::vector<ViewFrame> frames;
   int every = 1;                                  // frames kept: every N-th of the file's, and the last
   double minX = 0, minY = 0, maxX = 0, maxY = 0;  // bounds of every body over the frames kept
-  double speedScale = 1;                          // m/s: the 99th percentile of floe speeds
+  double speedScale = 1;                          // m/s: the 99th percentile of moving floes' speeds
   double minThickness = 0, maxThickness = 0;      // m, over the floes
   std::uint64_t payloadBytes() const;             // the binary data the page will embed
 };

@@ -207,13 +207,13 @@ int runView(const ViewOptions& options) {
   ViewPack pack = packFrames(dir / "frames.ice", std::max(options.every, 1));
   const size_t framesRead = pack.frames.size();
   // Base64 makes 4 bytes of 3; the script, series and impacts are small beside the frames.
-  const auto estimate = [&] { return pack.payloadBytes() * 4 / 3; };
-  if (options.every == 0 && estimate() > kViewMaxBytes) {
-    const int thin = int(estimate() / kViewMaxBytes) + 1;
+  const std::uint64_t estimate = pack.payloadBytes() * 4 / 3;
+  if (options.every == 0 && estimate > options.maxBytes) {
+    const int thin = int(estimate / std::max<std::uint64_t>(options.maxBytes, 1)) + 1;
     thinFrames(pack, thin);
     if (!options.quiet)
       std::printf("gem view: all %zu frames would make a page of about %llu MB; keeping every %d-th (--every N to choose)\n", framesRead,
-                  static_cast<unsigned long long>(estimate() * thin >> 20), thin);
+                  static_cast<unsigned long long>(estimate >> 20), thin);
   }
 
   const std::map<std::string, std::string> summary = readSummary(dir);
