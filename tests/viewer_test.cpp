@@ -2,6 +2,7 @@
 // must draw without a script error, show floes on its canvas, and change when stepped.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <cstring>
@@ -14,6 +15,7 @@
 
 #include "framework/analysis/frame_series.hpp"
 #include "framework/analysis/view_page.hpp"
+#include "framework/world/constants.hpp"
 #include "test_support.hpp"
 
 using namespace gem;
@@ -59,7 +61,7 @@ ViewedRun& sharedRun() {
 }
 
 struct Browsed {
-  std::string title, stderrText;
+  std::string title, stderrText, dom;
   int status = -1;
 };
 
@@ -79,8 +81,8 @@ Browsed browse(const TempDir& dir, const std::filesystem::path& page, const std:
   b.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   b.stderrText = test::readFile(err);
   std::smatch m;
-  const std::string dom = test::readFile(out);
-  if (std::regex_search(dom, m, std::regex("<title>([^<]*)</title>"))) b.title = m[1];
+  b.dom = test::readFile(out);
+  if (std::regex_search(b.dom, m, std::regex("<title>([^<]*)</title>"))) b.title = m[1];
   return b;
 }
 
@@ -208,6 +210,24 @@ TEST(View, DrawsInHeadlessChromiumAndStepping) {
   const Browsed byId = browse(dir, r.page, "frame=3&color=id", "--dump-dom");
   EXPECT_EQ(byId.title, "gem view: frame 3 drawn") << byId.stderrText;
   expectNoScriptErrors(byId);
+
+  // Hovering a floe (#hover puts the pointer on a world point) shows its id and mass.
+  const FrameState start = readFrameSeries(r.run / "frames.ice").front();
+  const auto floe = std::find_if(start.bodies.begin(), start.bodies.end(), [](const FrameBody& b) { return b.kind == BodyKind::Floe; });
+  ASSERT_NE(floe, start.bodies.end());
+  double cx = 0, cy = 0, area = 0;  // the vertex mean lies inside a convex polygon
+  for (size_t k = 0; k < floe->vertices.size(); ++k) {
+    const Vec2 p = floe->vertices[k], q = floe->vertices[(k + 1) % floe->vertices.size()];
+    cx += p.x / double(floe->vertices.size()), cy += p.y / double(floe->vertices.size());
+    area += (p.x * q.y - q.x * p.y) / 2;
+  }
+  const Browsed hover = browse(dir, r.page, "frame=0&hover=" + std::to_string(cx) + "," + std::to_string(cy), "--dump-dom");
+  expectNoScriptErrors(hover);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(hover.dom, m, std::regex("<div id=\"tip\"[^>]*>floe (\\d+)\\s+mass ([0-9.e+]+) t")))
+      << hover.dom.substr(0, 3000);
+  EXPECT_EQ(std::stoll(m[1]), floe->id);
+  EXPECT_NEAR(std::stod(m[2]), area * floe->thickness * kRhoIce / 1000, 1e-3 * area * floe->thickness * kRhoIce / 1000);
 
 #ifdef GEM_HAVE_CAIRO
   const auto firstPng = dir.path() / "first.png", lastPng = dir.path() / "last.png";

@@ -329,6 +329,10 @@ window.addEventListener("unhandledrejection", function (e) { document.title = "g
     }
     const r = view.getBoundingClientRect();
     const wx = centreX + (e.clientX - r.left - cssWidth / 2) / scale, wy = centreY - (e.clientY - r.top - cssHeight / 2) / scale;
+    showFacts(wx, wy, e.clientX, e.clientY);
+  });
+  // The tip beside the pointer (clientX, clientY) with the facts of the body at world point (wx, wy).
+  function showFacts(wx, wy, clientX, clientY) {
     const hit = bodyAt(wx, wy);
     if (hit < 0) { tip.style.display = "none"; return; }
     const f = frameData(current), s = f.list[hit], kind = shape.kind[s];
@@ -336,10 +340,10 @@ window.addEventListener("unhandledrejection", function (e) { document.title = "g
     tip.textContent = kinds[kind] + " " + shape.id[s] + (shape.piece[s] ? " (broken piece)" : "") +
       (kind === 0 ? "\nmass " + (mass / 1000).toPrecision(4) + " t\nthickness " + shape.thickness[s].toPrecision(3) + " m" : "") +
       "\nspeed " + f.poses[4 * hit + 3].toPrecision(3) + " m/s";
-    tip.style.left = e.clientX + 14 + "px";
-    tip.style.top = e.clientY + 14 + "px";
+    tip.style.left = clientX + 14 + "px";
+    tip.style.top = clientY + 14 + "px";
     tip.style.display = "block";
-  });
+  }
   // The body under a world point: bounding circle first, then the polygon in the shape's frame.
   function bodyAt(wx, wy) {
     const f = frameData(current), list = f.list, poses = f.poses;
@@ -357,7 +361,8 @@ window.addEventListener("unhandledrejection", function (e) { document.title = "g
     return -1;
   }
 
-  // #frame=K (negative: from the end) opens paused at K; #color=speed|thickness|id; #fps=N; #play=1.
+  // #frame=K (negative: from the end) opens paused at K, with #hover=X,Y the facts of the body at
+  // world point X,Y; #color=speed|thickness|id; #fps=N; #play=0 keeps a page without frame paused.
   function applyHash() {
     const p = new URLSearchParams(location.hash.slice(1));
     const colour = p.get("color") || p.get("colour");
@@ -368,6 +373,12 @@ window.addEventListener("unhandledrejection", function (e) { document.title = "g
       const k = p.get("frame") === "last" ? frameCount - 1 : Number(p.get("frame"));
       setPlaying(false);
       show(k < 0 ? frameCount + k : k);
+      // hover=X,Y (world, m): the facts of the body there, as if the pointer were on it.
+      const at = (p.get("hover") || "").split(",").map(Number);
+      if (at.length === 2 && at.every(Number.isFinite)) {
+        const r = view.getBoundingClientRect();
+        showFacts(at[0], at[1], r.left + (at[0] - centreX) * scale + cssWidth / 2, r.top + cssHeight / 2 - (at[1] - centreY) * scale);
+      }
     } else {
       show(current);
       if (p.get("play") !== "0") setPlaying(true);
