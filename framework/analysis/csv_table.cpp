@@ -29,6 +29,7 @@ std::vector<double> CsvTable::numbers(const std::string& name) const {
     while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
     while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
     if (s.starts_with('+')) s.remove_prefix(1);
+    // Empty cells are "no value" (timeseries.csv's ship columns in a run without a vessel).
     double v = std::numeric_limits<double>::quiet_NaN();
     if (!s.empty()) {
       const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
@@ -67,6 +68,8 @@ CsvTable readCsvTable(const std::filesystem::path& file) {
     anyText = false;
     rowLine = line;
   };
+  // One pass over the characters: a quoted field may hold the line breaks and commas that a split
+  // by lines, then by commas, would cut it at.
   for (size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
     if (quoted) {
@@ -89,7 +92,7 @@ CsvTable readCsvTable(const std::filesystem::path& file) {
     } else if (c == '\n') {
       ++line;
       endRow();
-    } else if (c != '\r') {
+    } else if (c != '\r') {  // a Windows line end is a line end
       cells.back() += c;
       anyText = true;
     }
