@@ -64,8 +64,9 @@ ViewPack packFrames(const std::filesystem::path& iceFile, int every) {
   bool lastKept = false;
 
   forEachFrame(iceFile, [&](const FrameState& state) {
-    const bool keep = visited++ % pack.every == 0;
     ViewFrame frame;
+    frame.source = visited;
+    const bool keep = visited++ % pack.every == 0;
     frame.time = state.time;
     frame.poses.reserve(4 * state.bodies.size());
     std::vector<std::uint32_t> list;

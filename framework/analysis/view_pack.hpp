@@ -23,6 +23,7 @@ struct ViewShape {
 
 struct ViewFrame {
   double time = 0;
+  long source = 0;           // its place among frames.ice's frames (they differ once thinned)
   std::uint32_t list = 0;    // index into ViewPack::lists: the shapes present, in order
   std::vector<float> poses;  // x, y, angle, speed for each entry of the list
 };

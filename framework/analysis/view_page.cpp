@@ -113,15 +113,16 @@ std::string shapesJson(const ViewPack& pack) {
 }
 
 std::string framesJson(const ViewPack& pack) {
-  std::string times, lists, poses;
+  std::string times, lists, poses, sources;
   for (const ViewFrame& f : pack.frames) {
     const char* comma = times.empty() ? "" : ",";
     times += fmt::format("{}{}", comma, f.time);
     lists += fmt::format("{}{}", comma, f.list);
+    sources += fmt::format("{}{}", comma, f.source);
     poses += comma;
     poses += base64(f.poses);
   }
-  return fmt::format(R"({{"time":[{}],"list":[{}],"poses":[{}]}})", times, lists, poses);
+  return fmt::format(R"({{"time":[{}],"list":[{}],"source":[{}],"poses":[{}]}})", times, lists, sources, poses);
 }
 
 std::string listsJson(const ViewPack& pack) {

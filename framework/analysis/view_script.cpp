@@ -182,7 +182,8 @@ window.addEventListener("unhandledrejection", function (e) { document.title = "g
     ctx.font = "12px 'DejaVu Sans', sans-serif";
     ctx.fillText("t = " + f.time.toFixed(2) + " s   frame " + current + " / " + (frameCount - 1) + "   " + list.length + " bodies", 8, 16);
     seek.value = String(current);
-    clock.textContent = "t = " + f.time.toFixed(2) + " s, frame " + current + " of " + (frameCount - 1);
+    clock.textContent = "t = " + f.time.toFixed(2) + " s, frame " + current + " of " + (frameCount - 1) +
+      (D.every > 1 ? " (frames.ice frame " + D.frames.source[current] + ")" : "");
     drawSeries(f.time);
     document.title = "gem view: frame " + current + " drawn";
   }
