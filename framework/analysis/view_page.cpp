@@ -9,6 +9,7 @@
 #include <cstring>
 #include <map>
 #include <numeric>
+#include <ostream>
 #include <vector>
 
 #include "framework/analysis/csv_table.hpp"
@@ -112,17 +113,19 @@ std::string shapesJson(const ViewPack& pack) {
                      base64(kinds), base64(pieces), base64(thickness), base64(area), base64(radius), base64(start), base64(xy));
 }
 
-std::string framesJson(const ViewPack& pack) {
-  std::string times, lists, poses, sources;
+// The frames' times and poses, straight to the page: they are most of a large page, and building
+// them as one string first would hold the page in memory twice.
+void writeFramesJson(std::ostream& os, const ViewPack& pack) {
+  std::string times, lists, sources;
   for (const ViewFrame& f : pack.frames) {
     const char* comma = times.empty() ? "" : ",";
     times += fmt::format("{}{}", comma, f.time);
     lists += fmt::format("{}{}", comma, f.list);
     sources += fmt::format("{}{}", comma, f.source);
-    poses += comma;
-    poses += base64(f.poses);
   }
-  return fmt::format(R"({{"time":[{}],"list":[{}],"source":[{}],"poses":[{}]}})", times, lists, sources, poses);
+  os << fmt::format(R"({{"time":[{}],"list":[{}],"source":[{}],"poses":[)", times, lists, sources);
+  for (size_t k = 0; k < pack.frames.size(); ++k) os << (k ? "," : "") << base64(pack.frames[k].poses);
+  os << "]}";
 }
 
 std::string listsJson(const ViewPack& pack) {
@@ -229,20 +232,18 @@ int runView(const ViewOptions& options) {
     summaryFacts += ':';
     summaryFacts += jsonString(value);
   }
-  const std::string data = fmt::format(R"({{"run":{},"every":{},"bounds":[{},{},{},{}],"speedScale":{},"thickness":[{},{}],"rhoIce":{},)"
-                                       R"("shapes":{},"lists":{},"frames":{},"series":{},"impacts":{},"summary":{{{}}}}})",
-                                       jsonString(title), pack.every, pack.minX, pack.minY, pack.maxX, pack.maxY, pack.speedScale,
-                                       pack.minThickness, pack.maxThickness, double(kRhoIce), shapesJson(pack), listsJson(pack),
-                                       framesJson(pack), seriesJson(dir), impactsJson(dir), summaryFacts);
+  const std::string data =
+      fmt::format(R"({{"run":{},"every":{},"bounds":[{},{},{},{}],"speedScale":{},"thickness":[{},{}],"rhoIce":{},)"
+                  R"("shapes":{},"lists":{},"series":{},"impacts":{},"summary":{{{}}},"frames":)",
+                  jsonString(title), pack.every, pack.minX, pack.minY, pack.maxX, pack.maxY, pack.speedScale, pack.minThickness,
+                  pack.maxThickness, double(kRhoIce), shapesJson(pack), listsJson(pack), seriesJson(dir), impactsJson(dir), summaryFacts);
 
-  std::string page;
-  page.reserve(data.size() + 64 * 1024);
-  page += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
-  page += fmt::format("<meta name=\"gem-frames\" content=\"{}\">\n<meta name=\"gem-frame-every\" content=\"{}\">\n", pack.frames.size(),
+  std::string head = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
+  head += fmt::format("<meta name=\"gem-frames\" content=\"{}\">\n<meta name=\"gem-frame-every\" content=\"{}\">\n", pack.frames.size(),
                       pack.every);
-  page += "<title>gem view: loading " + htmlText(title) + "</title>\n<style>" + std::string(viewStyle()) + "</style>\n</head>\n<body>\n";
-  page += "<header><h1>gem view: " + htmlText(title) + "</h1><div class=\"facts\">" + summaryHtml(summary) + "</div></header>\n";
-  page += R"H(<div id="bar"><button id="back" title="step back (left arrow)">&#9664;</button>)H"
+  head += "<title>gem view: loading " + htmlText(title) + "</title>\n<style>" + std::string(viewStyle()) + "</style>\n</head>\n<body>\n";
+  head += "<header><h1>gem view: " + htmlText(title) + "</h1><div class=\"facts\">" + summaryHtml(summary) + "</div></header>\n";
+  head += R"H(<div id="bar"><button id="back" title="step back (left arrow)">&#9664;</button>)H"
           R"H(<button id="play" title="play or pause (space)">play</button>)H"
           R"H(<button id="forward" title="step forward (right arrow)">&#9654;</button>)H"
           R"H(<input id="seek" type="range" min="0" value="0" step="1"><span id="clock"></span>)H"
@@ -251,16 +252,20 @@ int runView(const ViewOptions& options) {
           R"H(<label>colour by <select id="colour"><option value="speed">speed</option><option value="thickness">thickness</option>)H"
           R"H(<option value="id">id</option></select></label><button id="fit" title="zoom to the whole field">fit</button></div>)H"
           "\n";
-  page += R"H(<div id="legend"><span id="scale-lo"></span><canvas id="bar-scale" width="160" height="12"></canvas>)H"
+  head += R"H(<div id="legend"><span id="scale-lo"></span><canvas id="bar-scale" width="160" height="12"></canvas>)H"
           R"H(<span id="scale-hi"></span><span class="note">vessel: red; walls: grey; broken pieces: dark outline;)H"
           R"H( impacts since the last frame: cyan rings; wheel: zoom, drag: pan, hover: a body's facts</span>)H";
-  if (pack.every > 1) page += fmt::format(R"H(<span class="note">every {}-th frame of frames.ice</span>)H", pack.every);
-  page += "</div>\n<canvas id=\"view\"></canvas>\n<canvas id=\"series\"></canvas>\n<div id=\"tip\"></div>\n";
-  page += "<script id=\"gem-data\" type=\"application/json\">" + data + "</script>\n";
-  page += "<script>" + std::string(viewScript()) + "</script>\n</body>\n</html>\n";
+  if (pack.every > 1) head += fmt::format(R"H(<span class="note">every {}-th frame of frames.ice</span>)H", pack.every);
+  head += "</div>\n<canvas id=\"view\"></canvas>\n<canvas id=\"series\"></canvas>\n<div id=\"tip\"></div>\n";
 
+  // Atomically, as every output: an interrupted gem view leaves no half page.
   const fs::path out = options.out.empty() ? dir / "view.html" : fs::path(options.out);
-  writeFileAtomically(out, page);
+  AtomicFile file(out);
+  std::ostream& os = file.stream();
+  os << head << "<script id=\"gem-data\" type=\"application/json\">" << data;
+  writeFramesJson(os, pack);
+  os << "}</script>\n<script>" << viewScript() << "</script>\n</body>\n</html>\n";
+  file.commit();
   if (!options.quiet) std::printf("%s\n", out.string().c_str());
   return 0;
 }

@@ -85,7 +85,7 @@ window.addEventListener("unhandledrejection", function (e) { document.title = "g
   const thicknessBucket = (s) => thicknessUniform ? kBuckets >> 1 :
     Math.max(0, Math.min(kBuckets - 1, Math.floor(((shape.thickness[s] - D.thickness[0]) / thicknessSpan) * kBuckets)));
   const scales = {
-    speed: { label: "speed", unit: "m/s", lo: 0, hi: D.speedScale, bucket: (s, sp) => Math.min(kBuckets - 1, Math.floor((sp / D.speedScale) * kBuckets)) },
+    speed: { label: "speed", unit: "m/s", lo: 0, hi: D.speedScale, bucket: (s, sp) => Math.min(kBuckets - 1, Math.floor((sp / D.speedScale) * kBuckets)) | 0 },
     thickness: { label: "thickness", unit: "m", lo: D.thickness[0], hi: D.thickness[1],
                  bucket: thicknessBucket },
     id: { label: "id", bucket: (s) => ((shape.id[s] % kBuckets) + kBuckets) % kBuckets },
@@ -279,9 +279,11 @@ window.addEventListener("unhandledrejection", function (e) { document.title = "g
     draw();
   }
   function setPlaying(on) {
+    const was = playing;
     playing = on && frameCount > 1;
     playButton.textContent = playing ? "pause" : "play";
-    if (playing) { lastTick = performance.now(); requestAnimationFrame(tick); }
+    // One animation loop at a time: a second would double the speed.
+    if (playing && !was) { lastTick = performance.now(); requestAnimationFrame(tick); }
   }
   let lastTick = 0;
   function tick(now) {
@@ -301,7 +303,9 @@ window.addEventListener("unhandledrejection", function (e) { document.title = "g
   seek.oninput = () => { setPlaying(false); show(Number(seek.value)); };
   colourSelect.onchange = () => { colourBy = colourSelect.value; drawLegend(); draw(); };
   window.addEventListener("keydown", (e) => {
-    if (e.target.tagName === "SELECT") return;
+    // A focused slider or list takes its own keys, and space clicks a focused button itself:
+    // handling those here too would step or toggle twice.
+    if (e.target.tagName === "SELECT" || e.target.tagName === "INPUT" || (e.target.tagName === "BUTTON" && e.key === " ")) return;
     if (e.key === " ") { e.preventDefault(); playButton.onclick(); }
     else if (e.key === "ArrowLeft") { setPlaying(false); show(current - 1); }
     else if (e.key === "ArrowRight") { setPlaying(false); show(current + 1); }
