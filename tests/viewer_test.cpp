@@ -66,12 +66,12 @@ struct Browsed {
 };
 
 // Opens the page at `hash` in headless chromium, with a fresh profile; `mode` is "--dump-dom" or
-// "--screenshot=PATH". Killed after 60 s should it hang.
+// "--screenshot=PATH". Stopped after 60 s should it hang (killed 5 s later if it ignores that).
 Browsed browse(const TempDir& dir, const std::filesystem::path& page, const std::string& hash, const std::string& mode) {
   static int calls = 0;
   const std::string tag = std::to_string(calls++);
   const auto profile = dir.path() / ("profile-" + tag), out = dir.path() / ("dom-" + tag), err = dir.path() / ("stderr-" + tag);
-  const std::string command = "timeout 60 " + chromiumPath() +
+  const std::string command = "timeout -k 5 60 " + chromiumPath() +
                               " --headless --no-sandbox --disable-gpu --enable-logging=stderr --v=0 --window-size=1000,800"
                               " --virtual-time-budget=5000 --user-data-dir=" +
                               profile.string() + " " + mode + " 'file://" + page.string() + "#" + hash + "' > " + out.string() + " 2> " +
