@@ -7,10 +7,12 @@ build_dir="${1:-$here/build}"
 shift || true
 targets=("$@")
 
+# chromium and libcairo2-dev: tests/viewer_test.cpp opens gem view's page in headless chromium and
+# reads its screenshots with Cairo.
 packages=(cmake ninja-build g++ pkg-config libeigen3-dev libboost-dev libboost-filesystem-dev
           libtomlplusplus-dev libfmt-dev libcgal-dev libgmp-dev libmpfr-dev libgtest-dev libgmock-dev
           libcli11-dev libpugixml-dev nlohmann-json3-dev zlib1g-dev libopenmpi-dev openmpi-bin clang-format
-          libcairo2-dev ffmpeg fonts-dejavu-core)
+          chromium libcairo2-dev ffmpeg fonts-dejavu-core)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

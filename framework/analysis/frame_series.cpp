@@ -37,6 +37,7 @@ void forEachFrame(const std::filesystem::path& iceFile, const std::function<void
         continue;
       }
       if (found == slot.end()) {
+        // A new body (a piece of a split floe, or any body of frame 0) must be written whole.
         if (!o.hasCoordinates || !o.hasThickness)
           throw InputError(iceFile.string(), 0, 0,
                            "frame " + std::to_string(frame.index) + ": object " + std::to_string(o.index) +
@@ -47,6 +48,7 @@ void forEachFrame(const std::filesystem::path& iceFile, const std::function<void
         live.push_back(std::move(body));
         continue;
       }
+      // A known body: only the elements the frame wrote changed.
       FrameBody& body = live[found->second];
       if (o.hasCoordinates) body.vertices = o.coordinates;
       if (o.hasVelocity) {

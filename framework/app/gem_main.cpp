@@ -15,6 +15,7 @@
 #include "framework/analysis/analyze.hpp"
 #include "framework/analysis/movie.hpp"
 #include "framework/analysis/run_plots.hpp"
+#include "framework/analysis/view_page.hpp"
 #include "bench/bench.hpp"
 #include "framework/app/calibration.hpp"
 #include "framework/api/errors.hpp"
@@ -280,6 +281,13 @@ int main(int argc, char** argv) {
   movieCommand->add_option("--color", movie.color, "what colours the floes: speed (default), thickness or id");
   movieCommand->add_option("--size", movie.size, "WxH in pixels, each even (default 1280x720)");
   movieCommand->add_option("--still", movie.still, "write frame K (0-based) as a PNG to --out instead of the movie");
+  ViewOptions view;
+  CLI::App* viewCommand = app.add_subcommand("view", "one self-contained HTML page that plays a run's frames in a browser");
+  viewCommand->add_option("dir", view.dir, "run folder (with frames.ice)")->required();
+  viewCommand->add_option("--out", view.out, "the page (default DIR/view.html)");
+  viewCommand->add_option("--every", view.every, "keep every N-th frame and the last (default: all, thinned above 300 MB)")
+      ->check(CLI::PositiveNumber);
+  viewCommand->add_flag("--quiet", view.quiet, "print nothing but errors");
 
   SweepOptions sweep;
   CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
@@ -319,6 +327,7 @@ int main(int argc, char** argv) {
                   m.width, m.height);
       return 0;
     }
+    if (*viewCommand) return runView(view);
     if (*calibrateCommand) return runCalibration(calibrationFile, calibrationOut, false) <= 0.02 ? 0 : 1;
     return commandInfo(infoPlugins);
   } catch (const InputError& e) {
