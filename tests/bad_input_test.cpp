@@ -179,3 +179,29 @@ TEST(BadInputCli, MissingScenarioFileAndUnknownOptionExit2) {
   EXPECT_NE(gem::test::readFile(dir.path() / "log.txt").find("absent.toml"), std::string::npos);
   EXPECT_EQ(gem::test::runGem("run --frobnicate x.toml", dir.path() / "log.txt"), 2);
 }
+
+// Every error of a scenario's tables comes in one message, each with its line and column, so the
+// user fixes them in one round; an error that only follows from an earlier one is not repeated.
+TEST(BadInput, EveryErrorOfTheTablesIsReportedAtOnce) {
+  TempDir dir;
+  const auto scenario = dir.write("many.toml",
+                                  "[simulation]\n"
+                                  "dt = -0.1\n"         // line 2
+                                  "durations = 60.0\n"  // line 3: a typo
+                                  "[vessel]\n"
+                                  "mass = \"heavy\"\n"  // line 5
+                                  "[output]\n"
+                                  "frame_every = -3\n"  // line 7
+                                  "formats = [\"vtk\"]\n"
+                                  "vtk_encoding = \"zip\"\n");  // line 9
+  for (const char* command : {"check", "run"}) {
+    const std::string out = std::string(command) == "run" ? " --out " + (dir.path() / "run").string() : "";
+    const int status = gem::test::runGem(std::string(command) + " " + scenario.string() + " --quiet" + out, dir.path() / "log.txt");
+    const std::string log = gem::test::readFile(dir.path() / "log.txt");
+    EXPECT_EQ(status, 2) << log;
+    for (const std::string& e : {":2:", "simulation.dt", ":3:", "did you mean \"duration\"", ":5:", "vessel.mass",
+                                 ":7:", "output.frame_every", ":9:", "output.vtk_encoding", "5 errors in all"})
+      EXPECT_NE(log.find(e), std::string::npos) << "missing \"" << e << "\" in: " << log;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "run" / "summary.json"));
+  }
+}

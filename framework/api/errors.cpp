@@ -11,6 +11,18 @@ std::string InputError::shorten(const std::string& message) {
          message.substr(message.size() - tail);
 }
 
+InputError InputError::multiline(const std::string& lines) {
+  std::string out;
+  size_t start = 0;
+  while (start <= lines.size()) {
+    const size_t end = std::min(lines.find('\n', start), lines.size());
+    if (start > 0) out += '\n';
+    out += shorten(lines.substr(start, end - start));
+    start = end + 1;
+  }
+  return InputError(out, Whole{});
+}
+
 std::string InputError::format(const std::string& file, int line, int column, const std::string& message) {
   if (file.empty()) return message;
   if (line > 0 && column > 0) return fmt::format("{}:{}:{}: {}", file, line, column, message);

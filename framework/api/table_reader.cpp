@@ -23,14 +23,59 @@ const toml::node* TableReader::node(const std::string& key) {
 
 void TableReader::accept(const std::string& key) { m_known.insert(key); }
 
-void TableReader::fail(const std::string& key, const std::string& message) const {
+InputError TableReader::errorFor(const std::string& key, const std::string& message) const {
   const toml::node* n = m_table ? m_table->get(key) : nullptr;
-  if (n) failAt(*n, fmt::format("{}: {}", keyPath(key), message));
+  if (n) return errorAt(*n, fmt::format("{}: {}", keyPath(key), message));
   if (m_table) {
     const auto& src = m_table->source();
-    throw InputError(m_file, src.begin.line, src.begin.column, fmt::format("{}: {}", keyPath(key), message));
+    return InputError(m_file, static_cast<int>(src.begin.line), static_cast<int>(src.begin.column),
+                      fmt::format("{}: {}", keyPath(key), message));
   }
-  throw InputError(m_file, 0, 0, fmt::format("{}: {}", keyPath(key), message));
+  return InputError(m_file, 0, 0, fmt::format("{}: {}", keyPath(key), message));
+}
+
+void TableReader::fail(const std::string& key, const std::string& message) const { throw errorFor(key, message); }
+void TableReader::failAt(const toml::node& n, const std::string& message) const { throw errorAt(n, message); }
+
+void TableReader::report(const std::string& key, const std::string& message) const {
+  if (ErrorCollector* errors = ErrorCollector::active()) return errors->add(errorFor(key, message).what(), keyPath(key));
+  fail(key, message);
+}
+
+void TableReader::reportAt(const toml::node& n, const std::string& message) const {
+  // The messages start with the key path they are about ("vessel.mass: ...", "unknown key ...").
+  if (ErrorCollector* errors = ErrorCollector::active())
+    return errors->add(errorAt(n, message).what(), message.substr(0, message.find(':')));
+  failAt(n, message);
+}
+
+namespace {
+thread_local ErrorCollector* t_collector = nullptr;
+}  // namespace
+
+ErrorCollector::ErrorCollector() : m_previous(t_collector) { t_collector = this; }
+ErrorCollector::~ErrorCollector() { t_collector = m_previous; }
+ErrorCollector* ErrorCollector::active() { return t_collector; }
+
+void ErrorCollector::add(const std::string& message, const std::string& key) {
+  // The same error twice (a value read by two readers) is one error.
+  if (std::find(m_messages.begin(), m_messages.end(), message) == m_messages.end()) m_messages.push_back(message);
+  if (!key.empty() && key.find(' ') == std::string::npos) m_keys.insert(key);
+}
+
+bool ErrorCollector::followsFrom(const std::string& message) const {
+  for (const std::string& key : m_keys)
+    if (message.find(" " + key + ":") != std::string::npos || message.find(" " + key + "[") != std::string::npos) return true;
+  return false;
+}
+
+void ErrorCollector::throwIfAny() const {
+  if (m_messages.empty()) return;
+  std::string text = m_messages.front();
+  if (m_messages.size() > 1) text += fmt::format("\n  ({} errors in all; the others:)", m_messages.size());
+  for (size_t k = 1; k < m_messages.size() && k < kMostShown; ++k) text += "\n  " + m_messages[k];
+  if (m_messages.size() > kMostShown) text += fmt::format("\n  ... and {} more", m_messages.size() - kMostShown);
+  throw InputError::multiline(text);
 }
 
 namespace {
@@ -40,7 +85,7 @@ thread_local const std::vector<std::string>* t_overrides = nullptr;
 OverrideScope::OverrideScope(const std::vector<std::string>& assignments) : m_previous(t_overrides) { t_overrides = &assignments; }
 OverrideScope::~OverrideScope() { t_overrides = m_previous; }
 
-void TableReader::failAt(const toml::node& n, const std::string& message) const {
+InputError TableReader::errorAt(const toml::node& n, const std::string& message) const {
   const auto& src = n.source();
   // A value from --set (no source): the message starts with its key path ("a.b: ...", "a.b[0]...")
   // or quotes it ("unknown key \"a.b\""); the last assignment of that key is the one in force.
@@ -49,10 +94,10 @@ void TableReader::failAt(const toml::node& n, const std::string& message) const 
       const std::string key = a->substr(0, a->find('='));
       const bool named = message.rfind(key + ":", 0) == 0 || message.rfind(key + "[", 0) == 0 || message.rfind(key + ".", 0) == 0 ||
                          message.find("\"" + key + "\"") != std::string::npos || message.find("\"" + key + ".") != std::string::npos;
-      if (named) throw InputError(fmt::format("--set {}: {}", *a, message));
+      if (named) return InputError(fmt::format("--set {}: {}", *a, message));
     }
   }
-  throw InputError(m_file, static_cast<int>(src.begin.line), static_cast<int>(src.begin.column), message);
+  return InputError(m_file, static_cast<int>(src.begin.line), static_cast<int>(src.begin.column), message);
 }
 
 namespace {
@@ -73,15 +118,21 @@ size_t editDistance(const std::string& a, const std::string& b) {
 }
 }  // namespace
 
-Real TableReader::toReal(const toml::node& n, const std::string& key) const {
+std::optional<Real> TableReader::toReal(const toml::node& n, const std::string& key) const {
   double v;
-  if (auto f = n.value_exact<double>())
+  if (auto f = n.value_exact<double>()) {
     v = *f;
-  else if (auto i = n.value_exact<std::int64_t>())
+  } else if (auto i = n.value_exact<std::int64_t>()) {
     v = static_cast<double>(*i);
-  else
-    failAt(n, fmt::format("{}: expected a number, got {}", keyPath(key), toml::impl::node_type_friendly_names[static_cast<int>(n.type())]));
-  if (!std::isfinite(v)) failAt(n, fmt::format("{}: expected a finite number, got {}", keyPath(key), v));
+  } else {
+    reportAt(n,
+             fmt::format("{}: expected a number, got {}", keyPath(key), toml::impl::node_type_friendly_names[static_cast<int>(n.type())]));
+    return std::nullopt;
+  }
+  if (!std::isfinite(v)) {
+    reportAt(n, fmt::format("{}: expected a finite number, got {}", keyPath(key), v));
+    return std::nullopt;
+  }
   return static_cast<Real>(v);
 }
 
@@ -95,13 +146,13 @@ Real TableReader::getReal(const std::string& key, Real fallback) { return findRe
 
 Real TableReader::getPositive(const std::string& key, Real fallback) {
   Real v = getReal(key, fallback);
-  if (!(v > 0)) fail(key, fmt::format("must be positive, got {}", v));
+  if (!(v > 0)) report(key, fmt::format("must be positive, got {}", v)), v = fallback;
   return v;
 }
 
 Real TableReader::getNonNegative(const std::string& key, Real fallback) {
   Real v = getReal(key, fallback);
-  if (!(v >= 0)) fail(key, fmt::format("must not be negative, got {}", v));
+  if (!(v >= 0)) report(key, fmt::format("must not be negative, got {}", v)), v = fallback;
   return v;
 }
 
@@ -109,8 +160,8 @@ std::int64_t TableReader::getInt(const std::string& key, std::int64_t fallback, 
   const toml::node* n = node(key);
   if (!n) return fallback;
   auto i = n->value_exact<std::int64_t>();
-  if (!i) failAt(*n, fmt::format("{}: expected an integer", keyPath(key)));
-  if (*i < min || *i > max) failAt(*n, fmt::format("{}: must be in [{}, {}], got {}", keyPath(key), min, max, *i));
+  if (!i) return reportAt(*n, fmt::format("{}: expected an integer", keyPath(key))), fallback;
+  if (*i < min || *i > max) return reportAt(*n, fmt::format("{}: must be in [{}, {}], got {}", keyPath(key), min, max, *i)), fallback;
   return *i;
 }
 
@@ -118,7 +169,7 @@ bool TableReader::getBool(const std::string& key, bool fallback) {
   const toml::node* n = node(key);
   if (!n) return fallback;
   auto b = n->value_exact<bool>();
-  if (!b) failAt(*n, fmt::format("{}: expected true or false", keyPath(key)));
+  if (!b) return reportAt(*n, fmt::format("{}: expected true or false", keyPath(key))), fallback;
   return *b;
 }
 
@@ -126,7 +177,7 @@ std::string TableReader::getString(const std::string& key, const std::string& fa
   const toml::node* n = node(key);
   if (!n) return fallback;
   auto s = n->value_exact<std::string>();
-  if (!s) failAt(*n, fmt::format("{}: expected a string", keyPath(key)));
+  if (!s) return reportAt(*n, fmt::format("{}: expected a string", keyPath(key))), fallback;
   return *s;
 }
 
@@ -134,23 +185,28 @@ std::string TableReader::getChoice(const std::string& key, const std::string& fa
   std::string v = getString(key, fallback);
   for (const auto& c : choices)
     if (c == v) return v;
-  fail(key, fmt::format("unknown value \"{}\" (valid: {})", v, fmt::join(choices, ", ")));
+  report(key, fmt::format("unknown value \"{}\" (valid: {})", v, fmt::join(choices, ", ")));
+  return fallback;
 }
 
 std::optional<std::vector<Real>> TableReader::findReals(const std::string& key) {
   const toml::node* n = node(key);
   if (!n) return std::nullopt;
   const toml::array* a = n->as_array();
-  if (!a) failAt(*n, fmt::format("{}: expected an array of numbers", keyPath(key)));
+  if (!a) return reportAt(*n, fmt::format("{}: expected an array of numbers", keyPath(key))), std::nullopt;
   std::vector<Real> out;
-  for (const toml::node& e : *a) out.push_back(toReal(e, key));
+  for (const toml::node& e : *a) {
+    const std::optional<Real> v = toReal(e, key);
+    if (!v) return std::nullopt;
+    out.push_back(*v);
+  }
   return out;
 }
 
 std::optional<Vec2> TableReader::findVec2(const std::string& key) {
   auto v = findReals(key);
   if (!v) return std::nullopt;
-  if (v->size() != 2) fail(key, fmt::format("expected [x, y], got {} numbers", v->size()));
+  if (v->size() != 2) return report(key, fmt::format("expected [x, y], got {} numbers", v->size())), std::nullopt;
   return Vec2{(*v)[0], (*v)[1]};
 }
 
@@ -158,12 +214,14 @@ std::optional<std::vector<Vec2>> TableReader::findPoints(const std::string& key)
   const toml::node* n = node(key);
   if (!n) return std::nullopt;
   const toml::array* a = n->as_array();
-  if (!a) failAt(*n, fmt::format("{}: expected an array of [x, y] points", keyPath(key)));
+  if (!a) return reportAt(*n, fmt::format("{}: expected an array of [x, y] points", keyPath(key))), std::nullopt;
   std::vector<Vec2> out;
   for (const toml::node& e : *a) {
     const toml::array* p = e.as_array();
-    if (!p || p->size() != 2) failAt(e, fmt::format("{}: expected [x, y]", keyPath(key)));
-    out.push_back({toReal(*p->get(0), key), toReal(*p->get(1), key)});
+    if (!p || p->size() != 2) return reportAt(e, fmt::format("{}: expected [x, y]", keyPath(key))), std::nullopt;
+    const std::optional<Real> x = toReal(*p->get(0), key), y = toReal(*p->get(1), key);
+    if (!x || !y) return std::nullopt;
+    out.push_back({*x, *y});
   }
   return out;
 }
@@ -171,14 +229,14 @@ std::optional<std::vector<Vec2>> TableReader::findPoints(const std::string& key)
 const toml::table* TableReader::findTable(const std::string& key) {
   const toml::node* n = node(key);
   if (!n) return nullptr;
-  if (!n->as_table()) failAt(*n, fmt::format("{}: expected a table", keyPath(key)));
+  if (!n->as_table()) return reportAt(*n, fmt::format("{}: expected a table", keyPath(key))), nullptr;
   return n->as_table();
 }
 
 const toml::array* TableReader::findArray(const std::string& key) {
   const toml::node* n = node(key);
   if (!n) return nullptr;
-  if (!n->as_array()) failAt(*n, fmt::format("{}: expected an array", keyPath(key)));
+  if (!n->as_array()) return reportAt(*n, fmt::format("{}: expected an array", keyPath(key))), nullptr;
   return n->as_array();
 }
 
@@ -193,9 +251,9 @@ void TableReader::finish() const {
     size_t best = std::max<size_t>(2, key.size() / 3) + 1;
     for (const std::string& candidate : valid)
       if (const size_t d = editDistance(key, candidate); d < best) best = d, nearest = candidate;
-    failAt(v, fmt::format("unknown key \"{}\"{} (valid keys here: {})", keyPath(key),
-                          nearest.empty() ? "" : fmt::format("; did you mean \"{}\"?", nearest),
-                          valid.empty() ? std::string("none") : fmt::format("{}", fmt::join(valid, ", "))));
+    reportAt(v, fmt::format("unknown key \"{}\"{} (valid keys here: {})", keyPath(key),
+                            nearest.empty() ? "" : fmt::format("; did you mean \"{}\"?", nearest),
+                            valid.empty() ? std::string("none") : fmt::format("{}", fmt::join(valid, ", "))));
   }
 }
 

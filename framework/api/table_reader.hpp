@@ -10,6 +10,7 @@
 
 #include <toml++/toml.h>
 
+#include "framework/api/errors.hpp"
 #include "geometry/vec2.hpp"
 
 namespace gem {
@@ -26,6 +27,34 @@ class OverrideScope {
 
  private:
   const std::vector<std::string>* m_previous;
+};
+
+// While one is alive on this thread, a TableReader records a bad value or an unknown key and goes
+// on with the key's default, so that one pass over a file reports all of its errors at once, each
+// with its line and column (loadScenario holds one). Without one, the first error throws.
+class ErrorCollector {
+ public:
+  ErrorCollector();
+  ~ErrorCollector();
+  ErrorCollector(const ErrorCollector&) = delete;
+  ErrorCollector& operator=(const ErrorCollector&) = delete;
+
+  // key: the dotted key the message is about, when known: a later error about the same key (what
+  // its default led to) is not a new error (followsFrom).
+  void add(const std::string& message, const std::string& key = "");
+  bool followsFrom(const std::string& message) const;
+  bool empty() const { return m_messages.empty(); }
+  // Throws one InputError listing the errors recorded, one per line (the first kMostShown, then how
+  // many more), if there are any.
+  void throwIfAny() const;
+  static ErrorCollector* active();
+
+  static constexpr size_t kMostShown = 20;
+
+ private:
+  std::vector<std::string> m_messages;
+  std::set<std::string> m_keys;
+  ErrorCollector* m_previous;
 };
 
 class TableReader {
@@ -57,13 +86,19 @@ class TableReader {
 
   [[noreturn]] void fail(const std::string& key, const std::string& message) const;
   [[noreturn]] void failAt(const toml::node& node, const std::string& message) const;
+  // As fail/failAt, but with an ErrorCollector alive the error is recorded and the caller goes on
+  // (with the key's default).
+  void report(const std::string& key, const std::string& message) const;
+  void reportAt(const toml::node& node, const std::string& message) const;
   const std::string& file() const { return m_file; }
   const std::string& path() const { return m_path; }
   std::string keyPath(const std::string& key) const { return m_path.empty() ? key : m_path + "." + key; }
 
  private:
   const toml::node* node(const std::string& key);
-  Real toReal(const toml::node& n, const std::string& key) const;
+  std::optional<Real> toReal(const toml::node& n, const std::string& key) const;  // nullopt: reported
+  InputError errorAt(const toml::node& node, const std::string& message) const;
+  InputError errorFor(const std::string& key, const std::string& message) const;
 
   const toml::table* m_table;
   std::string m_path, m_file;

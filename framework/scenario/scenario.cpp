@@ -304,23 +304,9 @@ const toml::table* Scenario::eventTable(const std::string& name) const {
   return events ? (*events)[name].as_table() : nullptr;
 }
 
-Scenario loadScenario(const fs::path& file, const std::vector<std::string>& overrides) {
-  Scenario s;
-  s.fileName = file.string();
-  const std::string text = readTomlFile(s.fileName, "scenario");  // bounded before the parser sees it
-  s.file = fs::absolute(file);
-  try {
-    s.root = toml::parse(text, s.file.string());
-  } catch (const toml::parse_error& e) {
-    throw InputError(s.fileName, static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
-                     std::string(e.description()));
-  }
-  for (const std::string& o : overrides) applyOverride(s.root, o);
-  s.overrides = overrides;
-  const OverrideScope blameSet(s.overrides);  // an error in a --set value names the --set
-  if (s.root.empty())
-    throw InputError(fmt::format("{}: nothing in it: a scenario needs at least a [simulation] table or bodies", s.fileName));
-
+static  // The scenario's tables into s (loadScenario: s.root parsed, overrides applied).
+    void
+    readScenarioTables(Scenario& s) {
   TableReader top(&s.root, "", s.fileName);
   // Plugins first: their events and broadphases are valid names in the sections below.
   requireEnvironmentPluginLibraries();
@@ -414,6 +400,34 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
   s.randomField.domain = s.domain;
   s.hexagonField.domain = s.domain;
   checkFieldMemory(s);
+}
+
+Scenario loadScenario(const fs::path& file, const std::vector<std::string>& overrides) {
+  Scenario s;
+  s.fileName = file.string();
+  const std::string text = readTomlFile(s.fileName, "scenario");  // bounded before the parser sees it
+  s.file = fs::absolute(file);
+  try {
+    s.root = toml::parse(text, s.file.string());
+  } catch (const toml::parse_error& e) {
+    throw InputError(s.fileName, static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
+                     std::string(e.description()));
+  }
+  for (const std::string& o : overrides) applyOverride(s.root, o);
+  s.overrides = overrides;
+  const OverrideScope blameSet(s.overrides);  // an error in a --set value names the --set
+  if (s.root.empty())
+    throw InputError(fmt::format("{}: nothing in it: a scenario needs at least a [simulation] table or bodies", s.fileName));
+
+  // Every error of the tables at once (each bad value is recorded and its default used), then
+  // any that stopped the reading: the user fixes them in one round.
+  ErrorCollector errors;
+  try {
+    readScenarioTables(s);
+  } catch (const InputError& e) {
+    if (!errors.followsFrom(e.what())) errors.add(e.what());
+  }
+  errors.throwIfAny();
   return s;
 }
 
