@@ -199,9 +199,20 @@ TEST(BadInput, EveryErrorOfTheTablesIsReportedAtOnce) {
     const int status = gem::test::runGem(std::string(command) + " " + scenario.string() + " --quiet" + out, dir.path() / "log.txt");
     const std::string log = gem::test::readFile(dir.path() / "log.txt");
     EXPECT_EQ(status, 2) << log;
-    for (const std::string& e : {":2:", "simulation.dt", ":3:", "did you mean \"duration\"", ":5:", "vessel.mass",
-                                 ":7:", "output.frame_every", ":9:", "output.vtk_encoding", "5 errors in all"})
+    for (const char* e : {":2:", "simulation.dt", ":3:", "did you mean \"duration\"", ":5:", "vessel.mass", ":7:", "output.frame_every",
+                          ":9:", "output.vtk_encoding", "5 errors in all"})
       EXPECT_NE(log.find(e), std::string::npos) << "missing \"" << e << "\" in: " << log;
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "run" / "summary.json"));
   }
+}
+
+// The events' tables too: each event's errors, all of them, in one message.
+TEST(BadInput, EveryEventTableErrorIsReportedAtOnce) {
+  TempDir dir;
+  const auto scenario = dir.write("events.toml", "[simulation]\nsteps = 5\n[events.drag]\ncdd = 0.1\n[events.impact]\nfrictio = 0.2\n");
+  const int status = gem::test::runGem("check " + scenario.string() + " --quiet", dir.path() / "log.txt");
+  const std::string log = gem::test::readFile(dir.path() / "log.txt");
+  EXPECT_EQ(status, 2) << log;
+  for (const char* e : {":4:", "events.drag.cdd", ":6:", "events.impact.frictio", "2 errors in all"})
+    EXPECT_NE(log.find(e), std::string::npos) << "missing \"" << e << "\" in: " << log;
 }

@@ -300,13 +300,14 @@ void readBroadphaseTables(const toml::table& tables, Scenario& s) {
 }  // namespace
 
 const toml::table* Scenario::eventTable(const std::string& name) const {
-  const toml::table* events = root["events"].as_table();
+  const toml::table* events = (document ? *document : root)["events"].as_table();
   return events ? (*events)[name].as_table() : nullptr;
 }
 
-static  // The scenario's tables into s (loadScenario: s.root parsed, overrides applied).
-    void
-    readScenarioTables(Scenario& s) {
+namespace {
+
+// The scenario's tables into s (loadScenario: s.root parsed, overrides applied).
+void readScenarioTables(Scenario& s) {
   TableReader top(&s.root, "", s.fileName);
   // Plugins first: their events and broadphases are valid names in the sections below.
   requireEnvironmentPluginLibraries();
@@ -402,6 +403,8 @@ static  // The scenario's tables into s (loadScenario: s.root parsed, overrides 
   checkFieldMemory(s);
 }
 
+}  // namespace
+
 Scenario loadScenario(const fs::path& file, const std::vector<std::string>& overrides) {
   Scenario s;
   s.fileName = file.string();
@@ -428,6 +431,10 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
     if (!errors.followsFrom(e.what())) errors.add(e.what());
   }
   errors.throwIfAny();
+  // The document with its lines and columns, shared by every copy of s (a copied toml table
+  // loses them), so that an event's error names its line; root becomes a copy to edit.
+  s.document = std::make_shared<const toml::table>(std::move(s.root));
+  s.root = *s.document;
   return s;
 }
 

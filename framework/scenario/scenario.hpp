@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,9 +32,12 @@ struct PluginSpec {
 };
 
 struct Scenario {
-  std::filesystem::path file;          // the scenario file (absolute)
-  std::string fileName;                // as given, for messages
-  toml::table root;                    // the parsed document, overrides applied
+  std::filesystem::path file;  // the scenario file (absolute)
+  std::string fileName;        // as given, for messages
+  toml::table root;            // the parsed document, overrides applied (a copy: no source lines)
+  // The same document as read, with its source lines and columns (toml++ drops them when a table
+  // is copied), shared by every copy of this Scenario: eventTable() reads it.
+  std::shared_ptr<const toml::table> document;
   std::vector<std::string> overrides;  // the --set (and sweep) overrides, "key=VALUE", as applied
 
   // [simulation]
@@ -77,7 +81,7 @@ struct Scenario {
 
   VesselSpec vessel;
 
-  // [events.NAME] given in the scenario: its enabled flag. Its table is looked up in root by
+  // [events.NAME] given in the scenario: its enabled flag. Its table is looked up in document by
   // eventTable(), never stored as a pointer, so a copied Scenario stays self-contained.
   struct EventSetting {
     bool enabled;

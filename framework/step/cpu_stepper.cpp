@@ -131,17 +131,24 @@ CpuStepper::CpuStepper(const Scenario& scenario, World world) : m_scenario(scena
 void CpuStepper::setUp() {
   const OverrideScope blameSet(m_scenario.overrides);  // an error in a --set value names the --set
   m_broadphase = Registry::global().broadphase(m_scenario.broadphase).make(m_scenario.broadphaseSettings);
-  for (const EventEntry* entry : Registry::global().events()) {
-    auto it = m_scenario.events.find(entry->name);
-    const toml::table* table = m_scenario.eventTable(entry->name);
-    const bool enabled = it == m_scenario.events.end() ? entry->enabledByDefault : it->second.enabled;
-    TableReader reader(table, "events." + entry->name, m_scenario.fileName);
-    reader.accept("enabled");
-    EventConfig config{reader, m_scenario, m_streams};
-    auto instance = entry->makeCpu(config);  // parsed even when off, so its table is still checked
-    reader.finish();
-    if (enabled) m_events.push_back({entry->name, entry->phase, std::move(instance)});
+  // Every event's table is checked, and all their errors reported together (docs/scenario.md 2).
+  ErrorCollector errors;
+  try {
+    for (const EventEntry* entry : Registry::global().events()) {
+      auto it = m_scenario.events.find(entry->name);
+      const toml::table* table = m_scenario.eventTable(entry->name);
+      const bool enabled = it == m_scenario.events.end() ? entry->enabledByDefault : it->second.enabled;
+      TableReader reader(table, "events." + entry->name, m_scenario.fileName);
+      reader.accept("enabled");
+      EventConfig config{reader, m_scenario, m_streams};
+      auto instance = entry->makeCpu(config);  // parsed even when off, so its table is still checked
+      reader.finish();
+      if (enabled) m_events.push_back({entry->name, entry->phase, std::move(instance)});
+    }
+  } catch (const InputError& e) {
+    if (!errors.followsFrom(e.what())) errors.add(e.what());
   }
+  errors.throwIfAny();
   m_records.reset(m_streams);
   for (int i = 0; i < m_world.size(); ++i)
     if (m_world.kind[i] == BodyKind::Vessel) m_vesselId = m_world.id[i];
