@@ -216,3 +216,15 @@ TEST(BadInput, EveryEventTableErrorIsReportedAtOnce) {
   for (const char* e : {":4:", "events.drag.cdd", ":6:", "events.impact.frictio", "2 errors in all"})
     EXPECT_NE(log.find(e), std::string::npos) << "missing \"" << e << "\" in: " << log;
 }
+
+// "Did you mean" for names as for keys: an event, a broadphase, a choice.
+TEST(BadInput, MisspelledNamesGetASuggestion) {
+  TempDir dir;
+  const auto scenario =
+      dir.write("names.toml", "[simulation]\nsteps = 5\nbroadphase = \"uniform_gird\"\nbackend = \"cpuu\"\n[events.dragg]\n");
+  const int status = gem::test::runGem("check " + scenario.string() + " --quiet", dir.path() / "log.txt");
+  const std::string log = gem::test::readFile(dir.path() / "log.txt");
+  EXPECT_EQ(status, 2) << log;
+  for (const char* e : {"did you mean \"uniform_grid\"", "did you mean \"cpu\"", "did you mean \"drag\"", "3 errors in all"})
+    EXPECT_NE(log.find(e), std::string::npos) << "missing \"" << e << "\" in: " << log;
+}

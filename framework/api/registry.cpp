@@ -1,5 +1,7 @@
 #include "framework/api/registry.hpp"
 
+#include "framework/api/table_reader.hpp"
+
 #include <algorithm>
 
 #include <fmt/format.h>
@@ -94,13 +96,14 @@ const EventEntry* Registry::findEvent(const std::string& name) const {
 
 const EventEntry& Registry::event(const std::string& name) const {
   if (auto* e = findEvent(name)) return *e;
-  throw InputError(fmt::format("unknown event \"{}\" (valid: {})", name, fmt::join(eventNames(), ", ")));
+  throw InputError(fmt::format("unknown event \"{}\"{} (valid: {})", name, didYouMean(name, eventNames()), fmt::join(eventNames(), ", ")));
 }
 
 const BroadphaseEntry& Registry::broadphase(const std::string& name) const {
   auto it = m_broadphases.find(name);
   if (it != m_broadphases.end()) return it->second;
-  throw InputError(fmt::format("unknown broadphase \"{}\" (valid: {})", name, fmt::join(broadphaseNames(), ", ")));
+  throw InputError(fmt::format("unknown broadphase \"{}\"{} (valid: {})", name, didYouMean(name, broadphaseNames()),
+                               fmt::join(broadphaseNames(), ", ")));
 }
 
 std::vector<const EventEntry*> Registry::events() const {

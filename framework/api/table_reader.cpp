@@ -118,6 +118,14 @@ size_t editDistance(const std::string& a, const std::string& b) {
 }
 }  // namespace
 
+std::string didYouMean(const std::string& word, const std::vector<std::string>& candidates) {
+  std::string nearest;
+  size_t best = std::max<size_t>(2, word.size() / 3) + 1;
+  for (const std::string& candidate : candidates)
+    if (const size_t d = editDistance(word, candidate); d < best) best = d, nearest = candidate;
+  return nearest.empty() ? std::string() : fmt::format("; did you mean \"{}\"?", nearest);
+}
+
 std::optional<Real> TableReader::toReal(const toml::node& n, const std::string& key) const {
   double v;
   if (auto f = n.value_exact<double>()) {
@@ -185,7 +193,7 @@ std::string TableReader::getChoice(const std::string& key, const std::string& fa
   std::string v = getString(key, fallback);
   for (const auto& c : choices)
     if (c == v) return v;
-  report(key, fmt::format("unknown value \"{}\" (valid: {})", v, fmt::join(choices, ", ")));
+  report(key, fmt::format("unknown value \"{}\"{} (valid: {})", v, didYouMean(v, choices), fmt::join(choices, ", ")));
   return fallback;
 }
 
@@ -246,13 +254,7 @@ void TableReader::finish() const {
     std::string key(k.str());
     if (m_known.count(key)) continue;
     std::vector<std::string> valid(m_known.begin(), m_known.end());
-    // The nearest valid key, when it is near enough to be a typo.
-    std::string nearest;
-    size_t best = std::max<size_t>(2, key.size() / 3) + 1;
-    for (const std::string& candidate : valid)
-      if (const size_t d = editDistance(key, candidate); d < best) best = d, nearest = candidate;
-    reportAt(v, fmt::format("unknown key \"{}\"{} (valid keys here: {})", keyPath(key),
-                            nearest.empty() ? "" : fmt::format("; did you mean \"{}\"?", nearest),
+    reportAt(v, fmt::format("unknown key \"{}\"{} (valid keys here: {})", keyPath(key), didYouMean(key, valid),
                             valid.empty() ? std::string("none") : fmt::format("{}", fmt::join(valid, ", "))));
   }
 }

@@ -57,6 +57,10 @@ class ErrorCollector {
   ErrorCollector* m_previous;
 };
 
+// "; did you mean \"NAME\"?" for the candidate nearest to word when it is near enough to be a
+// typo (edit distance at most a third of the word's length, and at least 2), else "".
+std::string didYouMean(const std::string& word, const std::vector<std::string>& candidates);
+
 class TableReader {
  public:
   // table may be null (section absent): every get returns its default. path is the dotted name

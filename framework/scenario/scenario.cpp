@@ -329,11 +329,13 @@ void readScenarioTables(Scenario& s) {
     s.steps = hasSteps ? static_cast<long>(steps) : static_cast<long>(std::llround(s.duration / s.dt));
     if (hasSteps) s.duration = static_cast<Real>(s.steps) * s.dt;
     s.backend = t.getChoice("backend", "auto", {"auto", "cpu", "cuda"});
+    const std::string defaultBroadphase = s.broadphase;
     s.broadphase = t.getString("broadphase", s.broadphase);
     try {
       Registry::global().broadphase(s.broadphase);  // unknown name: lists the valid ones
     } catch (const InputError& e) {
-      t.fail("broadphase", e.what());
+      t.report("broadphase", e.what());
+      s.broadphase = defaultBroadphase;  // read on with the default (the error is recorded)
     }
     s.seed = static_cast<std::uint64_t>(t.getInt("seed", 1, 0, INT64_MAX));
     // The older home of the broadphase settings; [broadphase.NAME] is the strategy's own table.
@@ -372,8 +374,11 @@ void readScenarioTables(Scenario& s) {
   if (const toml::table* events = top.findTable("events")) {
     for (const auto& [key, node] : *events) {
       const std::string name(key.str());
-      if (!Registry::global().findEvent(name))
-        top.failAt(node, fmt::format("events.{}: unknown event (valid: {})", name, fmt::join(Registry::global().eventNames(), ", ")));
+      if (!Registry::global().findEvent(name)) {
+        top.reportAt(node, fmt::format("events.{}: unknown event{} (valid: {})", name, didYouMean(name, Registry::global().eventNames()),
+                                       fmt::join(Registry::global().eventNames(), ", ")));
+        continue;
+      }
       const toml::table* table = node.as_table();
       if (!table) top.failAt(node, fmt::format("events.{}: expected a table [events.{}]", name, name));
       bool enabled = true;
