@@ -18,7 +18,7 @@ rm -rf "$work/load"  # timed from scratch: the issue's figure is for the whole s
 start=$(date +%s.%N)
 "$gem" sweep "$here/scenarios/thesis/load_study.toml" --out "$work/load" --quiet --jobs "$(nproc)"
 load_seconds=$(awk -v a="$start" -v b="$(date +%s.%N)" "BEGIN{printf \"%.1f\", b - a}")
-"$gem" analyze "$work/load" --groups 121,004,040,400 --quiet
+"$gem" analyze "$work/load" --groups '121_46;004_46;040_46;400_46' --quiet
 
 cp "$work/resistance/analysis/resistance_vs_speed.svg" "$work/resistance/analysis/resistance_vs_concentration.svg" "$docs/"
 for f in force_cdf floe_mass_hist apex_hist across_bow force_vs_stem_distance force_vs_ship_speed; do

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "events/ship_impact.hpp"
+#include "framework/output/csv.hpp"
 #include "framework/scenario/scenario.hpp"
 #include "framework/step/stepper.hpp"
 
@@ -80,22 +81,10 @@ inline int runGem(const std::string& arguments, const std::filesystem::path& log
 // The impacts the last step logged (ship_impact's record stream).
 inline std::vector<ImpactRecord> impactsOf(const Stepper& stepper) { return stepper.records().rows<ImpactRecord>(kImpactStream); }
 
-// Splits one CSV line, honouring quoted fields (RFC 4180: commas and doubled quotes inside).
+// One CSV line's cells, through GEM's CSV module (quoted fields hold commas and doubled quotes).
 inline std::vector<std::string> csvCells(const std::string& line) {
-  std::vector<std::string> cells(1);
-  bool quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"')
-      cells.back() += '"', ++i;
-    else if (c == '"')
-      quoted = !quoted;
-    else if (c == ',' && !quoted)
-      cells.emplace_back();
-    else
-      cells.back() += c;
-  }
-  return cells;
+  CsvRecords records = parseCsvRecords(line);
+  return records.cells.empty() ? std::vector<std::string>(1) : std::move(records.cells.front());
 }
 
 inline std::string readFile(const std::filesystem::path& file) {

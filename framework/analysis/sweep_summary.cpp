@@ -10,7 +10,7 @@
 
 #include "framework/api/errors.hpp"
 #include "framework/output/atomic_file.hpp"
-#include "framework/output/csv_field.hpp"
+#include "framework/output/csv.hpp"
 
 namespace fs = std::filesystem;
 

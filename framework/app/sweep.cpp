@@ -199,7 +199,7 @@ int runSweep(const SweepOptions& options) {
   std::vector<std::string> texts;
   std::vector<Scenario> scenarios;  // as each case will run
   for (const SweepCase& c : sweep.cases) {
-    dirs.push_back(outDir / "cases" / c.name);
+    dirs.push_back(outDir / "cases" / c.folder);
     scenarios.push_back(validateCase(sweep, c, dirs.back()));
     texts.push_back(scenarioText(sweep, c, scenarios.back()));
   }
