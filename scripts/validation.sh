@@ -25,8 +25,11 @@ for f in force_cdf floe_mass_hist apex_hist across_bow force_vs_stem_distance fo
   [ -f "$work/load/analysis/$f.svg" ] && cp "$work/load/analysis/$f.svg" "$docs/load_$f.svg"
 done
 
-# CSV to a Markdown table (no quoted commas in these files' first columns).
-table() { awk -F, 'NR==1{h="|";s="|";for(i=1;i<=NF;i++){h=h" "$i" |";s=s" --- |"};print h;print s;next}{r="|";for(i=1;i<=NF;i++){r=r" "$i" |"};print r}' "$1"; }
+# CSV to a Markdown table, read as RFC 4180 (a sweep's group labels are quoted and hold commas).
+table() { python3 -c 'import csv,sys
+rows = list(csv.reader(open(sys.argv[1], newline="")))
+print("| " + " | ".join(rows[0]) + " |"); print("|" + " --- |" * len(rows[0]))
+for r in rows[1:]: print("| " + " | ".join(c.replace("|", "\\|") for c in r) + " |")' "$1"; }
 cut_columns() { cut -d, -f"$2" "$1"; }
 
 {
