@@ -61,17 +61,10 @@ void writeCase(const fs::path& sweep, const std::string& folder, const std::stri
 
 // statistics.csv as group -> column -> text.
 std::map<std::string, std::map<std::string, std::string>> readStatistics(const fs::path& file) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  for (std::stringstream s(line); std::getline(s, line, ',');) header.push_back(line);
+  const CsvTable table = readCsvTable(file);  // quoted labels hold commas; a short row throws
   std::map<std::string, std::map<std::string, std::string>> rows;
-  while (std::getline(in, line)) {
-    const std::vector<std::string> cells = gem::test::csvCells(line);  // quoted names hold commas
-    EXPECT_EQ(cells.size(), header.size()) << line;
-    for (size_t i = 0; i < cells.size() && i < header.size(); ++i) rows[cells[0]][header[i]] = cells[i];
-  }
+  for (const std::vector<std::string>& cells : table.rows)
+    for (size_t i = 0; i < cells.size(); ++i) rows[cells[0]][table.header[i]] = cells[i];
   return rows;
 }
 
@@ -132,10 +125,7 @@ TEST(Analyze, RunFolderRecoversTheDistributions) {
   std::getline(bow, line);
   EXPECT_EQ(line, "group,y_min_m,y_max_m,impacts,impacts_per_m_per_run");
   int bins = 0, total = 0;
-  while (std::getline(bow, line)) {
-    std::vector<std::string> c;
-    std::stringstream s(line);
-    for (std::string x; std::getline(s, x, ',');) c.push_back(x);
+  for (const std::vector<std::string>& c : readCsvTable(out / "across_bow.csv").rows) {
     ASSERT_EQ(c.size(), 5u);
     EXPECT_DOUBLE_EQ(num(c[2]) - num(c[1]), 1.0);
     EXPECT_DOUBLE_EQ(num(c[4]), num(c[3]));  // one run, 1 m bins
