@@ -44,7 +44,7 @@ struct Impact {
 double stemDistance(const Impact& i) { return i.xFromStem >= kMinStemDistance ? i.xFromStem : NAN; }
 
 struct Run {
-  std::string name, group;
+  std::string name, group, folder;
   std::vector<Impact> impacts;
   bool hasShipSpeed = false;
 };
@@ -373,6 +373,7 @@ int runAnalyze(const AnalyzeOptions& options) {
       if (fs::exists(c.dir / "impacts.csv")) {
         runs.push_back(readRun(c.dir, c.name));
         runs.back().group = c.group;
+        runs.back().folder = c.dir.filename().string();
       } else {
         ++incomplete;
       }
@@ -396,7 +397,7 @@ int runAnalyze(const AnalyzeOptions& options) {
     for (const Run& r : runs) byGroup[r.group].push_back(&r);
     std::set<std::string> chosen;
     for (const std::string& wanted : options.groups) {
-      const auto member = std::find_if(runs.begin(), runs.end(), [&](const Run& r) { return r.name == wanted; });
+      const auto member = std::find_if(runs.begin(), runs.end(), [&](const Run& r) { return r.name == wanted || r.folder == wanted; });
       if (byGroup.count(wanted)) {
         chosen.insert(wanted);
       } else if (member != runs.end()) {
