@@ -3,8 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <map>
-#include <set>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -15,9 +13,7 @@
 #include "framework/step/stepper.hpp"
 #include "framework/app/sweep.hpp"
 #include "framework/scenario/sweep_file.hpp"
-#include "framework/analysis/analyze.hpp"
 #include "framework/analysis/sweep_summary.hpp"
-#include "framework/output/csv.hpp"
 #include "test_support.hpp"
 
 using namespace gem;
@@ -26,34 +22,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A tiny channel: 20 floes, a small vessel entering them; milliseconds per run.
-const char* kBase = R"(
-[simulation]
-dt = 0.1
-steps = 40
-seed = 2
-[domain]
-x = [0.0, 60.0]
-y = [-20.0, 20.0]
-walls = true
-[field]
-kind = "random_convex"
-count = 20
-concentration = 0.3
-size_mean = 4.0
-size_sd = 1.0
-size_min = 2.0
-size_max = 7.0
-thickness = 0.5
-[vessel]
-length = 30.0
-beam = 8.0
-mass = 5e5
-position = [-16.0, 0.0]
-bollard_thrust = 92e3
-[output]
-frame_every = 0
-)";
+const char* const kBase = test::kTinyChannel;
 
 const char* kProduct = R"([sweep]
 base = "base.toml"
@@ -105,41 +74,6 @@ TEST(SweepFile, ProductExpandsFirstParameterSlowest) {
   EXPECT_EQ(def.cases[3].overrides[0].key, "simulation.steps");
   EXPECT_EQ(def.cases[3].overrides[0].toml, "30");  // integers stay integers
   EXPECT_EQ(def.cases[3].base, fs::absolute(dir.path() / "base.toml").lexically_normal());
-}
-
-// A case keeps its name (summary.csv's row label) but its folder holds only [A-Za-z0-9._-]: no
-// comma or '=' for a shell or a tool that splits on them; two cases never share a folder.
-TEST(SweepFile, CaseFoldersAreSafeAndUnique) {
-  EXPECT_EQ(caseFolderName("bollard_thrust=46000,concentration=0.25"), "bollard_thrust-46000_concentration-0.25");
-  EXPECT_EQ(caseFolderName("groups#0,x=1e+06"), "groups-0_x-1e06");
-  EXPECT_EQ(caseFolderName("=a"), "_-a");
-  EXPECT_EQ(caseFolderName("@"), "_");
-  TempDir dir;
-  dir.write("base.toml", kBase);
-  // "a,b" and "a_b" would both be folder a_b; "a_b_2" would be the clash's suffix.
-  const SweepDefinition def = readSweepFile(dir.write("s.toml", R"([sweep]
-base = "base.toml"
-[[cases]]
-name = "a,b"
-[[cases]]
-name = "a_b"
-[[cases]]
-name = "a_b_2"
-[[cases]]
-name = "x=1,y=2"
-)"));
-  ASSERT_EQ(def.cases.size(), 4u);
-  std::set<std::string> folders;
-  for (const SweepCase& c : def.cases) {
-    EXPECT_TRUE(folders.insert(c.folder).second) << c.folder;
-    EXPECT_EQ(c.folder.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._-"), std::string::npos)
-        << c.folder;
-  }
-  EXPECT_EQ(def.cases[0].folder, "a_b");
-  EXPECT_EQ(def.cases[1].folder, "a_b_2");
-  EXPECT_EQ(def.cases[2].folder, "a_b_2_2");
-  EXPECT_EQ(def.cases[3].folder, "x-1_y-2");
-  EXPECT_EQ(def.cases[3].name, "x=1,y=2");
 }
 
 TEST(SweepFile, CasesTimesParametersAndNonScalarValues) {
@@ -206,33 +140,6 @@ TEST(Sweep, RunsEveryCaseWritesScenariosAndGathers) {
   EXPECT_EQ(row[10], summary.at("resistance_mean_n"));
   EXPECT_GT(std::stod(row[10]), 0);  // the ice slows the vessel: a positive mean net thrust
   EXPECT_EQ(row[13], summary.at("resistance_in_ice_n"));
-}
-
-// gem analyze on a real sweep of 2 concentrations x 2 thrusts: one group per concentration (the
-// thrust does not group), each of its two cases; the inputs come from the cases' scenario.toml.
-TEST(Sweep, AnalyzeGroupsByTheVariedKeysButNotTheThrust) {
-  TempDir dir;
-  dir.write("base.toml", kBase);
-  const fs::path out = dir.path() / "out";
-  // kProduct with a small light vessel that is wholly in the field within the 30 steps: the in-ice
-  // means of the resistance analysis.
-  std::string product = kProduct;
-  product.replace(product.find("set = {"), 7,
-                  "set = { \"vessel.length\" = 4.0, \"vessel.beam\" = 2.0, \"vessel.mass\" = 2e4, \"vessel.position\" = [-2.5, 0.0],");
-  ASSERT_EQ(sweep(dir.write("study.toml", product), out), 0);
-  AnalyzeOptions options;
-  options.dir = out.string();
-  options.quiet = true;
-  ASSERT_EQ(runAnalyze(options), 0);
-  const CsvTable stats = readCsvTable(out / "analysis" / "statistics.csv");
-  std::map<std::string, std::string> runs;
-  for (const auto& row : stats.rows) runs[row[0]] = row[size_t(stats.column("runs"))];
-  EXPECT_EQ(runs, (std::map<std::string, std::string>{{"all", "4"}, {"concentration=0.25", "2"}, {"concentration=0.3", "2"}}));
-  // It varies the thrust and summary.csv has the in-ice means: the resistance analysis too, with
-  // the concentration of each case from its scenario.
-  const CsvTable resistance = readCsvTable(out / "analysis" / "resistance.csv");
-  ASSERT_EQ(resistance.rows.size(), 4u);
-  for (const auto& row : resistance.rows) EXPECT_EQ(row[0], "concentration=" + row[1]);
 }
 
 TEST(Sweep, ThreadsDoNotChangeResults) {

@@ -87,6 +87,35 @@ inline std::vector<std::string> csvCells(const std::string& line) {
   return records.cells.empty() ? std::vector<std::string>(1) : std::move(records.cells.front());
 }
 
+// A tiny channel for sweep tests: 20 floes, a small vessel entering them; milliseconds per run.
+inline const char* const kTinyChannel = R"(
+[simulation]
+dt = 0.1
+steps = 40
+seed = 2
+[domain]
+x = [0.0, 60.0]
+y = [-20.0, 20.0]
+walls = true
+[field]
+kind = "random_convex"
+count = 20
+concentration = 0.3
+size_mean = 4.0
+size_sd = 1.0
+size_min = 2.0
+size_max = 7.0
+thickness = 0.5
+[vessel]
+length = 30.0
+beam = 8.0
+mass = 5e5
+position = [-16.0, 0.0]
+bollard_thrust = 92e3
+[output]
+frame_every = 0
+)";
+
 inline std::string readFile(const std::filesystem::path& file) {
   std::ifstream in(file);
   return std::string(std::istreambuf_iterator<char>(in), {});
