@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/csv.hpp"
 #include "framework/api/errors.hpp"
 #include "framework/field/field_generator.hpp"
 #include "bench/geometry_bench.hpp"
@@ -193,8 +194,9 @@ class Table {
     if (!m_param.empty()) std::printf("%15s ", r.param.c_str());
     std::printf("%8d %10.4f %10.0f %14.3g %12.0f  %s\n", r.bodies, t * 1e3, 1 / t, r.floes / t, realTime, r.device.c_str());
     std::fflush(stdout);
-    m_csv += fmt::format("\"{}\",{},{},{}{},{},{:.6f},{:.1f},{:.6g},{:.1f},\"{}\"\n", r.caseName, r.backend, r.broadphase,
-                         m_param.empty() ? "" : r.param + ",", r.bodies, r.floes, t * 1e3, 1 / t, r.floes / t, realTime, r.device);
+    m_csv += fmt::format("{},{},{},{}{},{},{:.6f},{:.1f},{:.6g},{:.1f},{}\n", csvQuoted(r.caseName), csvField(r.backend),
+                         csvField(r.broadphase), m_param.empty() ? "" : csvField(r.param) + ",", r.bodies, r.floes, t * 1e3, 1 / t,
+                         r.floes / t, realTime, csvQuoted(r.device));
     if (!m_csvPath.empty()) writeFileAtomically(m_csvPath, m_csv);
     m_rows.push_back(r);
   }

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/csv.hpp"
 #include "bench/bench.hpp"
 #include "framework/api/errors.hpp"
 #include "geometry/polygon.hpp"
@@ -254,11 +255,13 @@ int runGeometryBench(const GeometryBenchOptions& options) {
     if (r.gpu) {
       std::printf("%9ld %11.4f %13.4f %13.4f %10.1f %10.1f %10.3f\n", n, r.cpuMs, r.gpuMs.kernelMs, r.gpuMs.totalMs,
                   r.cpuMs / r.gpuMs.kernelMs, r.cpuMs / r.gpuMs.totalMs, r.extra);
-      csv += fmt::format("{},{},{:.6f},{:.6f},{:.6f},{:.3f},{:.3f},{:.4f},\"{}\",\"{}\"\n", options.table, n, r.cpuMs, r.gpuMs.kernelMs,
-                         r.gpuMs.totalMs, r.cpuMs / r.gpuMs.kernelMs, r.cpuMs / r.gpuMs.totalMs, r.extra, device, cpu);
+      csv +=
+          fmt::format("{},{},{:.6f},{:.6f},{:.6f},{:.3f},{:.3f},{:.4f},{},{}\n", csvField(options.table), n, r.cpuMs, r.gpuMs.kernelMs,
+                      r.gpuMs.totalMs, r.cpuMs / r.gpuMs.kernelMs, r.cpuMs / r.gpuMs.totalMs, r.extra, csvQuoted(device), csvQuoted(cpu));
     } else {
       std::printf("%9ld %11.4f %13s %13s %10s %10s %10.3f\n", n, r.cpuMs, "-", "-", "-", "-", r.extra);
-      csv += fmt::format("{},{},{:.6f},,,,,{:.4f},\"{}\",\"{}\"\n", options.table, n, r.cpuMs, r.extra, device, cpu);
+      csv +=
+          fmt::format("{},{},{:.6f},,,,,{:.4f},{},{}\n", csvField(options.table), n, r.cpuMs, r.extra, csvQuoted(device), csvQuoted(cpu));
     }
     std::fflush(stdout);
   }

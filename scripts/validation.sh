@@ -18,15 +18,18 @@ rm -rf "$work/load"  # timed from scratch: the issue's figure is for the whole s
 start=$(date +%s.%N)
 "$gem" sweep "$here/scenarios/thesis/load_study.toml" --out "$work/load" --quiet --jobs "$(nproc)"
 load_seconds=$(awk -v a="$start" -v b="$(date +%s.%N)" "BEGIN{printf \"%.1f\", b - a}")
-"$gem" analyze "$work/load" --groups 121,004,040,400 --quiet
+"$gem" analyze "$work/load" --groups '121_46;004_46;040_46;400_46' --quiet
 
 cp "$work/resistance/analysis/resistance_vs_speed.svg" "$work/resistance/analysis/resistance_vs_concentration.svg" "$docs/"
 for f in force_cdf floe_mass_hist apex_hist across_bow force_vs_stem_distance force_vs_ship_speed; do
   [ -f "$work/load/analysis/$f.svg" ] && cp "$work/load/analysis/$f.svg" "$docs/load_$f.svg"
 done
 
-# CSV to a Markdown table (no quoted commas in these files' first columns).
-table() { awk -F, 'NR==1{h="|";s="|";for(i=1;i<=NF;i++){h=h" "$i" |";s=s" --- |"};print h;print s;next}{r="|";for(i=1;i<=NF;i++){r=r" "$i" |"};print r}' "$1"; }
+# CSV to a Markdown table, read as RFC 4180 (a sweep's group labels are quoted and hold commas).
+table() { python3 -c 'import csv,sys
+rows = list(csv.reader(open(sys.argv[1], newline="")))
+print("| " + " | ".join(rows[0]) + " |"); print("|" + " --- |" * len(rows[0]))
+for r in rows[1:]: print("| " + " | ".join(c.replace("|", "\\|") for c in r) + " |")' "$1"; }
 cut_columns() { cut -d, -f"$2" "$1"; }
 
 {

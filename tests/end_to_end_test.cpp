@@ -195,12 +195,10 @@ TEST(GemRun, AnIceFieldWithWallsHasUniqueIds) {
   EXPECT_EQ(test::runGem("check " + scenario.string() + " --quiet", dir.path() / "log"), 0) << test::readFile(dir.path() / "log");
   ASSERT_EQ(test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / "out").string(), dir.path() / "log"), 0)
       << test::readFile(dir.path() / "log");
-  std::istringstream rows(test::readFile(dir.path() / "out" / "state.csv"));
-  std::string row;
-  std::getline(rows, row);  // header
+  const std::vector<double> idColumn = readCsvTable(dir.path() / "out" / "state.csv").numbers("id");
   std::set<long> ids;
   int count = 0;
-  while (std::getline(rows, row)) ++count, ids.insert(std::stol(row.substr(0, row.find(','))));
+  for (double id : idColumn) ++count, ids.insert(std::lround(id));
   EXPECT_EQ(count, 4);
   EXPECT_EQ(ids, (std::set<long>{0, 1, 2, 3}));  // the floes 0 and 1 as in the file, then the walls
 }

@@ -46,6 +46,6 @@ frame_every = 0
   EXPECT_NE(text.find("rank 1 ["), std::string::npos) << text;
   const std::string csv = gem::test::readFile(dir.path() / "out" / "summary.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7) << csv;  // header + every case once
-  for (const char* name : {"bollard_thrust=23000", "bollard_thrust=740000"})
+  for (const char* name : {"bollard_thrust-23000", "bollard_thrust-740000"})
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "out" / "cases" / name / "summary.json")) << name;
 }

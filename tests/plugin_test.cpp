@@ -143,12 +143,7 @@ TEST(PluginRegistry, NameClashIsAnErrorUnlessTheScenarioOverrides) {
   const fs::path plain = dir.write("plain.toml", kFloe);
   ASSERT_EQ(gem::test::runGem("run " + plain.string() + " --quiet --out " + (dir.path() / "plain").string(), dir.path() / "log"), 0);
   // state.csv: id,kind,x,y,angle,vx,...: the plugin's drag slows the floe far more.
-  auto vx = [](const fs::path& state) {
-    std::string text = readFile(state);
-    std::string row = text.substr(text.find('\n') + 1);
-    for (int k = 0; k < 5; ++k) row = row.substr(row.find(',') + 1);
-    return std::stod(row.substr(0, row.find(',')));
-  };
+  auto vx = [](const fs::path& state) { return gem::readCsvTable(state).numbers("vx").at(0); };
   const double vxOverride = vx(dir.path() / "over" / "state.csv"), vxPlain = vx(dir.path() / "plain" / "state.csv");
   EXPECT_GT(vxPlain, 0.8);
   EXPECT_LT(vxOverride, 0.5 * vxPlain);
@@ -163,10 +158,7 @@ TEST(PluginSdk, APluginOfTheOldLayoutStillBuildsAndRuns) {
   ASSERT_EQ(gem::test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / "out").string(), dir.path() / "log"), 0)
       << readFile(dir.path() / "log");
   // state.csv: id,kind,x,y,angle,vx,vy,...: 20 steps of 0.1 s at 1 m/s^2 give vy = 2 m/s.
-  std::string row = readFile(dir.path() / "out" / "state.csv");
-  row = row.substr(row.find('\n') + 1);
-  for (int k = 0; k < 6; ++k) row = row.substr(row.find(',') + 1);
-  EXPECT_NEAR(std::stod(row.substr(0, row.find(','))), 2.0, 1e-9);
+  EXPECT_NEAR(gem::readCsvTable(dir.path() / "out" / "state.csv").numbers("vy").at(0), 2.0, 1e-9);
 }
 
 // Declared event order (docs/plugins.md "Order"): gem info lists the pair events in the order they
@@ -198,13 +190,10 @@ TEST(PluginOrder, AFrictionEventRunsAfterImpactAndReadsItsNormalImpulse) {
     EXPECT_EQ(gem::test::runGem("run " + scenario.string() + " --quiet --out " + (dir.path() / name).string(), dir.path() / "log"), 0)
         << readFile(dir.path() / "log");
     // state.csv: id,kind,x,y,angle,vx,vy,...: the row of id 1.
-    std::istringstream rows(readFile(dir.path() / name / "state.csv"));
-    std::string row;
-    while (std::getline(rows, row))
-      if (row.rfind("1,", 0) == 0) {
-        for (int k = 0; k < 6; ++k) row = row.substr(row.find(',') + 1);
-        return std::stod(row.substr(0, row.find(',')));
-      }
+    const gem::CsvTable state = gem::readCsvTable(dir.path() / name / "state.csv");
+    const std::vector<double> ids = state.numbers("id"), vy = state.numbers("vy");
+    for (size_t r = 0; r < ids.size(); ++r)
+      if (ids[r] == 1) return vy[r];
     ADD_FAILURE() << "no floe 1 in " << name;
     return 0.0;
   };
@@ -275,13 +264,7 @@ TEST(PluginSdk, InstallBuildEachExampleOutOfTreeRunItAndSeeItInGemInfo) {
   // shear_current: U = 0.2 + 0.01 y, floes at y = -40, 0, 40 (state.csv rows in id order): the
   // first drifts back (U < 0), the last fastest.
   {
-    std::vector<double> vx;
-    std::string text = readFile(dir.path() / "run_shear_current" / "state.csv");
-    for (size_t at = text.find('\n'); at + 1 < text.size(); at = text.find('\n', at + 1)) {
-      std::string row = text.substr(at + 1);
-      for (int k = 0; k < 5; ++k) row = row.substr(row.find(',') + 1);
-      vx.push_back(std::stod(row.substr(0, row.find(','))));
-    }
+    std::vector<double> vx = gem::readCsvTable(dir.path() / "run_shear_current" / "state.csv").numbers("vx");
     ASSERT_EQ(vx.size(), 3u);
     EXPECT_LT(vx[0], 0);
     EXPECT_GT(vx[1], 0);

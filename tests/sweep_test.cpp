@@ -22,34 +22,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A tiny channel: 20 floes, a small vessel entering them; milliseconds per run.
-const char* kBase = R"(
-[simulation]
-dt = 0.1
-steps = 40
-seed = 2
-[domain]
-x = [0.0, 60.0]
-y = [-20.0, 20.0]
-walls = true
-[field]
-kind = "random_convex"
-count = 20
-concentration = 0.3
-size_mean = 4.0
-size_sd = 1.0
-size_min = 2.0
-size_max = 7.0
-thickness = 0.5
-[vessel]
-length = 30.0
-beam = 8.0
-mass = 5e5
-position = [-16.0, 0.0]
-bollard_thrust = 92e3
-[output]
-frame_every = 0
-)";
+const char* const kBase = test::kTinyChannel;
 
 const char* kProduct = R"([sweep]
 base = "base.toml"
@@ -139,7 +112,7 @@ TEST(Sweep, RunsEveryCaseWritesScenariosAndGathers) {
   const fs::path out = dir.path() / "out";
   ASSERT_EQ(sweep(file, out), 0);
 
-  const fs::path caseDir = out / "cases" / "bollard_thrust=46000,concentration=0.3";
+  const fs::path caseDir = out / "cases" / "bollard_thrust-46000_concentration-0.3";
   ASSERT_TRUE(fs::exists(caseDir / "summary.json"));
   // The case as the sweep wrote it (case.toml) is the whole base with its overrides, and runs where
   // it lies; the run's own record (scenario.toml) repeats it.
@@ -253,10 +226,10 @@ TEST(Sweep, CaseIndexRunsExactlyOne) {
   int complete = 0;
   for (const auto& entry : fs::directory_iterator(out / "cases")) complete += fs::exists(entry.path() / "summary.json");
   EXPECT_EQ(complete, 1);
-  EXPECT_TRUE(fs::exists(out / "cases" / "bollard_thrust=92000,concentration=0.25" / "summary.json"));
+  EXPECT_TRUE(fs::exists(out / "cases" / "bollard_thrust-92000_concentration-0.25" / "summary.json"));
   // Unlike gem run, a sweep's case makes no plots: they would slow a large sweep for figures
   // nobody looks at case by case (gem plot draws one when wanted).
-  EXPECT_FALSE(fs::exists(out / "cases" / "bollard_thrust=92000,concentration=0.25" / "plots"));
+  EXPECT_FALSE(fs::exists(out / "cases" / "bollard_thrust-92000_concentration-0.25" / "plots"));
   EXPECT_EQ(lines(out / "summary.csv").size(), 2u);
   EXPECT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --case-index 4", log), 2);
 }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "events/ship_impact.hpp"
+#include "framework/output/csv.hpp"
 #include "framework/scenario/scenario.hpp"
 #include "framework/step/stepper.hpp"
 
@@ -80,23 +81,40 @@ inline int runGem(const std::string& arguments, const std::filesystem::path& log
 // The impacts the last step logged (ship_impact's record stream).
 inline std::vector<ImpactRecord> impactsOf(const Stepper& stepper) { return stepper.records().rows<ImpactRecord>(kImpactStream); }
 
-// Splits one CSV line, honouring quoted fields (RFC 4180: commas and doubled quotes inside).
+// One CSV line's cells, through GEM's CSV module (quoted fields hold commas and doubled quotes).
 inline std::vector<std::string> csvCells(const std::string& line) {
-  std::vector<std::string> cells(1);
-  bool quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"')
-      cells.back() += '"', ++i;
-    else if (c == '"')
-      quoted = !quoted;
-    else if (c == ',' && !quoted)
-      cells.emplace_back();
-    else
-      cells.back() += c;
-  }
-  return cells;
+  CsvRecords records = parseCsvRecords(line);
+  return records.cells.empty() ? std::vector<std::string>(1) : std::move(records.cells.front());
 }
+
+// A tiny channel for sweep tests: 20 floes, a small vessel entering them; milliseconds per run.
+inline const char* const kTinyChannel = R"(
+[simulation]
+dt = 0.1
+steps = 40
+seed = 2
+[domain]
+x = [0.0, 60.0]
+y = [-20.0, 20.0]
+walls = true
+[field]
+kind = "random_convex"
+count = 20
+concentration = 0.3
+size_mean = 4.0
+size_sd = 1.0
+size_min = 2.0
+size_max = 7.0
+thickness = 0.5
+[vessel]
+length = 30.0
+beam = 8.0
+mass = 5e5
+position = [-16.0, 0.0]
+bollard_thrust = 92e3
+[output]
+frame_every = 0
+)";
 
 inline std::string readFile(const std::filesystem::path& file) {
   std::ifstream in(file);

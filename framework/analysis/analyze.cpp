@@ -15,10 +15,10 @@
 #include <fmt/format.h>
 
 #include "framework/output/atomic_file.hpp"
-#include "framework/output/csv_field.hpp"
+#include "framework/output/csv.hpp"
 #include "framework/api/errors.hpp"
-#include "framework/analysis/csv_columns.hpp"
 #include "framework/analysis/statistics.hpp"
+#include "framework/analysis/sweep_cases.hpp"
 #include "framework/analysis/svg_plot.hpp"
 
 namespace gem {
@@ -44,7 +44,7 @@ struct Impact {
 double stemDistance(const Impact& i) { return i.xFromStem >= kMinStemDistance ? i.xFromStem : NAN; }
 
 struct Run {
-  std::string name;
+  std::string name, group, folder;
   std::vector<Impact> impacts;
   bool hasShipSpeed = false;
 };
@@ -357,8 +357,6 @@ void printTable(const std::vector<Group>& groups, const std::vector<GroupStatist
 
 }  // namespace
 
-std::string caseGroup(const std::string& caseName) { return caseName.substr(0, caseName.find('_')); }
-
 int runAnalyze(const AnalyzeOptions& options) {
   const fs::path dir = options.dir;
   if (!fs::is_directory(dir)) throw InputError(fmt::format("{}: no such folder", dir.string()));
@@ -370,19 +368,18 @@ int runAnalyze(const AnalyzeOptions& options) {
   size_t incomplete = 0;
   if (!sweep) {
     runs.push_back(readRun(dir, dir.filename().string()));
-  } else if (fs::is_directory(dir / "cases")) {
-    std::vector<fs::path> cases;
-    for (const fs::directory_entry& e : fs::directory_iterator(dir / "cases"))
-      if (e.is_directory()) cases.push_back(e.path());
-    std::sort(cases.begin(), cases.end());
-    for (const fs::path& c : cases) {
-      if (fs::exists(c / "impacts.csv"))
-        runs.push_back(readRun(c, c.filename().string()));
-      else
+  } else {
+    for (const SweepCaseInfo& c : readSweepCases(dir).cases) {
+      if (fs::exists(c.dir / "impacts.csv")) {
+        runs.push_back(readRun(c.dir, c.name));
+        runs.back().group = c.group;
+        runs.back().folder = c.dir.filename().string();
+      } else {
         ++incomplete;
+      }
     }
   }
-  // A resistance sweep (cases "FIELD,bollard_thrust=T") also gets its resistance analysis.
+  // A sweep of bollard thrusts with summary.csv's in-ice means also gets its resistance analysis.
   const bool resistance = sweep && analyzeResistance(dir, options.quiet);
   if (runs.empty() && resistance) return 0;
   if (runs.empty())
@@ -391,26 +388,33 @@ int runAnalyze(const AnalyzeOptions& options) {
                     "case",
                     dir.string()));
 
-  // Groups: a run folder is one group "all"; a sweep groups its cases by name prefix (thesis
-  // Figure 6.38), plus "all" of the chosen ones.
+  // Groups: a run folder is one group "all"; a sweep groups its cases by the values of its varied
+  // keys other than thrust and seed (sweep_cases.hpp; thesis Figure 6.38 groups by ice mix), plus
+  // "all" of the chosen ones. --groups names a group by its label or by one of its cases' names.
   std::vector<Group> groups;
   if (sweep) {
-    std::map<std::string, std::vector<const Run*>> byPrefix;
-    for (const Run& r : runs) byPrefix[caseGroup(r.name)].push_back(&r);
-    for (const std::string& wanted : options.groups)
-      if (!byPrefix.count(wanted)) {
+    std::map<std::string, std::vector<const Run*>> byGroup;
+    for (const Run& r : runs) byGroup[r.group].push_back(&r);
+    std::set<std::string> chosen;
+    for (const std::string& wanted : options.groups) {
+      const auto member = std::find_if(runs.begin(), runs.end(), [&](const Run& r) { return r.name == wanted || r.folder == wanted; });
+      if (byGroup.count(wanted)) {
+        chosen.insert(wanted);
+      } else if (member != runs.end()) {
+        chosen.insert(member->group);
+      } else {
         std::string known;
-        for (const auto& [name, members] : byPrefix) known += (known.empty() ? "" : ", ") + name;
+        for (const auto& [name, members] : byGroup) known += (known.empty() ? "" : "; ") + name;
         throw InputError(fmt::format("{}: no case in group \"{}\" (groups: {})", dir.string(), wanted, known));
       }
-    for (const auto& [name, members] : byPrefix)
-      if (options.groups.empty() || std::count(options.groups.begin(), options.groups.end(), name))
-        groups.push_back({name, plotColor(groups.size()), members});
+    }
+    for (const auto& [name, members] : byGroup)
+      if (options.groups.empty() || chosen.count(name)) groups.push_back({name, plotColor(groups.size()), members});
   }
   Group all{"all", kAllColor, {}};
   for (const Group& g : groups) all.runs.insert(all.runs.end(), g.runs.begin(), g.runs.end());
   if (!sweep) all.runs.push_back(&runs.front());
-  if (groups.size() == 1) groups.clear();  // one prefix: it is "all"
+  if (groups.size() == 1) groups.clear();  // one group: it is "all"
   groups.push_back(std::move(all));
 
   std::vector<GroupStatistics> stats;

@@ -18,15 +18,12 @@ namespace gem {
 struct AnalyzeOptions {
   std::string dir;  // a run folder (impacts.csv) or a sweep folder (cases/*/impacts.csv)
   bool quiet = false;
-  // Sweep only: the groups to analyse, by case-name prefix before the first '_' (the thesis's run
-  // names nnn_p group by ice mix nnn: Figure 6.38 shows 121, 004, 040 and 400). Empty: every
-  // prefix. The group "all" is the union of the chosen groups.
+  // Sweep only: the groups to analyse, each by its label ("concentration=0.4": the values of the
+  // varied keys other than vessel.bollard_thrust and simulation.seed, sweep_cases.hpp) or by the
+  // name of one of its cases ("121_46" for the load study's ice mix 121, thesis Figure 6.38).
+  // Empty: every group. The group "all" is the union of the chosen groups.
   std::vector<std::string> groups;
 };
-
-// The group of a sweep case: its name up to the first '_' ("121_370" -> "121"), or the whole
-// name when it has none.
-std::string caseGroup(const std::string& caseName);
 
 // Returns 0. Throws InputError when DIR holds neither impacts.csv nor cases/*/impacts.csv, when an
 // impacts.csv is malformed (file:line), or when a requested group has no case.

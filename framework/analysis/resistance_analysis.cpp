@@ -11,6 +11,8 @@
 
 #include "framework/output/atomic_file.hpp"
 #include "framework/analysis/statistics.hpp"
+#include "framework/analysis/sweep_cases.hpp"
+#include "framework/output/csv.hpp"
 #include "framework/analysis/svg_plot.hpp"
 
 namespace fs = std::filesystem;
@@ -18,30 +20,6 @@ namespace fs = std::filesystem;
 namespace gem {
 
 namespace {
-
-// One CSV line into cells; quoted cells may hold commas ("" is a quote).
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> cells(1);
-  bool quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"')
-        cells.back() += '"', ++i;
-      else if (c == '"')
-        quoted = false;
-      else
-        cells.back() += c;
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      cells.emplace_back();
-    } else {
-      cells.back() += c;
-    }
-  }
-  return cells;
-}
 
 double toNumber(const std::string& s) {
   try {
@@ -51,36 +29,31 @@ double toNumber(const std::string& s) {
   }
 }
 
+// A concentration as its cell: empty when the case's scenario gives none (not "nan").
+std::string concentrationCell(double c) { return std::isfinite(c) ? fmt::format("{}", c) : ""; }
+
 }  // namespace
 
 std::vector<ResistancePoint> readResistancePoints(const fs::path& sweepDir) {
-  std::ifstream in(sweepDir / "summary.csv");
-  std::string line;
-  if (!in || !std::getline(in, line)) return {};
-  const std::vector<std::string> header = splitCsv(line);
-  auto column = [&](const char* name) {
-    for (size_t k = 0; k < header.size(); ++k)
-      if (header[k] == name) return static_cast<int>(k);
-    return -1;
-  };
-  const int name = column("name"), thrust = column("vessel.bollard_thrust"), speed = column("ship_speed_in_ice_mean"),
-            resistance = column("resistance_in_ice_mean");
-  if (name < 0 || thrust < 0 || speed < 0 || resistance < 0) return {};
+  if (!fs::exists(sweepDir / "summary.csv")) return {};
+  const CsvTable summary = readCsvTable(sweepDir / "summary.csv");
+  const int name = summary.column("name"), speed = summary.column("ship_speed_in_ice_mean"),
+            resistance = summary.column("resistance_in_ice_mean");
+  if (name < 0 || summary.column("vessel.bollard_thrust") < 0 || speed < 0 || resistance < 0) return {};
+  // The inputs of each case from its own folder (scenario.toml), never from its name.
+  const SweepCases cases = readSweepCases(sweepDir);
   std::vector<ResistancePoint> points;
-  while (std::getline(in, line)) {
-    const std::vector<std::string> cells = splitCsv(line);
-    if (static_cast<int>(cells.size()) <= std::max({name, thrust, speed, resistance})) continue;
-    const std::string& caseName = cells[name];
-    const auto comma = caseName.find(',');
-    if (comma == std::string::npos) continue;
+  for (const std::vector<std::string>& row : summary.rows) {
+    const auto c =
+        std::find_if(cases.cases.begin(), cases.cases.end(), [&](const SweepCaseInfo& i) { return i.name == row[size_t(name)]; });
+    if (c == cases.cases.end()) continue;
     ResistancePoint p;
-    p.field = caseName.substr(0, comma);
-    const auto underscore = p.field.rfind('_');
-    p.concentration = underscore == std::string::npos ? NAN : toNumber(p.field.substr(underscore + 1)) / 100;
-    p.thrust = toNumber(cells[thrust]);
-    p.speed = toNumber(cells[speed]);
-    p.resistance = toNumber(cells[resistance]);
-    if (std::isfinite(p.speed) && std::isfinite(p.resistance)) points.push_back(p);
+    p.field = c->group;
+    p.concentration = c->concentration;
+    p.thrust = c->thrust;
+    p.speed = toNumber(row[size_t(speed)]);
+    p.resistance = toNumber(row[size_t(resistance)]);
+    if (std::isfinite(p.thrust) && std::isfinite(p.speed) && std::isfinite(p.resistance)) points.push_back(p);
   }
   return points;
 }
@@ -95,7 +68,8 @@ bool analyzeResistance(const fs::path& sweepDir, bool quiet) {
   std::map<std::string, std::vector<const ResistancePoint*>> byField;
   std::map<double, std::vector<const ResistancePoint*>> byThrust;
   for (const ResistancePoint& p : points) {
-    table += fmt::format("{},{},{},{:.6g},{:.6g}\n", p.field, p.concentration, p.thrust, p.speed, p.resistance);
+    table +=
+        fmt::format("{},{},{},{:.6g},{:.6g}\n", csvField(p.field), concentrationCell(p.concentration), p.thrust, p.speed, p.resistance);
     byField[p.field].push_back(&p);
     byThrust[p.thrust].push_back(&p);
   }
@@ -123,8 +97,9 @@ bool analyzeResistance(const fs::path& sweepDir, bool quiet) {
       }
       vsSpeed.addLine("", lx, ly, color);
     }
-    fits += fit.ok ? fmt::format("{},{},{:.6g},{:.6g},{:.4f},{}\n", field, list.front()->concentration, fit.a, fit.b, fit.r2, fit.count)
-                   : fmt::format("{},{},,,,{}\n", field, list.front()->concentration, fit.count);
+    const std::string row = csvField(field) + "," + concentrationCell(list.front()->concentration);
+    fits += fit.ok ? fmt::format("{},{:.6g},{:.6g},{:.4f},{}\n", row, fit.a, fit.b, fit.r2, fit.count)
+                   : fmt::format("{},,,,{}\n", row, fit.count);
     if (!quiet)
       std::printf("%-14s %5.0f%% %12.4g %7.3f %6.3f\n", field.c_str(), 100 * list.front()->concentration, fit.ok ? fit.a : NAN,
                   fit.ok ? fit.b : NAN, fit.ok ? fit.r2 : NAN);

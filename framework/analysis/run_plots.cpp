@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "framework/analysis/csv_columns.hpp"
+#include "framework/output/csv.hpp"
 #include "framework/analysis/svg_plot.hpp"
 #include "framework/api/errors.hpp"
 #include "framework/output/run_folder.hpp"

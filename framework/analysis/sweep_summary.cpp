@@ -10,7 +10,7 @@
 
 #include "framework/api/errors.hpp"
 #include "framework/output/atomic_file.hpp"
-#include "framework/output/csv_field.hpp"
+#include "framework/output/csv.hpp"
 
 namespace fs = std::filesystem;
 
@@ -92,8 +92,7 @@ int writeSweepSummary(const SweepDefinition& sweep, const fs::path& csv, const s
   std::vector<std::string> header{"name"};
   header.insert(header.end(), sweep.columns.begin(), sweep.columns.end());
   header.insert(header.end(), sweepSummaryColumns().begin(), sweepSummaryColumns().end());
-  for (size_t k = 0; k < header.size(); ++k) out.stream() << (k ? "," : "") << csvField(header[k]);
-  out.stream() << "\n";
+  out.stream() << csvRow(header);
   int rows = 0;
   for (size_t i = 0; i < sweep.cases.size(); ++i) {
     const fs::path json = caseDirs[i] / "summary.json";
@@ -101,13 +100,13 @@ int writeSweepSummary(const SweepDefinition& sweep, const fs::path& csv, const s
     const std::map<std::string, std::string> summary = readSummaryJson(json);
     if (auto completed = summary.find("completed"); completed != summary.end() && completed->second == "false") continue;
     const SweepCase& c = sweep.cases[i];
-    out.stream() << csvField(c.name);
-    for (const std::string& key : sweep.columns) out.stream() << "," << csvField(sweepCell(c, key));
+    std::vector<std::string> row{c.name};
+    for (const std::string& key : sweep.columns) row.push_back(sweepCell(c, key));
     for (const auto& [column, key] : columnKeys()) {
       auto it = summary.find(key);
-      out.stream() << "," << csvField(it == summary.end() ? "" : it->second);
+      row.push_back(it == summary.end() ? "" : it->second);
     }
-    out.stream() << "\n";
+    out.stream() << csvRow(row);
     ++rows;
   }
   out.commit();

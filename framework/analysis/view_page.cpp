@@ -12,7 +12,7 @@
 #include <ostream>
 #include <vector>
 
-#include "framework/analysis/csv_table.hpp"
+#include "framework/output/csv.hpp"
 #include "framework/analysis/sweep_summary.hpp"
 #include "framework/analysis/view_pack.hpp"
 #include "framework/analysis/view_script.hpp"

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/csv.hpp"
 #include "framework/step/cpu_stepper.hpp"
 #include "framework/world/vessel.hpp"
 
@@ -140,9 +141,9 @@ double runCalibration(const std::string& scenarioFile, const std::string& outDir
       std::printf("%-28s %6.1f %6.1f %14.2f %14.2f %8.2f%%%s\n", c.name.c_str(), static_cast<double>(r.frameAngleDeg),
                   static_cast<double>(r.logged ? r.record.apexDeg : 0), r.record.force / 1e3, r.directForce / 1e3, 100 * diff,
                   r.logged ? "" : "  (no impact logged)");
-    csv += fmt::format("{},{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", c.name, c.edge, c.corner ? "corner" : "face",
-                       c.speed, c.thickness, r.frameAngleDeg, r.logged ? r.record.apexDeg : Real(NAN), r.record.force, r.directForce, diff,
-                       r.record.forceLimit, r.directLimit, r.record.broke ? 1 : 0);
+    csv += fmt::format("{},{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", csvField(c.name), c.edge,
+                       c.corner ? "corner" : "face", c.speed, c.thickness, r.frameAngleDeg, r.logged ? r.record.apexDeg : Real(NAN),
+                       r.record.force, r.directForce, diff, r.record.forceLimit, r.directLimit, r.record.broke ? 1 : 0);
   }
   std::filesystem::create_directories(outDir);
   writeFileAtomically(std::filesystem::path(outDir) / "calibration.csv", csv);

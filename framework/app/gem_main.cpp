@@ -263,7 +263,13 @@ int main(int argc, char** argv) {
   AnalyzeOptions analyze;
   CLI::App* analyzeCommand = app.add_subcommand("analyze", "impact-load statistics and plots of a run or sweep folder");
   analyzeCommand->add_option("dir", analyze.dir, "run folder or sweep folder")->required();
-  analyzeCommand->add_option("--groups", analyze.groups, "case-name prefixes to analyse, e.g. 121,004,040,400")->delimiter(',');
+  // A label holds commas ("concentration=0.4,count=668"): groups are separated by ';' or given by
+  // repeating --groups.
+  analyzeCommand
+      ->add_option("--groups", analyze.groups,
+                   "groups to analyse, each by its label (concentration=0.4) or a case's name (121_46); several: repeat "
+                   "--groups or separate with ';'")
+      ->delimiter(';');
   analyzeCommand->add_flag("--quiet", analyze.quiet, "print nothing but errors");
 
   std::string plotDir;

@@ -12,8 +12,11 @@
 
 #include <fmt/format.h>
 
+#include <nlohmann/json.hpp>
+
 #include "events/propulsion.hpp"
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/csv.hpp"
 #include "framework/output/run_folder.hpp"
 #include "framework/output/run_folder_lock.hpp"
 #include "framework/api/errors.hpp"
@@ -38,11 +41,21 @@ struct Accumulator {
   Stats stats() const { return count ? Stats{min, sum / count, max, count} : Stats{}; }
 };
 
-std::string jsonNumber(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
+// A finite double as summary.json has always written it, 9 significant digits (an integral value
+// without a fraction: "100", not "100.0"); NaN and infinities, which JSON lacks, as null.
+nlohmann::ordered_json jsonNumber(double v) {
+  if (!std::isfinite(v)) return nullptr;
+  const double rounded = std::stod(fmt::format("{:.9g}", v));
+  if (rounded == std::trunc(rounded) && std::fabs(rounded) < 1e15) return static_cast<std::int64_t>(rounded);
+  return rounded;
+}
 
-std::string jsonStats(const Stats& s) {
-  if (s.count == 0) return R"({"min": null, "mean": null, "max": null})";
-  return fmt::format(R"({{"min": {}, "mean": {}, "max": {}}})", jsonNumber(s.min), jsonNumber(s.mean), jsonNumber(s.max));
+nlohmann::ordered_json jsonStats(const Stats& s) {
+  nlohmann::ordered_json out;
+  out["min"] = s.count ? jsonNumber(s.min) : nullptr;
+  out["mean"] = s.count ? jsonNumber(s.mean) : nullptr;
+  out["max"] = s.count ? jsonNumber(s.max) : nullptr;
+  return out;
 }
 
 std::string formatDuration(double seconds) {
@@ -59,40 +72,66 @@ void writeStateCsv(const std::filesystem::path& file, const World& w) {
     const int n = w.worldVertices(i, v);
     std::string vertices;
     for (int k = 0; k < n; ++k) vertices += fmt::format("{}{:.9g} {:.9g}", k ? " " : "", v[k].x, v[k].y);
-    out.stream() << fmt::format("{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},\"{}\"\n", w.id[i],
-                                bodyKindName(w.kind[i]), w.x[i], w.y[i], w.angle[i], w.vx[i], w.vy[i], w.omega[i], w.area[i],
-                                w.thickness[i], w.mass[i], vertices);
+    out.stream() << fmt::format("{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n", w.id[i],
+                                csvField(bodyKindName(w.kind[i])), w.x[i], w.y[i], w.angle[i], w.vx[i], w.vy[i], w.omega[i], w.area[i],
+                                w.thickness[i], w.mass[i], csvQuoted(vertices));
   }
   out.commit();
 }
 
 }  // namespace
 
-// The record streams' totals (ship_impact's "impacts" and "impact_force_n"), one line each.
-static std::string recordTotalsJson(const RunSummary& s) {
-  std::string out;
-  for (const RecordTotals& t : s.records) {
-    if (!t.countKey.empty()) out += fmt::format("  \"{}\": {},\n", t.countKey, t.count);
-    if (!t.statisticKey.empty()) out += fmt::format("  \"{}\": {},\n", t.statisticKey, jsonStats(t.statistic));
-  }
-  return out;
-}
-
+// summary.json through nlohmann-json, so that every string (a device name with quotes or
+// backslashes) is escaped; the keys in the order docs/scenario.md 4.1 lists them.
 std::string summaryJson(const RunSummary& s) {
-  return fmt::format(
-      "{{\n"
-      "  \"gem_version\": \"{}\",\n  \"completed\": {},\n  \"stop_reason\": \"{}\",\n  \"steps\": {},\n  \"sim_time_s\": {},\n  "
-      "\"wall_time_s\": {},\n"
-      "  \"real_time_factor\": {},\n  \"backend\": \"{}\",\n  \"driver\": \"{}\",\n  \"broadphase\": \"{}\",\n  \"device\": \"{}\",\n"
-      "  \"floes_initial\": {},\n  \"floes_final\": {},\n  \"floes_broken\": {},\n"
-      "  \"ice_mass_initial_kg\": {},\n  \"ice_mass_final_kg\": {},\n  \"rubble_mass_kg\": {},\n"
-      "  \"cases_on_device\": {},\n{}  \"ship_speed\": {},\n  \"net_thrust_n\": {},\n"
-      "  \"resistance_mean_n\": {},\n  \"ship_speed_in_ice\": {},\n  \"resistance_in_ice_n\": {}\n}}\n",
-      GEM_VERSION, s.completed ? "true" : "false", s.stopReason, s.steps, jsonNumber(s.simTime), jsonNumber(s.wallTime),
-      jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY), s.backend, s.driver, s.broadphase, s.device, s.floesInitial,
-      s.floesFinal, s.floesBroken, jsonNumber(s.iceMassInitial), jsonNumber(s.iceMassFinal), jsonNumber(s.rubbleMass), s.casesOnDevice,
-      recordTotalsJson(s), jsonStats(s.shipSpeed), jsonStats(s.netThrust), s.netThrust.count ? jsonNumber(s.netThrust.mean) : "null",
-      jsonStats(s.shipSpeedInIce), s.netThrustInIce.count ? jsonNumber(s.netThrustInIce.mean) : "null");
+  nlohmann::ordered_json j;
+  j["gem_version"] = GEM_VERSION;
+  j["completed"] = s.completed;
+  j["stop_reason"] = s.stopReason;
+  j["steps"] = s.steps;
+  j["sim_time_s"] = jsonNumber(s.simTime);
+  j["wall_time_s"] = jsonNumber(s.wallTime);
+  j["real_time_factor"] = jsonNumber(s.wallTime > 0 ? s.simTime / s.wallTime : INFINITY);
+  j["backend"] = s.backend;
+  j["driver"] = s.driver;
+  j["broadphase"] = s.broadphase;
+  j["device"] = s.device;
+  j["floes_initial"] = s.floesInitial;
+  j["floes_final"] = s.floesFinal;
+  j["floes_broken"] = s.floesBroken;
+  j["ice_mass_initial_kg"] = jsonNumber(s.iceMassInitial);
+  j["ice_mass_final_kg"] = jsonNumber(s.iceMassFinal);
+  j["rubble_mass_kg"] = jsonNumber(s.rubbleMass);
+  j["cases_on_device"] = s.casesOnDevice;
+  // The record streams' totals (ship_impact's "impacts" and "impact_force_n").
+  for (const RecordTotals& t : s.records) {
+    if (!t.countKey.empty()) j[t.countKey] = t.count;
+    if (!t.statisticKey.empty()) j[t.statisticKey] = jsonStats(t.statistic);
+  }
+  j["ship_speed"] = jsonStats(s.shipSpeed);
+  j["net_thrust_n"] = jsonStats(s.netThrust);
+  j["resistance_mean_n"] = s.netThrust.count ? jsonNumber(s.netThrust.mean) : nullptr;
+  j["ship_speed_in_ice"] = jsonStats(s.shipSpeedInIce);
+  j["resistance_in_ice_n"] = s.netThrustInIce.count ? jsonNumber(s.netThrustInIce.mean) : nullptr;
+  // The layout GEM has always written (one key a line, the min/mean/max objects on theirs); every
+  // key and value through nlohmann's dump, so strings are escaped, and invalid UTF-8 (a device
+  // name cut mid-character) is replaced rather than thrown.
+  const auto dump = [](const nlohmann::ordered_json& v) {
+    return v.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  };
+  std::string out = "{\n";
+  size_t k = 0;
+  for (const auto& [key, value] : j.items()) {
+    std::string text;
+    if (value.is_object()) {
+      for (const auto& [name, inner] : value.items()) text += (text.empty() ? "{" : ", ") + dump(name) + ": " + dump(inner);
+      text += "}";
+    } else {
+      text = dump(value);
+    }
+    out += "  " + dump(key) + ": " + text + (++k < j.size() ? ",\n" : "\n");
+  }
+  return out + "}\n";
 }
 
 namespace {

@@ -81,6 +81,8 @@ Scenario validateCase(const SweepDefinition& sweep, const SweepCase& c, const fs
   }
 }
 
+// The first two lines are read back by gem analyze (framework/analysis/sweep_cases.cpp): the case's
+// name and its base scenario, which its folder name and scenario.toml do not hold.
 std::string scenarioText(const SweepDefinition& sweep, const SweepCase& c, const Scenario& s) {
   std::ostringstream out;
   out << "# Case \"" << c.name << "\" of the sweep " << sweep.file.string() << " (gem sweep)\n# base: " << c.base.string() << "\n";
@@ -199,7 +201,7 @@ int runSweep(const SweepOptions& options) {
   std::vector<std::string> texts;
   std::vector<Scenario> scenarios;  // as each case will run
   for (const SweepCase& c : sweep.cases) {
-    dirs.push_back(outDir / "cases" / c.name);
+    dirs.push_back(outDir / "cases" / c.folder);
     scenarios.push_back(validateCase(sweep, c, dirs.back()));
     texts.push_back(scenarioText(sweep, c, scenarios.back()));
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -160,6 +161,20 @@ std::vector<Combination> expandParameters(const std::vector<Leaf>& parameters, c
 
 }  // namespace
 
+std::string caseFolderName(const std::string& name) {
+  std::string out;
+  for (char c : name) {
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-')
+      out += c;
+    else if (c == '=' || c == '#')
+      out += '-';
+    else if (c != '+')
+      out += '_';
+  }
+  if (out.empty() || out[0] == '.' || out[0] == '-') out = "_" + out;
+  return out;
+}
+
 std::string sweepCell(const SweepCase& c, const std::string& key) {
   for (const SweepOverride& o : c.overrides)
     if (o.varied && o.key == key) return o.text;
@@ -267,6 +282,14 @@ SweepDefinition readSweepFile(const fs::path& file) {
             fmt::format("two cases are named \"{}\" (cases {} and {}): case names must differ", sc.name, it->second, def.cases.size()));
       def.cases.push_back(std::move(sc));
     }
+  }
+  // Folders: unique among the sweep's cases, first come first served (the order of the cases is the
+  // sweep file's, so a sweep always gives a case the same folder).
+  std::set<std::string> folders;
+  for (SweepCase& c : def.cases) {
+    const std::string stem = caseFolderName(c.name);
+    c.folder = stem;
+    for (int k = 2; !folders.insert(c.folder).second; ++k) c.folder = fmt::format("{}_{}", stem, k);
   }
   return def;
 }

@@ -16,7 +16,8 @@ struct SweepOverride {
 };
 
 struct SweepCase {
-  std::string name;
+  std::string name;                      // the row label of summary.csv; may hold ',' and '='
+  std::string folder;                    // its folder under cases/: caseFolderName(name), unique
   std::filesystem::path base;            // absolute
   std::vector<SweepOverride> overrides;  // in the order they apply
   int line = 0, column = 0;              // its [[cases]] entry, else [parameters]
@@ -33,6 +34,12 @@ struct SweepDefinition {
 // Throws InputError (file:line:column) for a malformed sweep file. Checks that every base exists;
 // the scenarios themselves are checked by the caller.
 SweepDefinition readSweepFile(const std::filesystem::path& file);
+
+// A case name as a folder name of only [A-Za-z0-9._-], safe in a shell and in tools that split on
+// commas or '=': '=' and '#' become '-', ',' becomes '_', '+' is dropped ("1e+06" -> "1e06"), any
+// other character becomes '_'; a name that would start with '.' or '-' gets a leading '_'.
+// readSweepFile makes the folders of one sweep unique (a suffix "_2", "_3", ... on a clash).
+std::string caseFolderName(const std::string& name);
 
 // The value of `key` among a case's varied overrides ("" when it does not set it).
 std::string sweepCell(const SweepCase& c, const std::string& key);

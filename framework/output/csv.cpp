@@ -1,0 +1,177 @@
+// The CSV module (csv.hpp): one character-level RFC 4180 reader and the writer's quoting.
+#include "framework/output/csv.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
+
+namespace gem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The values a column of GEM's own files can hold: an edited file outside them is refused (naming
+// the line) rather than plotted (an apex of 1e7 deg made a 5-degree histogram of 150 MB).
+struct ColumnRange {
+  const char* column;
+  double lo, hi;
+  const char* why;
+};
+constexpr ColumnRange kColumnRanges[] = {
+    {"apex_deg", 0, 180, "an apex angle is 0 to 180 degrees"},
+    {"y_from_centerline", -1e4, 1e4, "no hull is 20 km wide"},
+    {"x_from_stem", -1e5, 1e5, "no hull is 100 km long"},
+};
+
+}  // namespace
+
+std::string csvQuoted(std::string_view text) {
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::string csvField(std::string_view text) {
+  const bool spaced = !text.empty() && (text.front() == ' ' || text.back() == ' ');
+  if (!spaced && text.find_first_of(",\"\n\r") == std::string_view::npos) return std::string(text);
+  return csvQuoted(text);
+}
+
+std::string csvRow(const std::vector<std::string>& fields) {
+  std::string out;
+  for (size_t k = 0; k < fields.size(); ++k) out += (k ? "," : "") + csvField(fields[k]);
+  return out + "\n";
+}
+
+CsvRecords parseCsvRecords(std::string_view text, const std::string& file) {
+  CsvRecords records;
+  std::vector<std::string> cells(1);
+  bool quoted = false, anyText = false;
+  int line = 1, rowLine = 1;
+  // Ends the current record; a blank line is no record.
+  const auto endRow = [&] {
+    if (anyText) {
+      records.cells.push_back(std::move(cells));
+      records.lines.push_back(rowLine);
+    }
+    cells.assign(1, std::string());
+    anyText = false;
+    rowLine = line;
+  };
+  // One pass over the characters: a quoted field may hold the line breaks and commas that a split
+  // by lines, then by commas, would cut it at.
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') {
+        cells.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        if (c == '\n') ++line;
+        cells.back() += c;
+      }
+      continue;
+    }
+    if (c == '"') {
+      quoted = anyText = true;
+    } else if (c == ',') {
+      cells.emplace_back();
+      anyText = true;
+    } else if (c == '\n') {
+      ++line;
+      endRow();
+    } else if (c != '\r') {  // a Windows line end is a line end
+      cells.back() += c;
+      anyText = true;
+    }
+  }
+  if (quoted) throw InputError(file, rowLine, 0, "a quoted field is not closed");
+  endRow();
+  return records;
+}
+
+int CsvTable::column(const std::string& name) const {
+  const auto it = std::find(header.begin(), header.end(), name);
+  return it == header.end() ? -1 : static_cast<int>(it - header.begin());
+}
+
+std::vector<double> CsvTable::numbers(const std::string& name, bool emptyIsNaN) const {
+  const int c = column(name);
+  if (c < 0) throw InputError(file.string(), 1, 0, fmt::format("no column \"{}\" in the header", name));
+  std::vector<double> values;
+  values.reserve(rows.size());
+  for (size_t r = 0; r < rows.size(); ++r) {
+    std::string_view s = rows[r][size_t(c)];
+    while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+    while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
+    if (s.starts_with('+')) s.remove_prefix(1);
+    double v = std::numeric_limits<double>::quiet_NaN();
+    if (s.empty() && !emptyIsNaN)
+      throw InputError(file.string(), lines[r], 0, fmt::format("column {}: \"{}\" is not a number", name, rows[r][size_t(c)]));
+    if (!s.empty()) {
+      const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+      if (ec != std::errc() || end != s.data() + s.size())
+        throw InputError(file.string(), lines[r], 0, fmt::format("column {}: \"{}\" is not a number", name, rows[r][size_t(c)]));
+    }
+    values.push_back(v);
+  }
+  return values;
+}
+
+CsvTable parseCsvTable(std::string_view text, const fs::path& file) {
+  CsvRecords records = parseCsvRecords(text, file.string());
+  if (records.cells.empty()) throw InputError(file.string(), 1, 0, "empty file: expected a header row");
+  CsvTable table;
+  table.file = file;
+  table.header = std::move(records.cells.front());
+  for (size_t r = 1; r < records.cells.size(); ++r) {
+    if (records.cells[r].size() != table.header.size())
+      throw InputError(file.string(), records.lines[r], 0,
+                       fmt::format("{} cells, the header has {}", records.cells[r].size(), table.header.size()));
+    table.rows.push_back(std::move(records.cells[r]));
+    table.lines.push_back(records.lines[r]);
+  }
+  return table;
+}
+
+CsvTable readCsvTable(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot be opened");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InputError(file.string() + ": cannot be read");
+  return parseCsvTable(text, file);
+}
+
+std::vector<std::string> readCsvHeader(const fs::path& file) { return readCsvTable(file).header; }
+
+std::vector<std::vector<double>> readColumns(const fs::path& file, const std::vector<std::string>& wanted, bool emptyIsNaN) {
+  const CsvTable table = readCsvTable(file);
+  for (const std::string& w : wanted)
+    if (table.column(w) < 0) throw InputError(file.string(), 1, 0, fmt::format("no column \"{}\" in the header", w));
+  std::vector<std::vector<double>> columns;
+  for (const std::string& w : wanted) {
+    columns.push_back(table.numbers(w, emptyIsNaN));
+    for (const ColumnRange& r : kColumnRanges) {
+      if (w != r.column) continue;
+      for (size_t k = 0; k < columns.back().size(); ++k) {
+        const double v = columns.back()[k];
+        if (std::isfinite(v) && !(v >= r.lo && v <= r.hi))
+          throw InputError(file.string(), table.lines[k], 0,
+                           fmt::format("column {}: {} is outside {} to {} ({})", r.column, v, r.lo, r.hi, r.why));
+      }
+    }
+  }
+  return columns;
+}
+
+}  // namespace gem
