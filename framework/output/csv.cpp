@@ -47,7 +47,10 @@ std::string csvField(std::string_view text) {
 
 std::string csvRow(const std::vector<std::string>& fields) {
   std::string out;
-  for (size_t k = 0; k < fields.size(); ++k) out += (k ? "," : "") + csvField(fields[k]);
+  for (size_t k = 0; k < fields.size(); ++k) {
+    if (k > 0) out += ',';
+    out += csvField(fields[k]);
+  }
   return out + "\n";
 }
 
