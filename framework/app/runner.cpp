@@ -312,7 +312,7 @@ class ScenarioRun {
  private:
   void writeFrames() {
     Stepper& sim = *m_stepper;
-    if (m_vtk) m_vtk->addFrame(sim.hostWorld(), sim.time());
+    if (m_vtk) m_vtk->addFrame(sim.hostWorld(), sim.time(), sim.contactForces());
     if (m_ice) m_ice->addFrame(sim.hostWorld(), sim.time());
   }
   void closeFiles() {

@@ -2,6 +2,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -111,7 +112,8 @@ class ArrayWriter {
   std::vector<unsigned char> m_appended;
 };
 
-std::string polyData(const World& world, double time, bool binary, const std::unordered_set<std::int64_t>& firstIds) {
+std::string polyData(const World& world, double time, bool binary, const std::unordered_set<std::int64_t>& firstIds,
+                     const std::vector<std::pair<std::int64_t, Real>>* contactForces) {
   const std::size_t n = static_cast<std::size_t>(world.size());
   std::vector<Vec2> points;  // every body's world vertices, one after the other
   std::vector<std::int64_t> offsets;
@@ -163,6 +165,11 @@ std::string polyData(const World& world, double time, bool binary, const std::un
   arrays.add<Real>(out, "mass", 1, n, [&](std::size_t i) { return world.mass[i]; });
   // 1 for a piece that a break made (an id the series' first frame did not have).
   arrays.add<std::uint8_t>(out, "broken", 1, n, [&](std::size_t i) { return firstIds.count(world.id[i]) ? 0 : 1; });
+  if (contactForces)
+    arrays.add<Real>(out, "contact_force", 1, n, [&](std::size_t i) {
+      const auto found = std::lower_bound(contactForces->begin(), contactForces->end(), std::pair<std::int64_t, Real>{world.id[i], Real(-1)});
+      return found != contactForces->end() && found->first == world.id[i] ? found->second : Real(0);
+    });
   out += "      </CellData>\n";
 
   // Polys: connectivity lists each polygon's point indices; offsets[i] is the end of polygon i.
@@ -185,13 +192,13 @@ VtkSeriesWriter::VtkSeriesWriter(std::filesystem::path runDir, bool binary) : m_
   if (ec) throw std::runtime_error("cannot create " + (m_runDir / "frames").string() + ": " + ec.message());
 }
 
-void VtkSeriesWriter::addFrame(const World& world, double time) {
+void VtkSeriesWriter::addFrame(const World& world, double time, const std::vector<std::pair<std::int64_t, Real>>* contactForces) {
   if (m_finished) throw std::logic_error("VtkSeriesWriter::addFrame after finish() in " + m_runDir.string());
   char name[32];
   std::snprintf(name, sizeof name, "frame_%06d.vtp", frameCount());
   const std::string relative = std::string("frames/") + name;
   if (m_entries.empty()) m_firstIds.insert(world.id.begin(), world.id.end());
-  writeFileAtomically(m_runDir / "frames" / name, polyData(world, time, m_binary, m_firstIds));
+  writeFileAtomically(m_runDir / "frames" / name, polyData(world, time, m_binary, m_firstIds, contactForces));
   m_entries.push_back({time, relative});
 
   // The whole collection each time: O(frames) per frame, small next to the frame itself, and the

@@ -3,7 +3,8 @@
 // Each body is one polygon cell; points are its world vertices (z = 0). Cell data: id (Int64, the
 // GlobalIds), kind (Int32: 0 floe, 1 vessel, 2 wall) and kind_name (its name), speed (m/s, the
 // active scalar ParaView colours by), velocity (m/s, 3 components, z = 0), angular_velocity
-// (rad/s), thickness (m), area (m^2), mass (kg), broken (1 for a piece a break made). ASCII, so
+// (rad/s), thickness (m), area (m^2), mass (kg), broken (1 for a piece a break made), and
+// contact_force (N) when the stepper keeps it. ASCII, so
 // the files diff and grep, or binary: zlib-compressed appended data for large fields. Every file is
 // written atomically and frames.pvd is rewritten after each frame, so a run that dies leaves a
 // series that opens.
@@ -12,6 +13,7 @@
 #include <cstdint>
 #include <string>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "framework/world/world.hpp"
@@ -25,7 +27,9 @@ class VtkSeriesWriter {
   explicit VtkSeriesWriter(std::filesystem::path runDir, bool binary = false);
 
   // Writes the next frame_NNNNNN.vtp for simulation time `time` (s) and rewrites frames.pvd.
-  void addFrame(const World& world, double time);
+  // contactForces (optional, Stepper::contactForces): each body's contact force by id, written as
+  // the contact_force cell array (0 for a body not listed).
+  void addFrame(const World& world, double time, const std::vector<std::pair<std::int64_t, Real>>* contactForces = nullptr);
   // The .pvd is already whole after every frame; finish() only refuses later frames.
   void finish();
 

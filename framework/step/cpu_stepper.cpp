@@ -379,21 +379,28 @@ void CpuStepper::gatherAndMove() {
   const int vessel = m_vesselId >= 0 ? vesselSlot() : -1;
   Vec2 vesselImpulse{0, 0};
   m_motionBodies.resize(n);
+  m_contactForceOfSlot.resize(n);
   forEachBody(n, [&](int i) {
-    Vec2 onVessel{0, 0};
+    Vec2 onBody{0, 0};
     for (int q = m_bodyContactStart[i]; q < m_bodyContactStart[i + 1]; ++q) {
       const int k = m_bodyContacts[static_cast<size_t>(q)] / 2, side = m_bodyContacts[static_cast<size_t>(q)] % 2;
       const Vec2 j = m_slots[k].impulse;
       if (j.x == 0 && j.y == 0) continue;
       const Vec2 ji = side == 0 ? -j : j;
-      if (i == vessel) onVessel += ji;
+      onBody += ji;
       addContactImpulse(m_pairBodies[i], ji, m_contacts[k].geometry.point, total[i]);
     }
-    if (i == vessel) vesselImpulse = onVessel;
+    if (i == vessel) vesselImpulse = onBody;
+    m_contactForceOfSlot[i] = norm(onBody) / m_scenario.dt;
     const PairBody& p = m_pairBodies[i];
     m_motionBodies[i] = MotionBody{p.kind, p.dof, p.position, p.angle, p.velocity + total[i].dv, p.omega + total[i].domega};
   });
   m_vesselIceForce = forceOfImpulse(vesselImpulse, m_scenario.dt);
+  // By id: the breaks and re-sorts after this phase move bodies between slots.
+  m_contactForces.clear();
+  for (int i = 0; i < n; ++i)
+    if (m_contactForceOfSlot[i] > 0) m_contactForces.emplace_back(m_world.id[i], m_contactForceOfSlot[i]);
+  std::sort(m_contactForces.begin(), m_contactForces.end());
 
   const StepContext ctx{m_scenario.dt, m_time, m_step};
   forEachRange(n, [&](int begin, int end) {

@@ -4,6 +4,8 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 #include <vector>
 
 #include "framework/api/errors.hpp"
@@ -46,6 +48,10 @@ class Stepper {
   // Wall seconds the backend's device has spent stepping so far, copies of results included (its
   // share when cases run together is the whole batch's); 0 for a backend without a device.
   virtual double deviceSeconds() const { return 0; }
+  // The magnitude of each body's contact force over the last step (the sum of its contacts'
+  // impulses / dt, N), by body id, sorted by id, bodies without contact left out; null for a
+  // backend that does not keep it (the ParaView frames then have no contact_force array).
+  virtual const std::vector<std::pair<std::int64_t, Real>>* contactForces() const { return nullptr; }
 };
 
 // A backend that cannot run this scenario (e.g. an event without a driver for it). Bad input when
