@@ -167,7 +167,8 @@ std::string polyData(const World& world, double time, bool binary, const std::un
   arrays.add<std::uint8_t>(out, "broken", 1, n, [&](std::size_t i) { return firstIds.count(world.id[i]) ? 0 : 1; });
   if (contactForces)
     arrays.add<Real>(out, "contact_force", 1, n, [&](std::size_t i) {
-      const auto found = std::lower_bound(contactForces->begin(), contactForces->end(), std::pair<std::int64_t, Real>{world.id[i], Real(-1)});
+      const auto found =
+          std::lower_bound(contactForces->begin(), contactForces->end(), std::pair<std::int64_t, Real>{world.id[i], Real(-1)});
       return found != contactForces->end() && found->first == world.id[i] ? found->second : Real(0);
     });
   out += "      </CellData>\n";

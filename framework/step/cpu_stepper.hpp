@@ -63,7 +63,7 @@ class CpuStepper final : public Stepper {
   static constexpr int kGrain = 512;
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
   const std::vector<std::pair<std::int64_t, Real>>* contactForces() const override { return &m_contactForces; }
-  int vesselSlot() const;                                            // -1 without a vessel
+  int vesselSlot() const;  // -1 without a vessel
 
   // Totals since the start.
   double rubbleMass() const override { return m_rubbleMass; }
@@ -123,7 +123,7 @@ class CpuStepper final : public Stepper {
   std::vector<std::vector<unsigned char>> m_recordRows;  // per stream: the pair phase's buffer
   std::vector<int> m_recordRoom;                         // per stream: rows the buffer holds
   Vec2 m_vesselIceForce{0, 0};
-  std::vector<Real> m_contactForceOfSlot;                       // |sum of a body's contact impulses| / dt, N
+  std::vector<Real> m_contactForceOfSlot;                      // |sum of a body's contact impulses| / dt, N
   std::vector<std::pair<std::int64_t, Real>> m_contactForces;  // the non-zero ones by id (contactForces())
   double m_rubbleMass = 0;
   long m_floesBroken = 0;
