@@ -189,12 +189,6 @@ void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range)
   });
 }
 
-void CpuStepper::forEachBody(int n, const std::function<void(int)>& body) {
-  forEachRange(n, [&](int begin, int end) {
-    for (int i = begin; i < end; ++i) body(i);
-  });
-}
-
 void CpuStepper::narrowphase() {
   const int n = m_world.size();
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
