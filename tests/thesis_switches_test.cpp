@@ -91,9 +91,10 @@ Struck floeStruckOnTheBow(const std::vector<std::string>& overrides) {
 }  // namespace
 
 TEST(ThesisSwitches, ElasticContactWithVesselFalseGivesAVesselPressedOnAFloeNoElasticForce) {
-  const Vec2 with = floePushedByTheStem({});
+  const Vec2 with = floePushedByTheStem({"events.elastic_contact.vessel=true"});
   const Vec2 without = floePushedByTheStem({"events.elastic_contact.vessel=false"});
-  EXPECT_GT(with.x, 1e-4) << "the default: the elastic stress pushes the floe off the stem";
+  EXPECT_EQ(floePushedByTheStem({}).x, 0) << "the default is the thesis's: ice-ice only";
+  EXPECT_GT(with.x, 1e-4) << "the elastic stress pushes the floe off the stem";
   EXPECT_EQ(without.x, 0);
   EXPECT_EQ(without.y, 0);
 }
