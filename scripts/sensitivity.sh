@@ -3,7 +3,7 @@
 # is silent or was not followed (hull friction, vessel-floe elastic stress, breaking, thickness,
 # 1 vs 3 DOF, a blunter bow, the impact window), one at a time from a base, on the 35 % resistance
 # field and two load-study fields, three field seeds each. About a minute on 2 cores.
-# Writes runs/sensitivity/ and docs/validation/sensitivity_tables.md + sensitivity_*.svg.
+# Writes runs/sensitivity/, the tables of docs/validation/sensitivity.md and its sensitivity_*.svg.
 # Usage: scripts/sensitivity.sh [BUILD_DIR] [JOBS]
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

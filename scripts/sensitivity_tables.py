@@ -2,6 +2,7 @@
 """Tables and plots of the sensitivity study (scripts/sensitivity.sh): for each sweep, per variant,
 the mean over the field seeds (and the spread min..max) of speed and resistance in ice, impact
 counts and mean impact force over the whole run and over the transit (in ice).
+Writes them into DOCS_DIR/sensitivity.md between its markers, and the SVG plots beside it.
 Usage: sensitivity_tables.py RUNS_DIR DOCS_DIR PROVENANCE"""
 import csv
 import statistics
@@ -87,5 +88,12 @@ for sweep, title in SWEEPS:
                 [(v, m) for v, m in means["impacts_in_ice"] if m is not None])
         bar_svg(docs / f"sensitivity_{sweep}_force.svg", f"{sweep}: mean impact force in ice (mean of 3 seeds)", "kN",
                 [(v, m) for v, m in means["impact_force_in_ice_mean"] if m is not None])
-(docs / "sensitivity_tables.md").write_text("\n".join(lines))
-print("wrote", docs / "sensitivity_tables.md")
+# The tables go between the markers of docs/validation/sensitivity.md; the text around them is
+# written by hand (it reads the tables).
+page = docs / "sensitivity.md"
+begin, end = "<!-- tables: begin (scripts/sensitivity.sh) -->", "<!-- tables: end -->"
+text = page.read_text() if page.exists() else f"# Sensitivity study\n\n{begin}\n{end}\n"
+head, rest = text.split(begin, 1)
+tail = rest.split(end, 1)[1]
+page.write_text(head + begin + "\n" + "\n".join(lines) + "\n" + end + tail)
+print("wrote", page)
