@@ -11,6 +11,7 @@ static ElasticContact::Params parseElasticContact(EventConfig& config) {
   p.sigmaMax = t.getPositive("sigma_max", Real(1e6));
   p.stiffness = t.getPositive("k_ice", 100);
   p.factor = t.getNonNegative("factor", Real(0.05));
+  p.vessel = t.getBool("vessel", false);  // ice-ice only, as the thesis (docs/validation/sensitivity.md)
   return p;
 }
 

@@ -5,8 +5,11 @@
 //   I_in = M_ec V_c  when V_c > 0, else 0                                                [N s]
 //
 // V_c is the closing speed of the two contact points along n (m/s). The impulse acts at c along n,
-// equal and opposite. Optional Coulomb friction (mu = 0 by default, as in the thesis): a tangential
-// impulse that stops the sliding at c, at most mu I_in.
+// equal and opposite. Coulomb friction (thesis 3.2.1, L425: the friction direction "is determined" in
+// every collision; A.1.5, L1624: "a second force is added in the tangential direction"): a tangential
+// impulse that stops the sliding at c, at most mu I_in. Vessel-floe pairs use the one ship-ice
+// coefficient, [events.ship_impact] hull_friction (0.1), the mu_h of the flexural limit too; every
+// other pair (ice-ice, ice-wall) uses [events.impact] friction (0: the thesis gives no value).
 #pragma once
 #include <cmath>
 
@@ -14,10 +17,17 @@
 
 namespace gem {
 
+struct Scenario;
+
+// The one ship-ice friction coefficient mu_h (docs/model.md 4): [events.ship_impact] hull_friction.
+constexpr Real kDefaultHullFriction = Real(0.1);
+Real shipIceFriction(const Scenario& scenario);  // host only: reads the scenario's table
+
 struct Impact {
   static constexpr int kOrder = event_order::kImpulses;  // docs/plugins.md "Order"
   struct Params {
-    Real friction;  // mu, dimensionless
+    Real friction;        // mu of ice-ice and wall pairs, dimensionless
+    Real vesselFriction;  // mu of vessel-floe pairs: ship_impact's hull_friction, dimensionless
   };
 
   GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact, PairSlot& slot,
@@ -29,13 +39,16 @@ struct Impact {
     if (!(inverseMass > 0)) return;  // two immovable bodies
     const Real normalImpulse = closing / inverseMass;
     slot.addNormal(normalImpulse, n);
-    if (p.friction > 0) {
+    const bool vesselFloe =
+        (a.kind == BodyKind::Vessel && b.kind == BodyKind::Floe) || (a.kind == BodyKind::Floe && b.kind == BodyKind::Vessel);
+    const Real mu = vesselFloe ? p.vesselFriction : p.friction;
+    if (mu > 0) {
       const Vec2 t = perpLeft(n);
       const Real sliding = dot(pointVelocity(a, c) - pointVelocity(b, c), t);
       const Real inverseTangentMass = inverseEffectiveMass(a, t, c) + inverseEffectiveMass(b, t, c);
       if (inverseTangentMass > 0) {
         Real tangentImpulse = sliding / inverseTangentMass;
-        const Real limit = p.friction * normalImpulse;
+        const Real limit = mu * normalImpulse;
         tangentImpulse = tangentImpulse > limit ? limit : (tangentImpulse < -limit ? -limit : tangentImpulse);
         slot.addTangent(tangentImpulse, t);
       }

@@ -1,6 +1,8 @@
 // Ship impact: hull frame angles and the vessel's 2.5D radii of gyration come from [vessel].
 #include "events/ship_impact.hpp"
 
+#include "events/impact.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -26,14 +28,14 @@ static ShipImpact::Params parseShipImpact(EventConfig& config) {
   p.gyrationZ2 = Real(0.06) * v.length * v.length;
   p.pressure = t.getPositive("pressure", Real(1e6));
   p.flexuralStrength = t.getPositive("flexural_strength", Real(0.5e6));
-  p.hullFriction = t.getNonNegative("hull_friction", Real(0.1));
+  p.hullFriction = t.getNonNegative("hull_friction", kDefaultHullFriction);  // the impact's too (impact.cpp)
   p.impacts = config.records.open<ImpactRecord>(kImpactStream);
   p.breaks = config.records.open<BreakRequest>(kBreakStream);
   return p;
 }
 
 // impacts.csv, one row per impact (docs/scenario.md 4.4); summary.json counts the impacts and gives
-// the statistics of their force.
+// the statistics of their force, over the whole run and over the transit of the field.
 static void writeImpactRow(const void* record, std::string& row) {
   const ImpactRecord& r = *static_cast<const ImpactRecord*>(record);
   row = fmt::format("{:.6g},{},{:.9g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{},{}\n", r.time,
@@ -42,10 +44,13 @@ static void writeImpactRow(const void* record, std::string& row) {
                     std::isfinite(r.forceLimit) ? fmt::format("{:.9g}", r.forceLimit) : "inf", r.broke ? 1 : 0);
 }
 
-GEM_REGISTER_RECORD_OUTPUT(
+// The whole run's totals ("impacts", "impact_force_n") and the transit's ("impacts_in_ice",
+// "impact_force_in_ice_n": the steps with the whole hull in the field, thesis 6.2.2.2 L1268).
+GEM_REGISTER_RECORD_OUTPUT_IN_ICE(
     kImpactStream, "impacts.csv",
     "t,floe_id,floe_mass,thickness,apex_deg,frame_angle_deg,x,y,nx,ny,x_from_stem,y_from_centerline,vn,fn,flim,broke", writeImpactRow,
-    "impacts", "impact_force_n", [](const void* record) { return static_cast<double>(static_cast<const ImpactRecord*>(record)->force); });
+    "impacts", "impact_force_n", [](const void* record) { return static_cast<double>(static_cast<const ImpactRecord*>(record)->force); },
+    "impacts_in_ice", "impact_force_in_ice_n");
 
 GEM_REGISTER_PAIR_EVENT(
     ShipImpact, "ship_impact",

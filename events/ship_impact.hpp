@@ -128,8 +128,13 @@ struct ShipImpact {
     const PairBody& f = vesselFirst ? b : a;
     const Vec2 c = contact.geometry.point;
     const Vec2 n = vesselFirst ? contact.geometry.normal : -contact.geometry.normal;  // vessel into floe
-    const Real vn = dot(pointVelocity(s, c) - pointVelocity(f, c), n);
-    if (!(vn > 0)) return;  // touching without approach: no impact
+    const Vec2 vs = pointVelocity(s, c), vf = pointVelocity(f, c);
+    const Real vn = dot(vs - vf, n);
+    // Touching without approach: no impact. A floe that the inelastic impulse left moving with the
+    // hull (no elastic push apart, elastic_contact.vessel = false) closes by rounding alone, a few
+    // ulps of the speeds: that is no collision either.
+    const Real roundingSpeed = (sizeof(Real) == sizeof(double) ? Real(1e-12) : Real(1e-5)) * (norm(vs) + norm(vf));
+    if (!(vn > roundingSpeed)) return;
 
     const Real beta = p.frameAngle[nearestEdge(s.vertices, s.vertexCount, c)];
     const int apex = vesselFirst ? contact.geometry.apexVertexQ : contact.geometry.apexVertexP;

@@ -200,6 +200,33 @@ TEST(HexagonField, MatchesTable61) {
   }
 }
 
+// With field.count, exactly the thesis's counts (Table 6.1): 456 at 46 % and 595 at 60 %, an nx by
+// ny array, every hexagon 10.1 m, valid and within 0.01 of the concentration; a count no array of
+// the domain holds, or one too far from the concentration, is refused naming field.count.
+TEST(HexagonField, CountGivesExactlyTheThesisFloes) {
+  for (auto [concentration, thesisCount] : {std::pair{0.46, 456}, std::pair{0.60, 595}}) {
+    HexagonFieldSpec spec;
+    spec.domain = kChannel;
+    spec.concentration = Real(concentration);
+    spec.count = thesisCount;
+    const auto floes = generateHexagonField(spec);
+    const FieldStats s = statsOf(floes, spec.domain);
+    EXPECT_EQ(s.count, static_cast<size_t>(thesisCount));
+    EXPECT_NEAR(s.concentration, thesisCount * 10.1 * 10.1 / (500 * 200), 1e-6);
+    EXPECT_NEAR(s.concentration, concentration, 0.01);
+    for (const BodySpec& b : floes) EXPECT_NEAR(signedArea(b.vertices.data(), 6), 10.1 * 10.1, 1e-6 * 102 + kRoundTol * 20);
+    expectValidField(floes, spec.domain, spec.minGap);
+  }
+  HexagonFieldSpec far;
+  far.domain = kChannel;
+  far.concentration = Real(0.46);
+  far.count = 500;  // 51 %
+  EXPECT_THROW(generateHexagonField(far), InputError);
+  HexagonFieldSpec prime = far;
+  prime.count = 457;  // prime: only 1 x 457 or 457 x 1, neither fits
+  EXPECT_THROW(generateHexagonField(prime), InputError);
+}
+
 TEST(HexagonField, RotationsBreakTheSymmetry) {
   HexagonFieldSpec spec;
   spec.domain = kChannel;

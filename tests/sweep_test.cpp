@@ -53,7 +53,7 @@ int sweep(const fs::path& file, const fs::path& out, int jobs = 2, long caseInde
 
 const std::string kHeaderTail =
     "impacts,ship_speed_min,ship_speed_mean,ship_speed_max,impact_force_min,impact_force_mean,impact_force_max,"
-    "resistance_mean,wall_time_s,ship_speed_in_ice_mean,resistance_in_ice_mean";
+    "resistance_mean,wall_time_s,ship_speed_in_ice_mean,resistance_in_ice_mean,impacts_in_ice,impact_force_in_ice_mean";
 
 }  // namespace
 
@@ -130,7 +130,7 @@ TEST(Sweep, RunsEveryCaseWritesScenariosAndGathers) {
   ASSERT_EQ(csv.size(), 5u);
   EXPECT_EQ(csv[0], "name,vessel.bollard_thrust,field.concentration," + kHeaderTail);
   const std::vector<std::string> row = csvCells(csv[2]);
-  ASSERT_EQ(row.size(), 14u);
+  ASSERT_EQ(row.size(), 16u);
   EXPECT_EQ(row[0], "bollard_thrust=46000,concentration=0.3");
   EXPECT_EQ(row[1], "46000");
   EXPECT_EQ(row[2], "0.3");
@@ -140,6 +140,7 @@ TEST(Sweep, RunsEveryCaseWritesScenariosAndGathers) {
   EXPECT_EQ(row[10], summary.at("resistance_mean_n"));
   EXPECT_GT(std::stod(row[10]), 0);  // the ice slows the vessel: a positive mean net thrust
   EXPECT_EQ(row[13], summary.at("resistance_in_ice_n"));
+  EXPECT_EQ(row[14], summary.at("impacts_in_ice"));
 }
 
 TEST(Sweep, ThreadsDoNotChangeResults) {

@@ -48,6 +48,9 @@ const std::vector<std::pair<std::string, std::string>>& columnKeys() {
       // Beyond the list: the means over the steady part of the transit (hull in the field).
       {"ship_speed_in_ice_mean", "ship_speed_in_ice.mean"},
       {"resistance_in_ice_mean", "resistance_in_ice_n"},
+      // The impacts over the same window (the transit, thesis 6.2.2.2).
+      {"impacts_in_ice", "impacts_in_ice"},
+      {"impact_force_in_ice_mean", "impact_force_in_ice_n.mean"},
   };
   return keys;
 }

@@ -122,6 +122,10 @@ struct RecordOutputEntry {
   void (*writeRow)(const void* record, std::string& row);  // the row, with its newline
   std::string countKey, statisticKey;
   double (*statisticValue)(const void* record);
+  // When not empty: the same count and statistics over the vessel's transit of the field only (the
+  // steps with the whole hull inside the domain's x range, as ship_speed_in_ice; ship_impact:
+  // "impacts_in_ice", "impact_force_in_ice_n").
+  std::string countInIceKey = {}, statisticInIceKey = {};
 };
 
 class Registry {
@@ -305,6 +309,13 @@ struct RegisterNow {
 #define GEM_REGISTER_RECORD_OUTPUT(STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, STATISTIC_KEY, STATISTIC_VALUE)                   \
   GEM_REGISTRATION(record_output_, registry.addRecordOutput(::gem::RecordOutputEntry{STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, \
                                                                                      STATISTIC_KEY, STATISTIC_VALUE}))
+
+// The same, with the keys of the in-ice totals (RecordOutputEntry::countInIceKey).
+#define GEM_REGISTER_RECORD_OUTPUT_IN_ICE(STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, STATISTIC_KEY, STATISTIC_VALUE, COUNT_IN_ICE_KEY, \
+                                          STATISTIC_IN_ICE_KEY)                                                                         \
+  GEM_REGISTRATION(record_output_,                                                                                                      \
+                   registry.addRecordOutput(::gem::RecordOutputEntry{STREAM, FILE, HEADER, WRITE_ROW, COUNT_KEY, STATISTIC_KEY,         \
+                                                                     STATISTIC_VALUE, COUNT_IN_ICE_KEY, STATISTIC_IN_ICE_KEY}))
 
 // Registers a broadphase class constructible from BroadphaseSettings; its kSettings, if any, name
 // the settings it reads.

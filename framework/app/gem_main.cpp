@@ -83,6 +83,10 @@ void reportRun(RunLog& log, const RunSummary& r) {
     std::string line = fmt::format("  {:<14} {}", t.countKey, t.count);
     if (!t.statisticKey.empty() && t.statistic.count)
       line += fmt::format(", {} mean {:.4g}, max {:.4g}", t.statisticKey, t.statistic.mean, t.statistic.max);
+    if (!t.countInIceKey.empty()) {
+      line += fmt::format("; in ice {}", t.countInIce);
+      if (t.statisticInIce.count) line += fmt::format(", mean {:.4g}", t.statisticInIce.mean);
+    }
     log.say(line);
   }
   // In ice first: the studies' figures (the steps with the whole hull inside the domain's x

@@ -107,6 +107,8 @@ std::string summaryJson(const RunSummary& s) {
   for (const RecordTotals& t : s.records) {
     if (!t.countKey.empty()) j[t.countKey] = t.count;
     if (!t.statisticKey.empty()) j[t.statisticKey] = jsonStats(t.statistic);
+    if (!t.countInIceKey.empty()) j[t.countInIceKey] = t.countInIce;
+    if (!t.statisticInIceKey.empty()) j[t.statisticInIceKey] = jsonStats(t.statisticInIce);
   }
   j["ship_speed"] = jsonStats(s.shipSpeed);
   j["net_thrust_n"] = jsonStats(s.netThrust);
@@ -169,7 +171,7 @@ class ScenarioRun {
     for (const RecordOutputEntry* output : Registry::global().recordOutputs()) {
       const int stream = sim.records().streams().find(output->stream);
       if (stream < 0) continue;  // no event of this run opened it
-      m_recordFiles.push_back(RecordFile{output, stream, std::make_unique<AtomicFile>(m_dir / output->file), {}});
+      m_recordFiles.push_back(RecordFile{output, stream, std::make_unique<AtomicFile>(m_dir / output->file), {}, {}});
       m_recordFiles.back().file->stream() << output->header << "\n";
     }
     const VesselSpec& vessel = scenario.vessel;
@@ -218,6 +220,11 @@ class ScenarioRun {
     Stepper& sim = *m_stepper;
     const Scenario& scenario = m_scenario;
     checkFinite(k);
+    const VesselSample vessel = sim.vessel();
+    // The transit of the field (thesis 6.2.1.3, 6.2.2.2 L1268): the whole hull inside the field's x
+    // range at the end of the step. The speed, the resistance and the in-ice record totals use it.
+    const bool inIce = vessel.present && scenario.hasDomain && vessel.position.x - scenario.vessel.length / 2 >= scenario.domain.x0 &&
+                       vessel.position.x + scenario.vessel.length / 2 <= scenario.domain.x1;
     std::string row;
     for (RecordFile& f : m_recordFiles) {
       const StepRecords& records = sim.records();
@@ -225,21 +232,17 @@ class ScenarioRun {
         const void* record = records.record(f.stream, r);
         f.output->writeRow(record, row);
         f.file->stream() << row;
-        if (f.output->statisticValue)
-          f.statistic.add(f.output->statisticValue(record));
-        else
-          ++f.statistic.count;
+        const double value = f.output->statisticValue ? f.output->statisticValue(record) : 0;
+        f.statistic.add(value);
+        if (inIce) f.statisticInIce.add(value);
       }
     }
-    const VesselSample vessel = sim.vessel();
     const Vec2 forward{std::cos(vessel.heading), std::sin(vessel.heading)};
     const Real surge = dot(vessel.velocity, forward);
     if (vessel.present) {
       m_speed.add(surge);
       m_netThrust.add(Propulsion::netThrust(m_thrust, surge));
-      // The steady part of the transit (thesis 6.2.1.3): the whole hull inside the field's x range.
-      if (scenario.hasDomain && vessel.position.x - scenario.vessel.length / 2 >= scenario.domain.x0 &&
-          vessel.position.x + scenario.vessel.length / 2 <= scenario.domain.x1) {
+      if (inIce) {
         m_speedInIce.add(surge);
         m_netThrustInIce.add(Propulsion::netThrust(m_thrust, surge));
       }
@@ -294,7 +297,9 @@ class ScenarioRun {
     m_summary.shipSpeed = m_speed.stats();
     m_summary.records.clear();
     for (const RecordFile& f : m_recordFiles)
-      m_summary.records.push_back(RecordTotals{f.output->countKey, f.output->statisticKey, f.statistic.count, f.statistic.stats()});
+      m_summary.records.push_back(RecordTotals{f.output->countKey, f.output->statisticKey, f.statistic.count, f.statistic.stats(),
+                                               f.output->countInIceKey, f.output->statisticInIceKey, f.statisticInIce.count,
+                                               f.statisticInIce.stats()});
     m_summary.netThrust = m_netThrust.stats();
     m_summary.shipSpeedInIce = m_speedInIce.stats();
     m_summary.netThrustInIce = m_netThrustInIce.stats();
@@ -335,7 +340,8 @@ class ScenarioRun {
     const RecordOutputEntry* output;
     int stream;
     std::unique_ptr<AtomicFile> file;
-    Accumulator statistic;  // of output->statisticValue, or only the count
+    Accumulator statistic;       // of output->statisticValue, or only the count
+    Accumulator statisticInIce;  // the same over the transit (the in-ice window)
   };
   std::vector<RecordFile> m_recordFiles;
   Propulsion::Params m_thrust{};

@@ -28,6 +28,10 @@ struct RecordTotals {
   std::string countKey, statisticKey;
   long count = 0;
   Stats statistic;
+  // Over the transit only (the in-ice window of shipSpeedInIce), under these keys when not empty.
+  std::string countInIceKey, statisticInIceKey;
+  long countInIce = 0;
+  Stats statisticInIce;
 };
 
 struct RunSummary {

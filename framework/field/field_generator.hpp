@@ -47,6 +47,9 @@ struct HexagonFieldSpec {
   Real rotationJitterDeg = 3;  // each hexagon rotated uniformly in +-jitter (breaks interlocking)
   Real thickness = Real(0.7);
   Real minGap = Real(0.05);  // m, as in RandomFieldSpec
+  // > 0: exactly this many hexagons, an nx by ny array with nx ny = count (the thesis's 456 and 595,
+  // Table 6.1), still within 0.01 of the concentration; 0: the count nearest the concentration.
+  int count = 0;
   std::uint64_t seed = 1;
 };
 

@@ -1,5 +1,6 @@
 // The hexagon field (thesis 6.2.1.1.1): a regular array of equal, slightly rotated hexagons,
-// the layout chosen nearest a regular lattice within the concentration tolerance.
+// the layout chosen nearest a regular lattice within the concentration tolerance, or among the nx by ny
+// arrays of exactly field.count hexagons.
 // Compiled without fused multiply-add or vectorizing, as every generator file (CMakeLists.txt;
 // why: field_shared.hpp).
 
@@ -65,9 +66,15 @@ std::vector<BodySpec> generateHexagonField(const HexagonFieldSpec& spec) {
   auto rowMargin = [&](int ny) { return std::max(0.5 * height / ny, circumradius + margin); };
   auto rowSpacing = [&](int ny) { return ny > 1 ? (height - 2 * rowMargin(ny)) / (ny - 1) : height; };
   std::vector<HexLayout> layouts;
+  if (spec.count < 0) fail("field.count: expected a count >= 0, got ", spec.count);
+  if (spec.count > 0 && std::fabs(double(spec.count) * hexArea / domainArea - spec.concentration) > 0.01)
+    fail("field.count: ", spec.count, " hexagons of field.size = ", spec.size, " m cover ", double(spec.count) * hexArea / domainArea,
+         " of the domain, more than 0.01 from field.concentration = ", spec.concentration);
   for (int ny = 1; height / ny >= circumradius; ++ny) {
-    const int around = static_cast<int>(std::round(ideal / ny));
+    if (spec.count > 0 && spec.count % ny != 0) continue;
+    const int around = spec.count > 0 ? spec.count / ny : static_cast<int>(std::round(ideal / ny));
     for (int nx = std::max(1, around - 2); nx <= around + 2; ++nx) {
+      if (spec.count > 0 && nx * ny != spec.count) continue;
       const double error = std::fabs(double(nx) * ny * hexArea / domainArea - spec.concentration);
       if (error > 0.01) continue;
       const double dx = width / (nx + (ny > 1 ? 0.5 : 0.0));
@@ -128,6 +135,9 @@ std::vector<BodySpec> generateHexagonField(const HexagonFieldSpec& spec) {
     sortAlongX(floes, centre);
     return floes;
   }
+  if (spec.count > 0)
+    fail("field.count: ", spec.count, " hexagons of field.size = ", spec.size,
+         " m fit in no nx by ny array of this domain, at least field.min_gap = ", spec.minGap, " m apart");
   fail("field.concentration: ", spec.concentration, " cannot be reached within 0.01 by hexagons of field.size = ", spec.size,
        " m in this domain, at least field.min_gap = ", spec.minGap, " m apart");
 }

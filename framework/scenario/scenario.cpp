@@ -69,7 +69,9 @@ void checkFieldMemory(const Scenario& s) {
   const double area = (static_cast<double>(s.domain.x1) - s.domain.x0) * (static_cast<double>(s.domain.y1) - s.domain.y0);
   double floes = 0;
   if (s.fieldKind == "hexagons") {
-    floes = area * s.hexagonField.concentration / (static_cast<double>(s.hexagonField.size) * s.hexagonField.size);
+    floes = s.hexagonField.count > 0
+                ? s.hexagonField.count
+                : area * s.hexagonField.concentration / (static_cast<double>(s.hexagonField.size) * s.hexagonField.size);
   } else {
     const RandomFieldSpec& r = s.randomField;
     const double meanArea = static_cast<double>(r.sizeMean) * r.sizeMean + static_cast<double>(r.sizeSd) * r.sizeSd;
@@ -106,6 +108,7 @@ void readField(TableReader& t, Scenario& s) {
     h.minGap = minGap;
     h.size = t.getPositive("size", Real(10.1));
     h.rotationJitterDeg = t.getNonNegative("rotation_jitter_deg", 3);
+    h.count = static_cast<int>(t.getInt("count", 0, 0, 100000000));
     h.seed = s.seed;
   } else {
     RandomFieldSpec& r = s.randomField;
