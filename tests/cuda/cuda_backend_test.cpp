@@ -150,19 +150,30 @@ TEST(CudaBackend, BusyChannelMatchesTheCpuAfter50Steps) {
   EXPECT_GT(a.impacts, 0);
 }
 
+// Over 300 steps the busy channel is chaotic: CPU and CUDA differ by rounding (1e-12 after 50
+// steps, above) and the runs part ways, so they are compared as ensembles (docs/performance.md 5):
+// six seeds, their mean impacts, breaks and floe speed.
 TEST(CudaBackend, BusyChannelSummaryMatchesTheCpuOver300Steps) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
-  const Scenario s = test::scenarioFromToml(dir, kBusyScene);
-  CpuStepper cpu(s);
-  CudaStepper gpu(s);
-  const State a = run(cpu, 300), b = run(gpu, 300);
-  std::printf("busy channel, 300 steps: impacts cpu %ld cuda %ld, broken cpu %ld cuda %ld, mean floe speed cpu %.6g cuda %.6g\n", a.impacts,
-              b.impacts, a.broken, b.broken, a.meanSpeed, b.meanSpeed);
-  EXPECT_NEAR(static_cast<double>(b.impacts), static_cast<double>(a.impacts), 0.1 * a.impacts + 1);
-  EXPECT_NEAR(static_cast<double>(b.broken), static_cast<double>(a.broken), 2.0);
-  EXPECT_NEAR(b.meanSpeed, a.meanSpeed, 0.05 * a.meanSpeed);
-  EXPECT_GT(a.broken, 0);  // breaks happen: the host topology round trip is covered
+  double impacts[2] = {0, 0}, broken[2] = {0, 0}, speed[2] = {0, 0};
+  constexpr int kSeeds = 6;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    const Scenario s = test::scenarioFromToml(dir, kBusyScene, {"simulation.seed=" + std::to_string(seed)});
+    CpuStepper cpu(s);
+    CudaStepper gpu(s);
+    const State a = run(cpu, 300), b = run(gpu, 300);
+    impacts[0] += a.impacts, impacts[1] += b.impacts;
+    broken[0] += a.broken, broken[1] += b.broken;
+    speed[0] += a.meanSpeed, speed[1] += b.meanSpeed;
+  }
+  std::printf(
+      "busy channel, 300 steps, %d seeds: impacts cpu %.0f cuda %.0f, broken cpu %.0f cuda %.0f, mean floe speed cpu %.6g cuda %.6g\n",
+      kSeeds, impacts[0], impacts[1], broken[0], broken[1], speed[0] / kSeeds, speed[1] / kSeeds);
+  EXPECT_NEAR(impacts[1], impacts[0], 0.1 * impacts[0] + 1);
+  EXPECT_NEAR(broken[1], broken[0], 0.2 * broken[0] + 2);
+  EXPECT_NEAR(speed[1], speed[0], 0.05 * speed[0]);
+  EXPECT_GT(broken[0], 0);  // breaks happen: the host topology round trip is covered
 }
 
 TEST(CudaBackend, RepeatedRunIsBitIdentical) {
