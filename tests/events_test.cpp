@@ -10,31 +10,10 @@
 #include "test_support.hpp"
 
 using namespace gem;
+using gem::test::eventsOnly;
 using gem::test::TempDir;
 
 namespace {
-
-BodySpec square(Vec2 centre, Real side, Real thickness, Vec2 velocity = {0, 0}, Real omega = 0) {
-  BodySpec s;
-  s.kind = BodyKind::Floe;
-  const Real h = side / 2;
-  s.vertices = {{centre.x - h, centre.y - h}, {centre.x + h, centre.y - h}, {centre.x + h, centre.y + h}, {centre.x - h, centre.y + h}};
-  s.thickness = thickness;
-  s.velocity = velocity;
-  s.angularVelocity = omega;
-  return s;
-}
-
-// Only the events named on: every other built-in event is switched off.
-std::string eventsOnly(std::initializer_list<const char*> on) {
-  std::string text;
-  for (const char* name : {"drag", "impact", "elastic_contact", "ship_impact", "flexural_breaking", "propulsion", "autopilot"}) {
-    bool enabled = false;
-    for (const char* o : on) enabled |= std::string(o) == name;
-    text += std::string("[events.") + name + "]\nenabled = " + (enabled ? "true" : "false") + "\n";
-  }
-  return text;
-}
 
 // The stem's x in the world for a vessel at the origin with heading 0.
 Real stemX(const Scenario& s) { return s.vessel.position.x + hullGeometry(s.vessel).stemX; }
@@ -61,8 +40,8 @@ TEST(Impact, HeadOnCentredImpactOfEqualFloesLeavesBothAtTheCommonVelocity) {
   TempDir dir;
   Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"impact"}));
   World w;
-  w.addBody(square({0, 0}, 10, 1, {1, 0}));
-  w.addBody(square({10.05, 0}, 10, 1, {0, 0}));
+  w.addBody(test::squareFloe({0, 0}, 10, 1, {1, 0}));
+  w.addBody(test::squareFloe({10.05, 0}, 10, 1, {0, 0}));
   CpuStepper sim(s, std::move(w));
   sim.step();  // closes the 5 cm gap
   EXPECT_EQ(sim.contactCount(), 0);
@@ -84,8 +63,8 @@ TEST(Impact, EveryContactConservesLinearAndAngularMomentum) {
   int withContact = 0;
   for (int trial = 0; trial < 200; ++trial) {
     World w;
-    w.addBody(square({0, 0}, 4 + 2 * u(rng), 0.5 + 0.4 * u(rng), {u(rng), u(rng)}, 0.2 * u(rng)));
-    BodySpec b = square({0, 0}, 3 + u(rng), 1 + 0.5 * u(rng), {u(rng), u(rng)}, 0.2 * u(rng));
+    w.addBody(test::squareFloe({0, 0}, 4 + 2 * u(rng), 0.5 + 0.4 * u(rng), {u(rng), u(rng)}, 0.2 * u(rng)));
+    BodySpec b = test::squareFloe({0, 0}, 3 + u(rng), 1 + 0.5 * u(rng), {u(rng), u(rng)}, 0.2 * u(rng));
     const Real angle = 3 * u(rng);
     const Vec2 offset{4.0 + 0.8 * u(rng), 2.5 * u(rng)};
     for (Vec2& v : b.vertices) v = rotate(v, angle) + offset;
@@ -108,8 +87,8 @@ TEST(Impact, ClosingBodiesNeverGainNormalSpeedAndSeparatingOnesAreLeftAlone) {
   TempDir dir;
   Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"impact"}));
   World w;
-  w.addBody(square({0, 0}, 10, 1, {-1, 0}));  // already separating, though overlapping
-  w.addBody(square({9.9, 0}, 10, 1, {1, 0}));
+  w.addBody(test::squareFloe({0, 0}, 10, 1, {-1, 0}));  // already separating, though overlapping
+  w.addBody(test::squareFloe({9.9, 0}, 10, 1, {1, 0}));
   CpuStepper sim(s, std::move(w));
   sim.step();
   ASSERT_EQ(sim.contactCount(), 1);
@@ -121,8 +100,8 @@ TEST(ElasticContact, ImpulseMatchesTheFormulaForTwoOverlappingSquaresAtRest) {
   TempDir dir;
   Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"elastic_contact"}));
   World w;
-  w.addBody(square({0, 0}, 10, 1.0));
-  w.addBody(square({7.8, 0}, 6, 0.5));  // overlap 0.2 m x 6 m
+  w.addBody(test::squareFloe({0, 0}, 10, 1.0));
+  w.addBody(test::squareFloe({7.8, 0}, 6, 0.5));  // overlap 0.2 m x 6 m
   CpuStepper sim(s, std::move(w));
   const Real m1 = sim.world().mass[0], m2 = sim.world().mass[1];
   sim.step();
@@ -133,8 +112,8 @@ TEST(ElasticContact, ImpulseMatchesTheFormulaForTwoOverlappingSquaresAtRest) {
   EXPECT_NEAR(sim.world().vx[0], -impulse / m1, 1e-12);
   // A thin sliver: C = A_0 K / (w D) < 1 scales it down.
   World thin;
-  thin.addBody(square({0, 0}, 10, 1.0));
-  thin.addBody(square({7.99, 0}, 6, 0.5));  // A_0 = 0.06, C = 0.06 * 100 / 36
+  thin.addBody(test::squareFloe({0, 0}, 10, 1.0));
+  thin.addBody(test::squareFloe({7.99, 0}, 6, 0.5));  // A_0 = 0.06, C = 0.06 * 100 / 36
   CpuStepper sim2(s, std::move(thin));
   sim2.step();
   EXPECT_NEAR(sim2.world().vx[1], 0.05 * (0.06 * 100 / 36) * 1e6 * 6 * 0.5 * 0.1 / m2, 1e-9);
@@ -144,7 +123,7 @@ TEST(Drag, OneStepIsTheFormulaAndAFloeSlowsAsTheClosedForm) {
   TempDir dir;
   Scenario s = test::scenarioFromToml(dir, "[simulation]\ndt = 0.01\nsteps = 10\nmorton_sort = false\n" + eventsOnly({"drag"}));
   World w;
-  w.addBody(square({0, 0}, 5, 1.0, {1.0, -0.5}, 0.2));
+  w.addBody(test::squareFloe({0, 0}, 5, 1.0, {1.0, -0.5}, 0.2));
   CpuStepper sim(s, std::move(w));
   const Real k = 0.5 * 1025 * 0.05 / (900 * 1.0);  // 1/m
   sim.step();
@@ -203,7 +182,7 @@ TEST(Motion, OneDofVesselNeitherSwaysNorTurnsWhenHitObliquely) {
       dir, std::string(kBase) + eventsOnly({"impact", "elastic_contact"}) + "[vessel]\nposition = [0.0, 0.0]\nspeed = 3.0\n");
   World w;
   addVessel(w, s.vessel);
-  BodySpec floe = square({0, 0}, 8, 1.0, {0, 0});
+  BodySpec floe = test::squareFloe({0, 0}, 8, 1.0, {0, 0});
   for (Vec2& p : floe.vertices) p = rotate(p, 0.4) + Vec2{stemX(s) + 4, 6};
   w.addBody(floe);
   CpuStepper sim(s, std::move(w));
@@ -226,7 +205,7 @@ TEST(Wind, GivenStressAcceleratesAFloeAsFdtOverRhoH) {
   Scenario s = test::scenarioFromToml(
       dir, std::string(kBase) + eventsOnly({}) + "[events.wind]\nforce = 2.0\ndirection_deg = 90.0\n[events.current]\nforce = 1.0\n");
   World w;
-  w.addBody(square({0, 0}, 5, 0.5));
+  w.addBody(test::squareFloe({0, 0}, 5, 0.5));
   CpuStepper sim(s, std::move(w));
   sim.step();
   EXPECT_NEAR(sim.world().vy[0], 2.0 * 0.1 / (900 * 0.5), 1e-15);
@@ -238,7 +217,7 @@ TEST(Current, BulkStressDrivesAFloeTowardsTheCurrentSpeed) {
   Scenario s = test::scenarioFromToml(dir, "[simulation]\ndt = 0.5\nsteps = 10\nmorton_sort = false\n" + eventsOnly({}) +
                                                "[events.current]\nspeed = 0.3\ndirection_deg = 0.0\n");
   World w;
-  w.addBody(square({0, 0}, 5, 0.5));
+  w.addBody(test::squareFloe({0, 0}, 5, 0.5));
   CpuStepper sim(s, std::move(w));
   for (int i = 0; i < 20000; ++i) sim.step();
   // d(U - v)/dt = -k (U - v)^2 with k = rho_w C_w / (rho_ice h): U - v = U / (1 + k U t).
@@ -253,7 +232,7 @@ TEST(ShipImpact, ForceIsTheDirectEvaluationOfModelSection5) {
   vessel.position = {0, 0};
   World w;
   const int s = addVessel(w, vessel);
-  const int f = w.addBody(square({60, 0}, 10, 0.7));
+  const int f = w.addBody(test::squareFloe({60, 0}, 10, 0.7));
   auto body = [&](int i) {
     PairBody b{};
     b.kind = w.kind[i];
@@ -309,7 +288,7 @@ TEST(ShipImpact, AFloePushedAlongTheBowIsStruckAgainAndAgain) {
                                       "[vessel]\nposition = [0.0, 0.0]\nspeed = 2.0\n");
   World w;
   addVessel(w, s.vessel);
-  w.addBody(square({stemX(s) + 5.1, 0}, 10, 2.0));  // thick: it will not break
+  w.addBody(test::squareFloe({stemX(s) + 5.1, 0}, 10, 2.0));  // thick: it will not break
   CpuStepper sim(s, std::move(w));
   std::vector<double> speeds;
   for (int i = 0; i < 600; ++i) {
@@ -332,7 +311,7 @@ TEST(ShipImpact, IsLoggedAtTheFirstStrikeWithTheHullAngleOfTheStem) {
                                                "[vessel]\nposition = [0.0, 0.0]\nspeed = 2.0\n");
   World w;
   addVessel(w, s.vessel);
-  w.addBody(square({stemX(s) + 5.1, 0}, 10, 2.0));  // thick: it will not break
+  w.addBody(test::squareFloe({stemX(s) + 5.1, 0}, 10, 2.0));  // thick: it will not break
   CpuStepper sim(s, std::move(w));
   int logged = 0, stepsInContact = 0;
   for (int i = 0; i < 30; ++i) {
@@ -360,7 +339,7 @@ TEST(FlexuralBreaking, ThinFloeStruckHardSplitsAndMassIsAccountedFor) {
                                       {"events.flexural_breaking.min_area=20.0"});
   World w;
   addVessel(w, s.vessel);
-  w.addBody(square({stemX(s) + 6.1, 0.5}, 12, 0.3, {0, 0}, 0.01));
+  w.addBody(test::squareFloe({stemX(s) + 6.1, 0.5}, 12, 0.3, {0, 0}, 0.01));
   CpuStepper sim(s, std::move(w));
   const double massBefore = sim.world().floeMass();
   bool broke = false;

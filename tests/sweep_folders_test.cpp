@@ -19,13 +19,7 @@ namespace {
 
 const char* const kBase = test::kTinyChannel;
 
-const char* kProduct = R"([sweep]
-base = "base.toml"
-set = { "simulation.steps" = 30 }
-[parameters]
-"vessel.bollard_thrust" = [46e3, 92e3]
-field.concentration = [0.25, 0.3]
-)";
+const char* const kProduct = test::kProductSweep;
 
 int sweep(const fs::path& file, const fs::path& out) {
   SweepOptions o;

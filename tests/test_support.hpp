@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <initializer_list>
 #include <string>
 
 #include "events/ship_impact.hpp"
@@ -120,5 +121,38 @@ inline std::string readFile(const std::filesystem::path& file) {
   std::ifstream in(file);
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
+
+// A square floe of the given side, centred at centre, at thickness m, moving at velocity, turning
+// at omega.
+inline BodySpec squareFloe(Vec2 centre, Real side, Real thickness, Vec2 velocity = {0, 0}, Real omega = 0) {
+  BodySpec s;
+  s.kind = BodyKind::Floe;
+  const Real h = side / 2;
+  s.vertices = {{centre.x - h, centre.y - h}, {centre.x + h, centre.y - h}, {centre.x + h, centre.y + h}, {centre.x - h, centre.y + h}};
+  s.thickness = thickness;
+  s.velocity = velocity;
+  s.angularVelocity = omega;
+  return s;
+}
+
+// Event tables that switch on only the built-in events named: every other one is off.
+inline std::string eventsOnly(std::initializer_list<const char*> on) {
+  std::string text;
+  for (const char* name : {"drag", "impact", "elastic_contact", "ship_impact", "flexural_breaking", "propulsion", "autopilot"}) {
+    bool enabled = false;
+    for (const char* o : on) enabled |= std::string(o) == name;
+    text += std::string("[events.") + name + "]\nenabled = " + (enabled ? "true" : "false") + "\n";
+  }
+  return text;
+}
+
+// A sweep over kTinyChannel (written as base.toml beside it): two thrusts by two concentrations.
+inline constexpr const char* kProductSweep = R"([sweep]
+base = "base.toml"
+set = { "simulation.steps" = 30 }
+[parameters]
+"vessel.bollard_thrust" = [46e3, 92e3]
+field.concentration = [0.25, 0.3]
+)";
 
 }  // namespace gem::test

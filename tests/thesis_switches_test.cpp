@@ -19,29 +19,10 @@
 #include "test_support.hpp"
 
 using namespace gem;
+using gem::test::eventsOnly;
 using gem::test::TempDir;
 
 namespace {
-
-BodySpec square(Vec2 centre, Real side, Real thickness, Vec2 velocity = {0, 0}) {
-  BodySpec s;
-  s.kind = BodyKind::Floe;
-  const Real h = side / 2;
-  s.vertices = {{centre.x - h, centre.y - h}, {centre.x + h, centre.y - h}, {centre.x + h, centre.y + h}, {centre.x - h, centre.y + h}};
-  s.thickness = thickness;
-  s.velocity = velocity;
-  return s;
-}
-
-std::string eventsOnly(std::initializer_list<const char*> on) {
-  std::string text;
-  for (const char* name : {"drag", "impact", "elastic_contact", "ship_impact", "flexural_breaking", "propulsion", "autopilot"}) {
-    bool enabled = false;
-    for (const char* o : on) enabled |= std::string(o) == name;
-    text += std::string("[events.") + name + "]\nenabled = " + (enabled ? "true" : "false") + "\n";
-  }
-  return text;
-}
 
 const char* kBase = "[simulation]\ndt = 0.1\nsteps = 10\nmorton_sort = false\n";
 
@@ -55,7 +36,7 @@ Vec2 floePushedByTheStem(const std::vector<std::string>& overrides) {
       dir, std::string(kBase) + eventsOnly({"elastic_contact"}) + "[vessel]\nposition = [0.0, 0.0]\nspeed = 0.0\n", overrides);
   World w;
   addVessel(w, s.vessel);
-  const int floe = w.addBody(square({stemX(s) + 4.9, 0}, 10, 1.0));
+  const int floe = w.addBody(test::squareFloe({stemX(s) + 4.9, 0}, 10, 1.0));
   CpuStepper sim(s, std::move(w));
   sim.step();
   EXPECT_EQ(sim.contactCount(), 1);
@@ -78,7 +59,7 @@ Struck floeStruckOnTheBow(const std::vector<std::string>& overrides) {
   addVessel(w, s.vessel);
   // Centred 6 m to starboard of the centreline, 7 m ahead of the stem's x: the shoulder edges
   // meet it obliquely.
-  const int floe = w.addBody(square({stemX(s) + 1.5, -6.5}, 4, 2.0));
+  const int floe = w.addBody(test::squareFloe({stemX(s) + 1.5, -6.5}, 4, 2.0));
   CpuStepper sim(s, std::move(w));
   int impacts = 0;
   for (int i = 0; i < 40; ++i) {
@@ -103,8 +84,8 @@ TEST(ThesisSwitches, ElasticContactWithVesselFalseStillActsBetweenFloes) {
   TempDir dir;
   Scenario s = test::scenarioFromToml(dir, std::string(kBase) + eventsOnly({"elastic_contact"}), {"events.elastic_contact.vessel=false"});
   World w;
-  w.addBody(square({0, 0}, 10, 1.0));
-  w.addBody(square({7.8, 0}, 6, 0.5));
+  w.addBody(test::squareFloe({0, 0}, 10, 1.0));
+  w.addBody(test::squareFloe({7.8, 0}, 6, 0.5));
   CpuStepper sim(s, std::move(w));
   sim.step();
   EXPECT_GT(sim.world().vx[1], 0);
