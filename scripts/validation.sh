@@ -11,7 +11,8 @@ work="$here/runs/validation"
 docs="$here/docs/validation"
 mkdir -p "$work" "$docs"
 
-"$gem" calibrate --out "$work/calibration" > "$work/calibration.txt"
+# Paths of this machine stay out of the report: the table's path is written relative to the project.
+"$gem" calibrate --out "$work/calibration" | sed "s|$here/||g" > "$work/calibration.txt"
 "$gem" sweep "$here/scenarios/thesis/resistance_study.toml" --out "$work/resistance" --quiet
 "$gem" analyze "$work/resistance" --quiet
 rm -rf "$work/load"  # timed from scratch: the figure is for the whole study
