@@ -10,6 +10,10 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${1:-$here/build}"
 jobs="${2:-2}"
 [ -x "$build/gem" ] || "$here/scripts/setup.sh" "$build"
+if ! command -v python3 >/dev/null; then  # the tables are written by a short Python script
+  sudo_cmd=""; [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq && $sudo_cmd apt-get install -y -qq --no-install-recommends python3 >/dev/null
+fi
 work="$here/runs/sensitivity"
 mkdir -p "$work"
 for s in resistance_35 load_001_185 load_121_185 random_69_sizes; do
