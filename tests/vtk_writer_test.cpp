@@ -206,16 +206,22 @@ TEST(VtkSeriesWriter, BinaryFramesHoldTheAsciiValues) {
     const pugi::xml_node t = textArrays[a], b = binaryArrays[a];
     EXPECT_STREQ(t.attribute("Name").value(), b.attribute("Name").value());
     if (std::string(b.attribute("format").value()) != "appended") continue;  // kind_name stays text
-    const std::uint64_t* header = reinterpret_cast<const std::uint64_t*>(appended + b.attribute("offset").as_ullong());
-    const std::uint64_t blocks = header[0], blockSize = header[1], lastSize = header[2];
+    // The header's UInt64s sit at any byte offset in the file: read them by copying.
+    const unsigned char* at = appended + b.attribute("offset").as_ullong();
+    auto word = [&](std::uint64_t i) {
+      std::uint64_t v;
+      std::memcpy(&v, at + i * sizeof v, sizeof v);
+      return v;
+    };
+    const std::uint64_t blocks = word(0), blockSize = word(1), lastSize = word(2);
     std::vector<unsigned char> raw;
-    const unsigned char* data = reinterpret_cast<const unsigned char*>(header + 3 + blocks);
+    const unsigned char* data = at + (3 + blocks) * sizeof(std::uint64_t);
     for (std::uint64_t k = 0; k < blocks; ++k) {
       uLongf size = (k + 1 == blocks && lastSize) ? lastSize : blockSize;
       std::vector<unsigned char> block(size);
-      ASSERT_EQ(uncompress(block.data(), &size, data, static_cast<uLong>(header[3 + k])), Z_OK);
+      ASSERT_EQ(uncompress(block.data(), &size, data, static_cast<uLong>(word(3 + k))), Z_OK);
       raw.insert(raw.end(), block.begin(), block.begin() + static_cast<std::ptrdiff_t>(size));
-      data += header[3 + k];
+      data += word(3 + k);
     }
     const std::string type = b.attribute("type").value();
     std::vector<double> values;
