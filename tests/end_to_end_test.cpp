@@ -1,5 +1,6 @@
 // End to end: whole scenarios through the scheduler and the gem binary.
 #include <gtest/gtest.h>
+#include <toml++/toml.h>
 #include <pugixml.hpp>
 #include <fmt/format.h>
 
@@ -304,6 +305,12 @@ TEST(GemRun, AReusedRunFolderHoldsOnlyItsLastRunAndRecordsItsScenario) {
   EXPECT_NE(record.find("# --set output.frame_every=0"), std::string::npos) << record;
   EXPECT_NE(record.find("seed = 3"), std::string::npos) << record;
   EXPECT_NE(record.find("broadphase = "), std::string::npos) << record;  // a default, resolved
+  // Every event's table as it took effect: the scenario sets none of drag's parameters.
+  const toml::table recorded = toml::parse(record);
+  EXPECT_TRUE(recorded["events"]["drag"]["cd"].is_floating_point()) << record;
+  EXPECT_EQ(recorded["events"]["drag"]["enabled"].value<bool>(), true) << record;
+  EXPECT_EQ(recorded["events"]["wind"]["enabled"].value<bool>(), false) << record;                 // off unless given
+  EXPECT_TRUE(recorded["events"]["flexural_breaking"]["min_area"].is_floating_point()) << record;  // the scene's own value kept
   const std::string gemLog = test::readFile(out / "gem.log");
   EXPECT_NE(gemLog.find("--set output.frame_every=0"), std::string::npos) << gemLog;  // the command line
   EXPECT_NE(gemLog.find("exit status 0"), std::string::npos) << gemLog;

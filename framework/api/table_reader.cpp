@@ -53,6 +53,27 @@ namespace {
 thread_local ErrorCollector* t_collector = nullptr;
 }  // namespace
 
+namespace {
+thread_local DefaultsRecorder* t_defaults = nullptr;
+}  // namespace
+
+DefaultsRecorder::DefaultsRecorder(toml::table& into) : m_into(&into), m_previous(t_defaults) { t_defaults = this; }
+DefaultsRecorder::~DefaultsRecorder() { t_defaults = m_previous; }
+DefaultsRecorder* DefaultsRecorder::active() { return t_defaults; }
+
+toml::table* DefaultsRecorder::parentOf(const std::string& path) {
+  if (path.find('[') != std::string::npos || path.find('.') == std::string::npos) return nullptr;
+  toml::table* table = m_into;
+  size_t start = 0;
+  for (size_t dot = path.find('.'); dot != std::string::npos; start = dot + 1, dot = path.find('.', start)) {
+    const std::string part = path.substr(start, dot - start);
+    if (!table->contains(part)) table->insert(part, toml::table{});
+    table = table->get(part)->as_table();
+    if (!table) return nullptr;
+  }
+  return table;
+}
+
 ErrorCollector::ErrorCollector() : m_previous(t_collector) { t_collector = this; }
 ErrorCollector::~ErrorCollector() { t_collector = m_previous; }
 ErrorCollector* ErrorCollector::active() { return t_collector; }
@@ -150,7 +171,10 @@ std::optional<Real> TableReader::findReal(const std::string& key) {
   return toReal(*n, key);
 }
 
-Real TableReader::getReal(const std::string& key, Real fallback) { return findReal(key).value_or(fallback); }
+Real TableReader::getReal(const std::string& key, Real fallback) {
+  if (!has(key)) recordDefault(key, static_cast<double>(fallback));
+  return findReal(key).value_or(fallback);
+}
 
 Real TableReader::getPositive(const std::string& key, Real fallback) {
   Real v = getReal(key, fallback);
@@ -166,7 +190,7 @@ Real TableReader::getNonNegative(const std::string& key, Real fallback) {
 
 std::int64_t TableReader::getInt(const std::string& key, std::int64_t fallback, std::int64_t min, std::int64_t max) {
   const toml::node* n = node(key);
-  if (!n) return fallback;
+  if (!n) return recordDefault(key, fallback), fallback;
   auto i = n->value_exact<std::int64_t>();
   if (!i) return reportAt(*n, fmt::format("{}: expected an integer", keyPath(key))), fallback;
   if (*i < min || *i > max) return reportAt(*n, fmt::format("{}: must be in [{}, {}], got {}", keyPath(key), min, max, *i)), fallback;
@@ -175,7 +199,7 @@ std::int64_t TableReader::getInt(const std::string& key, std::int64_t fallback, 
 
 bool TableReader::getBool(const std::string& key, bool fallback) {
   const toml::node* n = node(key);
-  if (!n) return fallback;
+  if (!n) return recordDefault(key, fallback), fallback;
   auto b = n->value_exact<bool>();
   if (!b) return reportAt(*n, fmt::format("{}: expected true or false", keyPath(key))), fallback;
   return *b;
@@ -183,7 +207,7 @@ bool TableReader::getBool(const std::string& key, bool fallback) {
 
 std::string TableReader::getString(const std::string& key, const std::string& fallback) {
   const toml::node* n = node(key);
-  if (!n) return fallback;
+  if (!n) return recordDefault(key, fallback), fallback;
   auto s = n->value_exact<std::string>();
   if (!s) return reportAt(*n, fmt::format("{}: expected a string", keyPath(key))), fallback;
   return *s;

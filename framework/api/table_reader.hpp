@@ -57,6 +57,30 @@ class ErrorCollector {
   ErrorCollector* m_previous;
 };
 
+// While one is alive on this thread, every key a TableReader reads that the table does not give is
+// written, with the default it took, into `into` at its dotted path (keys inside arrays aside), so
+// that a run's scenario.toml can show every value in force (CpuStepper holds one over the events'
+// tables).
+class DefaultsRecorder {
+ public:
+  explicit DefaultsRecorder(toml::table& into);
+  ~DefaultsRecorder();
+  DefaultsRecorder(const DefaultsRecorder&) = delete;
+  DefaultsRecorder& operator=(const DefaultsRecorder&) = delete;
+
+  // Inserts value at the dotted path unless something is there already.
+  template <class T>
+  void record(const std::string& path, T value) {
+    if (toml::table* parent = parentOf(path)) parent->emplace(path.substr(path.rfind('.') + 1), std::move(value));
+  }
+  static DefaultsRecorder* active();
+
+ private:
+  toml::table* parentOf(const std::string& path);  // null for a path inside an array
+  toml::table* m_into;
+  DefaultsRecorder* m_previous;
+};
+
 // "; did you mean \"NAME\"?" for the candidate nearest to word when it is near enough to be a
 // typo (edit distance at most a third of the word's length, and at least 2), else "".
 std::string didYouMean(const std::string& word, const std::vector<std::string>& candidates);
@@ -100,6 +124,10 @@ class TableReader {
 
  private:
   const toml::node* node(const std::string& key);
+  template <class T>
+  void recordDefault(const std::string& key, T value) const {
+    if (DefaultsRecorder* r = DefaultsRecorder::active()) r->record(keyPath(key), std::move(value));
+  }
   std::optional<Real> toReal(const toml::node& n, const std::string& key) const;  // nullopt: reported
   InputError errorAt(const toml::node& node, const std::string& message) const;
   InputError errorFor(const std::string& key, const std::string& message) const;

@@ -45,9 +45,26 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
     if (entry.is_regular_file() && staleTemporary(entry.path())) fs::remove(entry.path(), ec);
 }
 
+namespace {
+
+// Copies into `into` every key of `from` it does not have, tables merged key by key.
+void addMissing(toml::table& into, const toml::table& from) {
+  for (const auto& [key, value] : from) {
+    if (!into.contains(key)) {
+      into.insert(key, value);
+    } else if (const toml::table* sub = value.as_table(); sub && into.get(key)->is_table()) {
+      addMissing(*into.get(key)->as_table(), *sub);
+    }
+  }
+}
+
+}  // namespace
+
 void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) {
   namespace fs = std::filesystem;
   toml::table root = scenario.root;
+  // Every event's parameters as they took effect, the defaults the scenario left out included.
+  if (scenario.defaultsTaken) addMissing(root, *scenario.defaultsTaken);
   auto table = [&](const char* name) -> toml::table& {
     if (!root.contains(name)) root.insert(name, toml::table{});
     return *root.get(name)->as_table();

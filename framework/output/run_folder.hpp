@@ -24,10 +24,10 @@ inline constexpr const char* kMovieFile = "movie.mp4";
 void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles);
 
 // Writes dir/scenario.toml: the scenario as this run read it (every --set applied, the [simulation]
-// keys resolved with their defaults, its seed and step count, the field file and output folder by
-// absolute path), so that `gem run dir/scenario.toml` repeats it. Other tables keep the keys the
-// file gave (an event's defaults are its own; `gem info` lists them). Skipped when dir/scenario.toml
-// is the scenario file itself.
+// keys resolved with their defaults, every event's table with the defaults its parameters took and
+// whether it is on, its seed and step count, the field file and output folder by absolute path), so
+// that `gem run dir/scenario.toml` repeats it. The field, vessel and output tables keep the keys
+// the file gave. Skipped when dir/scenario.toml is the scenario file itself.
 void recordScenario(const std::filesystem::path& dir, const Scenario& scenario);
 
 }  // namespace gem

@@ -1,6 +1,7 @@
 #include "framework/step/cpu_stepper.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <map>
 
@@ -133,11 +134,14 @@ void CpuStepper::setUp() {
   m_broadphase = Registry::global().broadphase(m_scenario.broadphase).make(m_scenario.broadphaseSettings);
   // Every event's table is checked, and all their errors reported together (docs/scenario.md 2).
   ErrorCollector errors;
+  std::optional<DefaultsRecorder> defaults;
+  if (m_scenario.defaultsTaken) defaults.emplace(*m_scenario.defaultsTaken);
   try {
     for (const EventEntry* entry : Registry::global().events()) {
       auto it = m_scenario.events.find(entry->name);
       const toml::table* table = m_scenario.eventTable(entry->name);
       const bool enabled = it == m_scenario.events.end() ? entry->enabledByDefault : it->second.enabled;
+      if (defaults) defaults->record("events." + entry->name + ".enabled", enabled);
       TableReader reader(table, "events." + entry->name, m_scenario.fileName);
       reader.accept("enabled");
       EventConfig config{reader, m_scenario, m_streams};
