@@ -90,5 +90,13 @@ cut_columns() { cut -d, -f"$2" "$1"; }
   echo
   # The audit against the thesis is written by hand, not generated: it follows the tables.
   cat "$here/docs/validation/audit-summary.md"
+  # The sensitivity study (scripts/sensitivity.sh writes docs/validation/sensitivity.md): its findings
+  # and tables here too, headings one level down and links made relative to docs/.
+  echo
+  echo "## 5. Sensitivity study"
+  echo
+  sed -e '1d' -e 's/^## /### /' -e 's/^#### /##### /' -e 's|](sensitivity_|](validation/sensitivity_|g' \
+    -e 's|](thesis-audit.md)|](validation/thesis-audit.md)|g' -e 's|](audit-summary.md)|](validation/audit-summary.md)|g' \
+    "$here/docs/validation/sensitivity.md"
 } > "$here/docs/validation.md"
 echo "wrote $here/docs/validation.md"
