@@ -107,6 +107,8 @@ class TableReader {
   std::optional<std::vector<Real>> findReals(const std::string& key);
   const toml::table* findTable(const std::string& key);
   const toml::array* findArray(const std::string& key);
+  // The key's value whatever its type (a key that takes more than one), marked as read; null when absent.
+  const toml::node* findNode(const std::string& key) { return node(key); }
   // Marks a key as known without reading it (read elsewhere).
   void accept(const std::string& key);
   // Throws InputError for the first key that was never read.

@@ -24,6 +24,7 @@
 #include "framework/api/registry.hpp"
 #include "framework/app/run_log.hpp"
 #include "framework/app/runner.hpp"
+#include "framework/output/checkpoint.hpp"
 #include "framework/scenario/scenario.hpp"
 #include "framework/step/cpu_stepper.hpp"
 #include "framework/app/mpi_work.hpp"
@@ -45,6 +46,7 @@ struct RunArguments {
   bool quiet = false;
   std::string commandLine;  // for gem.log
   bool noPlots = false;     // gem run --no-plots
+  std::string resume;       // gem run --resume RUN_DIR
 };
 
 Scenario load(const RunArguments& a) {
@@ -120,16 +122,41 @@ int commandPlot(const fs::path& dir, bool quiet) {
   return 0;
 }
 
+// gem run --resume RUN_DIR: the run folder's own scenario.toml, to go on from its checkpoint.
+Scenario loadForResume(const RunArguments& a) {
+  const fs::path dir = fs::absolute(a.resume).lexically_normal();
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw InputError(fmt::format("--resume {}: not a folder", a.resume));
+  if (!fs::is_regular_file(dir / "scenario.toml", ec))
+    throw InputError(fmt::format("--resume {}: no scenario.toml there, so not the folder of a gem run", a.resume));
+  // Threads change no result (docs/scenario.md): the one setting a resumed run may change.
+  std::vector<std::string> overrides;
+  if (a.threads >= 0) overrides.push_back("simulation.threads=" + std::to_string(a.threads));
+  Scenario s = loadScenario((dir / "scenario.toml").string(), overrides);
+  s.output.dir = dir;  // where the run is now, should the folder have moved
+  return s;
+}
+
 int commandRun(const RunArguments& a) {
-  const Scenario s = load(a);
+  const bool resume = !a.resume.empty();
+  if (!resume && a.scenario.empty()) throw InputError("gem run: a scenario file is required (or --resume RUN_DIR)");
+  if (resume && !a.scenario.empty())
+    throw InputError(
+        fmt::format("gem run --resume {}: takes no scenario file ({}): the run folder's scenario.toml is the run's", a.resume, a.scenario));
+  const Scenario s = resume ? loadForResume(a) : load(a);
   RunOptions options;
   options.quiet = a.quiet;
   options.progress = isatty(fileno(stderr));
   RunLog log(a.commandLine, a.quiet);
-  log.say(fmt::format("gem run {}: {} steps of {:.3g} s, backend {}, broadphase {}", a.scenario, s.steps, static_cast<double>(s.dt),
-                      resolveBackend(s.backend), s.broadphase));
+  if (resume) {
+    log.continueFrom(s.output.dir);
+    log.say(fmt::format("gem run --resume {}: from its checkpoint to step {}", a.resume, s.steps));
+  } else {
+    log.say(fmt::format("gem run {}: {} steps of {:.3g} s, backend {}, broadphase {}", a.scenario, s.steps, static_cast<double>(s.dt),
+                        resolveBackend(s.backend), s.broadphase));
+  }
   try {
-    const RunSummary r = runScenario(s, options);
+    const RunSummary r = resume ? resumeScenario(s, options) : runScenario(s, options);
     log.note(fmt::format("  device         {} ({} driver)", r.device, r.driver));
     reportRun(log, r);
     if (!a.noPlots) commandPlot(r.outputDir, a.quiet);
@@ -141,6 +168,11 @@ int commandRun(const RunArguments& a) {
     throw;
   } catch (const Interrupted& e) {
     log.note(fmt::format("gem: {}", e.what()));
+    if (fs::exists(s.output.dir / kCheckpointFile)) {
+      const std::string hint = fmt::format("gem: a checkpoint is kept: `gem run --resume {}` goes on from here", s.output.dir.string());
+      std::fprintf(stderr, "%s\n", hint.c_str());
+      log.note(hint);
+    }
     log.write(s.output.dir, 128 + e.signal());
     throw;
   } catch (const std::exception& e) {
@@ -206,8 +238,9 @@ int main(int argc, char** argv) {
                                         std::to_string(GEM_PLUGIN_ABI_VERSION) + ")");
   RunArguments args;
   args.commandLine = commandLineText(argc, argv);
-  auto addRunOptions = [&](CLI::App* c) {
-    c->add_option("scenario", args.scenario, "scenario file (TOML)")->required();
+  auto addRunOptions = [&](CLI::App* c, bool scenarioRequired) {
+    auto* scenario = c->add_option("scenario", args.scenario, "scenario file (TOML)");
+    if (scenarioRequired) scenario->required();
     c->add_option("--backend", args.backend, "auto, cpu or cuda");
     c->add_option("--broadphase", args.broadphase, "broadphase strategy by name (see gem info)");
     c->add_option("--threads", args.threads, "CPU backend: threads stepping the field (simulation.threads; 0 = every core)")
@@ -218,12 +251,19 @@ int main(int argc, char** argv) {
     c->add_option("--set", args.set, "override a scenario key: --set simulation.dt=0.05")->take_all();
   };
   CLI::App* run = app.add_subcommand("run", "run a scenario and write its outputs");
-  addRunOptions(run);
+  addRunOptions(run, false);  // gem run --resume RUN_DIR takes none
   run->add_option("--out", args.out, "run folder (default: output.dir of the scenario, else runs/NAME)");
   run->add_flag("--quiet", args.quiet, "no progress line and no summary");
   run->add_flag("--no-plots", args.noPlots, "do not write RUN/plots/ at the end (gem plot RUN writes them later)");
+  // What a resumed run could change would make it another run: only --threads, --quiet and
+  // --no-plots go with --resume.
+  auto* resumeOption = run->add_option("--resume", args.resume,
+                                       "go on with the stopped run in this folder from its checkpoint (output.checkpoint_every, or the one "
+                                       "Ctrl-C and SIGTERM write), to the very files the whole run writes");
+  for (const char* other : {"--backend", "--broadphase", "--duration", "--steps", "--set", "--out"})
+    resumeOption->excludes(run->get_option(other));
   CLI::App* check = app.add_subcommand("check", "load and validate a scenario without running it");
-  addRunOptions(check);
+  addRunOptions(check, true);
   check->add_flag("--quiet", args.quiet, "print nothing when the scenario is valid");
   std::vector<std::string> infoPlugins;
   CLI::App* info = app.add_subcommand("info", "version, build, devices, registered events and broadphases");

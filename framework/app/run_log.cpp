@@ -5,6 +5,9 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -40,10 +43,20 @@ void RunLog::say(const std::string& line) {
 
 void RunLog::note(const std::string& line) { m_lines += line + "\n"; }
 
+void RunLog::continueFrom(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "gem.log", std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  m_earlier = text.str();
+  // A run killed (kill -9, a crash, a batch system's hard limit) wrote no gem.log of its own.
+  if (m_earlier.empty()) m_earlier = "(the run's earlier part left no gem.log: it was killed or crashed)\n";
+  m_earlier += "\n--- resumed from checkpoint.gem ---\n\n";
+}
+
 void RunLog::write(const std::filesystem::path& dir, int exitStatus) const {
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) return;
-  writeFileAtomically(dir / "gem.log", m_header + m_lines + fmt::format("\nended: {}, exit status {}\n", utcNow(), exitStatus));
+  writeFileAtomically(dir / "gem.log", m_earlier + m_header + m_lines + fmt::format("\nended: {}, exit status {}\n", utcNow(), exitStatus));
 }
 
 std::string commandLineText(int argc, char** argv) {

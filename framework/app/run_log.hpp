@@ -15,12 +15,15 @@ class RunLog {
   void say(const std::string& line);
   // A line for the log only (what the terminal shows on stderr, such as an error).
   void note(const std::string& line);
+  // A resumed run (gem run --resume): the log of the run's earlier parts in dir is kept, and this
+  // part's follows it.
+  void continueFrom(const std::filesystem::path& dir);
   // Writes dir/gem.log (atomically) with the lines so far and how gem ends (exit status). Does
   // nothing when dir does not exist (a run refused before it opened its folder).
   void write(const std::filesystem::path& dir, int exitStatus) const;
 
  private:
-  std::string m_header, m_lines;
+  std::string m_earlier, m_header, m_lines;
   bool m_quiet;
 };
 

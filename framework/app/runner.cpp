@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
+#include <sstream>
 #include <csignal>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +18,7 @@
 
 #include "events/propulsion.hpp"
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/checkpoint.hpp"
 #include "framework/output/csv.hpp"
 #include "framework/output/run_folder.hpp"
 #include "framework/output/run_folder_lock.hpp"
@@ -144,29 +147,39 @@ class ScenarioRun {
  public:
   // The stepper outlives the run (a case run together with others is stepped to the end even
   // when its outputs fail).
-  ScenarioRun(const Scenario& scenario, Stepper& stepper)
-      : m_scenario(scenario), m_stepper(&stepper), m_dir(scenario.output.dir), m_lock(m_dir), m_timeseries(m_dir / "timeseries.csv") {
+  // checkpoint: a checkpoint's payload (resumeScenario) to go on from, else null for a new run.
+  ScenarioRun(const Scenario& scenario, Stepper& stepper, const std::string* checkpoint = nullptr)
+      : m_scenario(scenario), m_stepper(&stepper), m_dir(scenario.output.dir), m_lock(m_dir) {
     Stepper& sim = *m_stepper;
     m_summary.backend = sim.backend();  // "auto" may have fallen back to the cpu
     m_summary.driver = sim.driver();
     m_summary.broadphase = scenario.broadphase;
     m_summary.outputDir = scenario.output.dir.string();
     m_summary.device = sim.device();
+    const OutputSpec& out = scenario.output;
+    m_frames = out.frameEvery > 0;
+    const VesselSpec& vessel = scenario.vessel;
+    m_thrust = Propulsion::Params{vessel.bollardThrust,
+                                  vessel.bollardThrust / (vessel.openWaterSpeed * vessel.openWaterSpeed * vessel.openWaterSpeed)};
+    if (checkpoint) {
+      resumeFrom(*checkpoint);
+      return;
+    }
     m_summary.floesInitial = sim.hostWorld().count(BodyKind::Floe);
     m_summary.iceMassInitial = sim.hostWorld().floeMass();
     // What an earlier run left here goes (a stale summary or old frames must not sit beside this
-    // run's files), and the scenario as read is recorded (gem-run.toml).
+    // run's files), and the scenario as read is recorded (scenario.toml).
     std::vector<std::string> recordFiles;
     for (const RecordOutputEntry* output : Registry::global().recordOutputs()) recordFiles.push_back(output->file);
     clearEarlierRun(m_dir, recordFiles);
     recordScenario(m_dir, scenario);
+    m_scenarioChecksum = checksumOf(recordedScenarioText());
 
-    const OutputSpec& out = scenario.output;
-    m_frames = out.frameEvery > 0;
     auto has = [&](const char* f) { return std::find(out.formats.begin(), out.formats.end(), f) != out.formats.end(); };
     if (m_frames && has("vtk")) m_vtk = std::make_unique<VtkSeriesWriter>(m_dir, out.vtkBinary);
     if (m_frames && has("ice")) m_ice = std::make_unique<IceFileWriter>(m_dir / "frames.ice");
-    m_timeseries.stream() << "t,ship_x,ship_y,ship_heading,ship_speed,net_thrust,ice_force_x,contacts\n";
+    m_timeseries = std::make_unique<AtomicFile>(m_dir / "timeseries.csv");
+    m_timeseries->stream() << "t,ship_x,ship_y,ship_heading,ship_speed,net_thrust,ice_force_x,contacts\n";
     // The record streams' files, from the events that own them (ship_impact: impacts.csv).
     for (const RecordOutputEntry* output : Registry::global().recordOutputs()) {
       const int stream = sim.records().streams().find(output->stream);
@@ -174,9 +187,6 @@ class ScenarioRun {
       m_recordFiles.push_back(RecordFile{output, stream, std::make_unique<AtomicFile>(m_dir / output->file), {}, {}});
       m_recordFiles.back().file->stream() << output->header << "\n";
     }
-    const VesselSpec& vessel = scenario.vessel;
-    m_thrust = Propulsion::Params{vessel.bollardThrust,
-                                  vessel.bollardThrust / (vessel.openWaterSpeed * vessel.openWaterSpeed * vessel.openWaterSpeed)};
     if (m_frames) writeFrames();
     // The stop rule's starting point: the field's extent (the domain, else the floes' bounding
     // box) and the vessel's reach about its centroid (its bounding radius).
@@ -249,11 +259,11 @@ class ScenarioRun {
     }
     if ((k + 1) % scenario.output.timeseriesEvery == 0) {
       if (vessel.present)
-        m_timeseries.stream() << fmt::format("{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n", sim.time(), vessel.position.x,
-                                             vessel.position.y, vessel.heading, surge, Propulsion::netThrust(m_thrust, surge),
-                                             sim.vesselIceForce().x, sim.contactCount());
+        m_timeseries->stream() << fmt::format("{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n", sim.time(), vessel.position.x,
+                                              vessel.position.y, vessel.heading, surge, Propulsion::netThrust(m_thrust, surge),
+                                              sim.vesselIceForce().x, sim.contactCount());
       else
-        m_timeseries.stream() << fmt::format("{:.6g},,,,,,,{}\n", sim.time(), sim.contactCount());
+        m_timeseries->stream() << fmt::format("{:.6g},,,,,,,{}\n", sim.time(), sim.contactCount());
     }
     if (m_frames && (k + 1) % scenario.output.frameEvery == 0) writeFrames();
   }
@@ -284,7 +294,7 @@ class ScenarioRun {
   // signal: then completed is false): the last files, state.csv, and summary.json last of all.
   RunSummary finish(double wallTime, long stepsRun, const std::string& reason = "duration", bool completed = true) {
     Stepper& sim = *m_stepper;
-    m_summary.wallTime = wallTime;
+    m_summary.wallTime = m_wallBefore + wallTime;
     m_summary.steps = stepsRun;
     m_summary.stopReason = reason;
     m_summary.completed = completed;
@@ -306,7 +316,45 @@ class ScenarioRun {
     closeFiles();
     writeStateCsv(m_dir / "state.csv", world);
     writeFileAtomically(m_dir / "summary.json", summaryJson(m_summary));
+    // A whole run needs no checkpoint; one a signal stopped keeps it (written just before), to
+    // go on from with gem run --resume.
+    std::error_code ignored;
+    if (completed) std::filesystem::remove(m_dir / kCheckpointFile, ignored);
     return m_summary;
+  }
+
+  // output.checkpoint_every: whether a checkpoint is due after `stepsRun` steps (never after the
+  // last: the run is about to end whole).
+  bool checkpointDue(long stepsRun, double wallSeconds) const {
+    const OutputSpec& out = m_scenario.output;
+    if (stepsRun >= m_scenario.steps) return false;
+    if (out.checkpointEverySteps > 0 && stepsRun % out.checkpointEverySteps == 0) return true;
+    return out.checkpointEverySeconds > 0 && wallSeconds - m_lastCheckpointWall >= out.checkpointEverySeconds;
+  }
+
+  // RUN_DIR/checkpoint.gem, after the step just recorded: the stepper's state, the totals, and
+  // where each output file stands (flushed first, so that the bytes it vouches for are in them).
+  void saveCheckpoint(double wallSeconds) {
+    Stepper& sim = *m_stepper;
+    BinaryWriter out;
+    out.put(sim.backend()), out.put(sim.driver()), out.put(m_scenarioChecksum);
+    putStepperState(out, sim.saveState());
+    out.put(m_wallBefore + wallSeconds), out.put(m_summary.floesInitial), out.put(m_summary.iceMassInitial);
+    out.put(m_speed), out.put(m_netThrust), out.put(m_speedInIce), out.put(m_netThrustInIce);
+    out.put(m_fieldLow), out.put(m_fieldHigh), out.put(m_vesselReach), out.put(m_reachedField), out.put(m_lastVesselPosition);
+    out.put(m_travelled);
+    out.put(m_timeseries->tempPath().filename().string()), out.put(m_timeseries->flushedSize());
+    out.put(static_cast<std::uint64_t>(m_recordFiles.size()));
+    for (RecordFile& f : m_recordFiles) {
+      out.put(f.output->file), out.put(f.file->tempPath().filename().string()), out.put(f.file->flushedSize());
+      out.put(f.statistic), out.put(f.statisticInIce);
+    }
+    out.put(static_cast<bool>(m_vtk));
+    if (m_vtk) m_vtk->save(out);
+    out.put(static_cast<bool>(m_ice));
+    if (m_ice) m_ice->save(out);
+    writeCheckpointFile(m_dir / kCheckpointFile, out.bytes());
+    m_lastCheckpointWall = wallSeconds;
   }
 
   // The run failed: keep what it produced (whole rows only), but write no summary.json.
@@ -320,8 +368,62 @@ class ScenarioRun {
     if (m_vtk) m_vtk->addFrame(sim.hostWorld(), sim.time(), sim.contactForces());
     if (m_ice) m_ice->addFrame(sim.hostWorld(), sim.time());
   }
+  // The state saveCheckpoint wrote, read back in its order: the stepper's, the totals, and each
+  // output file cut to where the checkpoint left it.
+  void resumeFrom(const std::string& payload) {
+    Stepper& sim = *m_stepper;
+    const std::string name = (m_dir / kCheckpointFile).string();
+    BinaryReader in(payload, name);
+    in.get<std::string>(), in.get<std::string>();  // the backend and driver, which resumeScenario chose by
+    in.get(m_scenarioChecksum);
+    if (m_scenarioChecksum != checksumOf(recordedScenarioText()))
+      throw InputError(fmt::format("{}: {} changed since the checkpoint was written; a run resumes only with the scenario it ran", name,
+                                   (m_dir / "scenario.toml").string()));
+    StepperState state;
+    getStepperState(in, state);
+    sim.restoreState(state);
+    in.get(m_wallBefore), in.get(m_summary.floesInitial), in.get(m_summary.iceMassInitial);
+    in.get(m_speed), in.get(m_netThrust), in.get(m_speedInIce), in.get(m_netThrustInIce);
+    in.get(m_fieldLow), in.get(m_fieldHigh), in.get(m_vesselReach), in.get(m_reachedField), in.get(m_lastVesselPosition);
+    in.get(m_travelled);
+    // What the stopped run wrote at its end (summary, state, plots) describes a run that is not over.
+    clearRunEnd(m_dir);
+    const std::filesystem::path timeseries = m_dir / "timeseries.csv";
+    const auto timeseriesTemp = in.get<std::string>();
+    m_timeseries = std::make_unique<AtomicFile>(timeseries, earlierTempPath(timeseries, timeseriesTemp), in.get<std::uint64_t>());
+    const auto files = in.get<std::uint64_t>();
+    std::vector<const RecordOutputEntry*> outputs;
+    for (const RecordOutputEntry* output : Registry::global().recordOutputs())
+      if (sim.records().streams().find(output->stream) >= 0) outputs.push_back(output);
+    if (files != outputs.size()) throw InputError(name + ": damaged (its record files are not this run's)");
+    for (const RecordOutputEntry* output : outputs) {
+      const auto file = in.get<std::string>();
+      if (file != output->file) throw InputError(name + ": damaged (its record files are not this run's)");
+      const std::filesystem::path path = m_dir / file;
+      const auto temp = in.get<std::string>();
+      const auto bytes = in.get<std::uint64_t>();
+      m_recordFiles.push_back(RecordFile{output,
+                                         sim.records().streams().find(output->stream),
+                                         std::make_unique<AtomicFile>(path, earlierTempPath(path, temp), bytes),
+                                         {},
+                                         {}});
+      in.get(m_recordFiles.back().statistic), in.get(m_recordFiles.back().statisticInIce);
+    }
+    if (in.get<bool>()) m_vtk = std::make_unique<VtkSeriesWriter>(m_dir, m_scenario.output.vtkBinary, in);
+    if (in.get<bool>()) m_ice = std::make_unique<IceFileWriter>(m_dir / "frames.ice", in);
+    if (!in.atEnd()) throw InputError(name + ": damaged (bytes past its end)");
+  }
+
+  // scenario.toml as the run folder holds it (a checkpoint belongs to that text).
+  std::string recordedScenarioText() const {
+    std::ifstream in(m_dir / "scenario.toml", std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+
   void closeFiles() {
-    m_timeseries.commit();
+    m_timeseries->commit();
     for (RecordFile& f : m_recordFiles) f.file->commit();
     if (m_vtk) m_vtk->finish();
     if (m_ice) m_ice->finish();
@@ -335,7 +437,7 @@ class ScenarioRun {
   std::unique_ptr<VtkSeriesWriter> m_vtk;
   std::unique_ptr<IceFileWriter> m_ice;
   RunFolderLock m_lock;  // before any file of the folder is opened
-  AtomicFile m_timeseries;
+  std::unique_ptr<AtomicFile> m_timeseries;
   struct RecordFile {
     const RecordOutputEntry* output;
     int stream;
@@ -352,6 +454,10 @@ class ScenarioRun {
   bool m_reachedField = false;
   Vec2 m_lastVesselPosition{0, 0};
   double m_travelled = 0;
+  // Checkpoints: the wall seconds of the run's earlier parts (a resumed run's), the last
+  // checkpoint's wall time in this part, and the scenario.toml they belong to.
+  double m_wallBefore = 0, m_lastCheckpointWall = 0;
+  std::uint32_t m_scenarioChecksum = 0;
 };
 
 // "SIGINT", "SIGTERM": the stop reason of a run a signal ended.
@@ -361,28 +467,33 @@ std::string signalName(int signal) {
 
 }  // namespace
 
-RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
+namespace {
+
+// The steps of a run, new or resumed from a checkpoint's payload, with its outputs.
+RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const std::string* checkpoint) {
   const std::unique_ptr<Stepper> stepper = makeStepper(scenario);  // bad input throws here, before anything is written
-  ScenarioRun run(scenario, *stepper);
+  ScenarioRun run(scenario, *stepper, checkpoint);
   Stepper& sim = *stepper;
   const auto start = std::chrono::steady_clock::now();
   auto lastProgress = start;
   auto wallSeconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  long stepsRun = 0;
+  const long firstStep = sim.stepIndex();  // 0, or the checkpoint's step
+  long stepsRun = firstStep;
   const char* reason = "duration";
   try {
-    for (long k = 0; k < scenario.steps; ++k) {
+    for (long k = firstStep; k < scenario.steps; ++k) {
       stopIfInterrupted(k);
       sim.step();
       run.record(k);
       stepsRun = k + 1;
       const char* stop = run.stopRuleReached();
+      if (!stop && run.checkpointDue(stepsRun, wallSeconds())) run.saveCheckpoint(wallSeconds());
       if (options.progress && !options.quiet) {
         const auto now = std::chrono::steady_clock::now();
         if (now - lastProgress > std::chrono::milliseconds(250) || k + 1 == scenario.steps || stop) {
           lastProgress = now;
           const double wall = std::chrono::duration<double>(now - start).count();
-          const double rate = (k + 1) / std::max(wall, 1e-9);
+          const double rate = (k + 1 - firstStep) / std::max(wall, 1e-9);
           std::fprintf(stderr, "\r  step %ld/%ld  t = %.1f s  %.0f steps/s  %.0fx real time  ETA %s   ", k + 1, scenario.steps,
                        static_cast<double>(sim.time()), rate, rate * scenario.dt, formatDuration((scenario.steps - k - 1) / rate).c_str());
           std::fflush(stderr);
@@ -394,8 +505,13 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
       }
     }
   } catch (const Interrupted& e) {
-    // Ctrl-C or SIGTERM between two steps: every file closed whole, and a summary of the steps run
-    // that says it is not the whole run.
+    // Ctrl-C or SIGTERM between two steps: a checkpoint of the steps run (gem run --resume goes
+    // on from it), every file closed whole, and a summary that says it is not the whole run.
+    try {
+      run.saveCheckpoint(wallSeconds());
+    } catch (const std::exception& failed) {
+      std::fprintf(stderr, "gem: no checkpoint written: %s\n", failed.what());
+    }
     run.finish(wallSeconds(), stepsRun, signalName(e.signal()), false);
     throw;
   } catch (...) {
@@ -404,6 +520,25 @@ RunSummary runScenario(const Scenario& scenario, const RunOptions& options) {
   }
   if (options.progress && !options.quiet) std::fprintf(stderr, "\n");
   return run.finish(wallSeconds(), stepsRun, reason);
+}
+
+}  // namespace
+
+RunSummary runScenario(const Scenario& scenario, const RunOptions& options) { return runSteps(scenario, options, nullptr); }
+
+RunSummary resumeScenario(Scenario scenario, const RunOptions& options) {
+  const std::filesystem::path file = scenario.output.dir / kCheckpointFile;
+  const std::string payload = readCheckpointFile(file);
+  // The backend and driver that wrote it: another one's arithmetic would not give the same files.
+  BinaryReader in(payload, file.string());
+  const auto backend = in.get<std::string>(), driver = in.get<std::string>();
+  const BackendEntry* entry = findBackend(backend);
+  if (!entry || !entry->available())
+    throw InputError(fmt::format("{}: the run was on the {} backend, which {}; it resumes only where that backend runs", file.string(),
+                                 backend, entry ? "has no device here" : "this gem was built without"));
+  scenario.backend = backend;
+  if (backend == "cuda") scenario.cudaDriver = driver;
+  return runSteps(scenario, options, &payload);
 }
 
 std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>& scenarios, std::vector<std::unique_ptr<Stepper>> steppers,

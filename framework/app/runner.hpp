@@ -56,6 +56,13 @@ struct RunSummary {
 
 RunSummary runScenario(const Scenario& scenario, const RunOptions& options);
 
+// gem run --resume (docs/reliability.md "Checkpoints and resume"): the run of scenario (read from
+// the run folder's scenario.toml, output.dir that folder) goes on from the folder's checkpoint, on
+// the backend that wrote it, and ends with the files the run would have written uninterrupted.
+// InputError (exit 2) when there is no checkpoint, it is damaged or foreign, scenario.toml changed
+// since it was written, or its backend is not here.
+RunSummary resumeScenario(Scenario scenario, const RunOptions& options);
+
 // Scenarios whose steppers share one device state (a sweep's batch on a GPU, made by the backend's
 // makeTogether): stepped together, every one's step k before any one's step k + 1, each writing its
 // own outputs exactly as runScenario does (wall_time_s is the batch's). They must have the same

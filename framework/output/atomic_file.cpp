@@ -8,6 +8,10 @@
 #include <stdexcept>
 #include <system_error>
 
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
+
 namespace gem {
 
 namespace {
@@ -26,6 +30,51 @@ AtomicFile::AtomicFile(std::filesystem::path path) : m_path(std::move(path)) {
   errno = 0;
   m_stream.open(m_tempPath, std::ios::out | std::ios::trunc | std::ios::binary);
   if (!m_stream) throw writeError("open for writing", m_tempPath, errno);
+}
+
+std::filesystem::path earlierTempPath(const std::filesystem::path& finalPath, const std::string& recordedName, const std::string& infix) {
+  const std::string prefix = finalPath.filename().string() + infix;
+  const bool digits =
+      recordedName.size() > prefix.size() && recordedName.find_first_not_of("0123456789", prefix.size()) == std::string::npos;
+  if (recordedName.compare(0, prefix.size(), prefix) != 0 || !digits)
+    throw InputError(fmt::format("checkpoint: damaged (it names \"{}\" as the temporary of {})", recordedName.substr(0, 200),
+                                 finalPath.filename().string()));
+  return finalPath.parent_path() / recordedName;
+}
+
+// The part of a file a checkpoint vouches for, from where the stopped run left it, as this
+// process's temporary.
+std::filesystem::path adoptForResume(const std::filesystem::path& path, const std::filesystem::path& earlierTemp,
+                                     const std::filesystem::path& ownTemp, std::uint64_t bytes) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path source = fs::is_regular_file(earlierTemp, ec) ? earlierTemp : fs::is_regular_file(path, ec) ? path : fs::path();
+  if (source.empty())
+    throw InputError("cannot resume: " + path.string() + " is missing (neither it nor " + earlierTemp.filename().string() +
+                     ", which the stopped run was writing, is there)");
+  const std::uintmax_t size = fs::file_size(source, ec);
+  if (ec || size < bytes)
+    throw InputError(
+        fmt::format("cannot resume: {} holds {} bytes, fewer than the {} of the checkpoint", source.string(), ec ? 0 : size, bytes));
+  if (source != ownTemp) fs::rename(source, ownTemp);
+  fs::resize_file(ownTemp, bytes);
+  return ownTemp;
+}
+
+AtomicFile::AtomicFile(std::filesystem::path path, const std::filesystem::path& earlierTemp, std::uint64_t bytes)
+    : m_path(std::move(path)) {
+  m_tempPath = m_path;
+  m_tempPath += ".tmp-" + std::to_string(::getpid());
+  adoptForResume(m_path, earlierTemp, m_tempPath, bytes);
+  errno = 0;
+  m_stream.open(m_tempPath, std::ios::out | std::ios::app | std::ios::ate | std::ios::binary);
+  if (!m_stream) throw writeError("open for writing", m_tempPath, errno);
+}
+
+std::uint64_t AtomicFile::flushedSize() {
+  m_stream.flush();
+  if (!m_stream) throw writeError("write", m_tempPath, errno);
+  return static_cast<std::uint64_t>(m_stream.tellp());
 }
 
 AtomicFile::~AtomicFile() {

@@ -12,6 +12,7 @@
 #include <string>
 #include <system_error>
 #include <unordered_set>
+#include <vector>
 
 #include "framework/api/errors.hpp"
 #include "framework/output/atomic_file.hpp"
@@ -34,6 +35,58 @@ IceFileWriter::IceFileWriter(std::filesystem::path path) : m_path(std::move(path
   errno = 0;
   m_frames.open(m_framesPath, std::ios::out | std::ios::trunc | std::ios::binary);
   if (!m_frames) throw std::runtime_error("cannot open " + m_framesPath.string() + " for writing: " + std::strerror(errno));
+}
+
+IceFileWriter::IceFileWriter(std::filesystem::path path, BinaryReader& in) : m_path(std::move(path)) {
+  namespace fs = std::filesystem;
+  m_framesPath = m_path;
+  m_framesPath += ".frames.tmp-" + std::to_string(::getpid());
+  const auto earlierTemp = in.get<std::string>();
+  const auto bytes = in.get<std::uint64_t>();
+  in.get(m_frameCount);
+  const auto ids = in.get<std::uint64_t>();
+  for (std::uint64_t k = 0; k < ids; ++k) {
+    const auto id = in.get<std::int64_t>();
+    Written& w = m_written[id];
+    in.get(w.coordinates), in.get(w.vx), in.get(w.vy), in.get(w.omega), in.get(w.thickness), in.get(w.kind), in.get(w.lastSeenFrame);
+  }
+  std::error_code ec;
+  const fs::path earlier = earlierTempPath(m_path, earlierTemp, ".frames.tmp-");
+  if (!fs::is_regular_file(earlier, ec) && fs::is_regular_file(m_path, ec)) {
+    // The stopped run finished its file: its frames follow the three header lines (finish()).
+    std::ifstream whole(m_path, std::ios::binary);
+    std::string line;
+    for (int k = 0; k < 3 && std::getline(whole, line);) ++k;
+    std::string frames(bytes, '\0');
+    whole.read(frames.data(), static_cast<std::streamsize>(bytes));
+    if (!whole) throw InputError("cannot resume: " + m_path.string() + " holds fewer frames than the checkpoint");
+    m_frames.open(m_framesPath, std::ios::out | std::ios::trunc | std::ios::binary);
+    m_frames.write(frames.data(), static_cast<std::streamsize>(frames.size()));
+    fs::remove(m_path, ec);  // written again, whole, when the resumed run finishes
+  } else {
+    adoptForResume(m_path, earlier, m_framesPath, bytes);
+    m_frames.open(m_framesPath, std::ios::out | std::ios::app | std::ios::ate | std::ios::binary);
+  }
+  if (!m_frames) throw std::runtime_error("cannot open " + m_framesPath.string() + " for writing: " + std::strerror(errno));
+}
+
+void IceFileWriter::save(BinaryWriter& out) {
+  m_frames.flush();
+  if (!m_frames) throw std::runtime_error("cannot write " + m_framesPath.string() + ": " + std::strerror(errno));
+  out.put(m_framesPath.filename().string());
+  out.put(static_cast<std::uint64_t>(m_frames.tellp()));
+  out.put(m_frameCount);
+  // By id, so that the same state always makes the same checkpoint.
+  std::vector<std::int64_t> ids;
+  ids.reserve(m_written.size());
+  for (const auto& [id, w] : m_written) ids.push_back(id);
+  std::sort(ids.begin(), ids.end());
+  out.put(static_cast<std::uint64_t>(ids.size()));
+  for (const std::int64_t id : ids) {
+    const Written& w = m_written.at(id);
+    out.put(id);
+    out.put(w.coordinates), out.put(w.vx), out.put(w.vy), out.put(w.omega), out.put(w.thickness), out.put(w.kind), out.put(w.lastSeenFrame);
+  }
 }
 
 IceFileWriter::~IceFileWriter() {

@@ -6,6 +6,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "framework/output/binary_archive.hpp"
 #include "framework/world/world.hpp"
 
 namespace gem {
@@ -16,6 +17,9 @@ namespace gem {
 class IceFileWriter {
  public:
   explicit IceFileWriter(std::filesystem::path path);
+  // Goes on from a checkpoint (save() wrote `in`'s next bytes): the frames written by then, taken
+  // from the stopped run's temporary or, when it finished its file (a signal), from that file.
+  IceFileWriter(std::filesystem::path path, BinaryReader& in);
   ~IceFileWriter();
   IceFileWriter(const IceFileWriter&) = delete;
   IceFileWriter& operator=(const IceFileWriter&) = delete;
@@ -28,6 +32,9 @@ class IceFileWriter {
   void finish();
 
   int frameCount() const { return m_frameCount; }
+  // For a checkpoint: the frames flushed to the temporary, where they end, and what each id was
+  // last written with (later frames are written as changes against it).
+  void save(BinaryWriter& out);
 
  private:
   // What was last written for one id: changes are measured against it, so values that creep by

@@ -3,13 +3,19 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <functional>
 #include <sstream>
 
 #include <fmt/format.h>
 
 #include "framework/output/atomic_file.hpp"
+#include "framework/output/checkpoint.hpp"
 
 namespace gem {
+
+namespace {
+void removePlots(const std::filesystem::path& dir, const std::function<bool(const std::filesystem::path&)>& staleTemporary);
+}  // namespace
 
 void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles) {
   namespace fs = std::filesystem;
@@ -22,8 +28,8 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
   };
   // gem-run.toml: GEM 0.2's name for scenario.toml. scenario.toml itself is not removed: it is
   // rewritten whole by recordScenario (and may be the very file this run reads).
-  std::vector<std::string> files{"summary.json", "state.csv", "timeseries.csv", "frames.pvd",
-                                 "frames.ice",   "gem.log",   "gem-run.toml",   kMovieFile};
+  std::vector<std::string> files{"summary.json", "state.csv",    "timeseries.csv", "frames.pvd",   "frames.ice",
+                                 "gem.log",      "gem-run.toml", kMovieFile,       kCheckpointFile};
   files.insert(files.end(), recordFiles.begin(), recordFiles.end());
   for (const std::string& f : files) fs::remove(dir / f, ec);
   const fs::path frames = dir / "frames";
@@ -32,7 +38,23 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
       if (entry.path().extension() == ".vtp" || staleTemporary(entry.path())) fs::remove(entry.path(), ec);
     if (fs::is_empty(frames, ec)) fs::remove(frames, ec);
   }
-  // The old plots describe the old run: gone, whether or not this run makes new ones (--no-plots).
+  removePlots(dir, staleTemporary);
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_regular_file() && staleTemporary(entry.path())) fs::remove(entry.path(), ec);
+}
+
+void clearRunEnd(const std::filesystem::path& dir) {
+  std::error_code ec;
+  for (const char* f : {"summary.json", "state.csv", kMovieFile}) std::filesystem::remove(dir / f, ec);
+  removePlots(dir, [](const std::filesystem::path&) { return false; });
+}
+
+namespace {
+
+// The old plots describe the old run: gone, whether or not this run makes new ones (--no-plots).
+void removePlots(const std::filesystem::path& dir, const std::function<bool(const std::filesystem::path&)>& staleTemporary) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
   const fs::path plots = dir / "plots";
   if (fs::is_directory(plots, ec)) {
     for (const char* name : kRunPlotNames)
@@ -41,11 +63,7 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
       if (staleTemporary(entry.path())) fs::remove(entry.path(), ec);
     if (fs::is_empty(plots, ec)) fs::remove(plots, ec);
   }
-  for (const auto& entry : fs::directory_iterator(dir, ec))
-    if (entry.is_regular_file() && staleTemporary(entry.path())) fs::remove(entry.path(), ec);
 }
-
-namespace {
 
 // Copies into `into` every key of `from` it does not have, tables merged key by key.
 void addMissing(toml::table& into, const toml::table& from) {

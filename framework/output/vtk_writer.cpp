@@ -195,15 +195,17 @@ VtkSeriesWriter::VtkSeriesWriter(std::filesystem::path runDir, bool binary) : m_
 
 void VtkSeriesWriter::addFrame(const World& world, double time, const std::vector<std::pair<std::int64_t, Real>>* contactForces) {
   if (m_finished) throw std::logic_error("VtkSeriesWriter::addFrame after finish() in " + m_runDir.string());
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%06d.vtp", frameCount());
-  const std::string relative = std::string("frames/") + name;
+  const std::string relative = frameFile(frameCount());
   if (m_entries.empty()) m_firstIds.insert(world.id.begin(), world.id.end());
-  writeFileAtomically(m_runDir / "frames" / name, polyData(world, time, m_binary, m_firstIds, contactForces));
+  writeFileAtomically(m_runDir / relative, polyData(world, time, m_binary, m_firstIds, contactForces));
   m_entries.push_back({time, relative});
 
-  // The whole collection each time: O(frames) per frame, small next to the frame itself, and the
-  // .pvd on disk is always a complete document listing only frames that exist.
+  writeCollection();
+}
+
+// The whole collection each time: O(frames) per frame, small next to the frame itself, and the
+// .pvd on disk is always a complete document listing only frames that exist.
+void VtkSeriesWriter::writeCollection() {
   std::string pvd;
   pvd.reserve(160 + m_entries.size() * 80);
   pvd += "<?xml version=\"1.0\"?>\n";
@@ -219,6 +221,40 @@ void VtkSeriesWriter::addFrame(const World& world, double time, const std::vecto
   pvd += "  </Collection>\n";
   pvd += "</VTKFile>\n";
   writeFileAtomically(m_runDir / "frames.pvd", pvd);
+}
+
+std::string VtkSeriesWriter::frameFile(int index) {
+  char name[40];
+  std::snprintf(name, sizeof name, "frames/frame_%06d.vtp", index);
+  return name;
+}
+
+void VtkSeriesWriter::save(BinaryWriter& out) const {
+  std::vector<double> times;
+  for (const Entry& e : m_entries) times.push_back(e.time);
+  out.put(times);
+  std::vector<std::int64_t> firstIds(m_firstIds.begin(), m_firstIds.end());
+  std::sort(firstIds.begin(), firstIds.end());
+  out.put(firstIds);
+}
+
+VtkSeriesWriter::VtkSeriesWriter(std::filesystem::path runDir, bool binary, BinaryReader& in) : VtkSeriesWriter(std::move(runDir), binary) {
+  std::vector<double> times;
+  std::vector<std::int64_t> firstIds;
+  in.get(times), in.get(firstIds);
+  for (const double t : times) m_entries.push_back({t, frameFile(frameCount())});
+  m_firstIds.insert(firstIds.begin(), firstIds.end());
+  // Frames the stopped run wrote after its checkpoint go: the resumed run writes them again, and
+  // one that stops earlier must not leave frames its series does not list.
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(m_runDir / "frames", ec)) {
+    const std::string name = entry.path().filename().string();
+    int index = -1;
+    const bool later =
+        std::sscanf(name.c_str(), "frame_%d.vtp", &index) == 1 && index >= frameCount() && entry.path().extension() == ".vtp";
+    if (later || name.find(".tmp-") != std::string::npos) std::filesystem::remove(entry.path(), ec);
+  }
+  writeCollection();
 }
 
 void VtkSeriesWriter::finish() { m_finished = true; }

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "framework/output/binary_archive.hpp"
 #include "framework/world/world.hpp"
 
 namespace gem {
@@ -25,6 +26,9 @@ class VtkSeriesWriter {
   // Creates runDir/frames (and runDir) if needed; throws std::runtime_error when it cannot.
   // binary: appended, zlib-compressed arrays (output.vtk_encoding = "binary"), else ASCII.
   explicit VtkSeriesWriter(std::filesystem::path runDir, bool binary = false);
+  // Goes on from a checkpoint (save() wrote `in`'s next bytes): its frames listed again, and any
+  // frame the stopped run wrote after the checkpoint removed.
+  VtkSeriesWriter(std::filesystem::path runDir, bool binary, BinaryReader& in);
 
   // Writes the next frame_NNNNNN.vtp for simulation time `time` (s) and rewrites frames.pvd.
   // contactForces (optional, Stepper::contactForces): each body's contact force by id, written as
@@ -34,8 +38,12 @@ class VtkSeriesWriter {
   void finish();
 
   int frameCount() const { return static_cast<int>(m_entries.size()); }
+  // For a checkpoint: the frames' times and the bodies of frame 0.
+  void save(BinaryWriter& out) const;
 
  private:
+  void writeCollection();                   // frames.pvd
+  static std::string frameFile(int index);  // "frames/frame_NNNNNN.vtp"
   struct Entry {
     double time;
     std::string file;  // relative to the run folder, as ParaView resolves it from the .pvd

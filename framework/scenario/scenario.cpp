@@ -208,6 +208,36 @@ void readVessel(TableReader& t, Scenario& s) {
   t.finish();
 }
 
+// output.checkpoint_every: a whole number of steps (1000), or a wall-clock interval as a string
+// ("90s", "10min", "2h"): a batch job's time limit is wall-clock time.
+void readCheckpointEvery(TableReader& t, OutputSpec& o) {
+  const toml::node* every = t.findNode("checkpoint_every");
+  if (!every) return;
+  const std::string expected =
+      "output.checkpoint_every: expected a number of steps from 1 to 2e9 (1000) or a wall-clock interval (\"90s\", \"10min\", \"2h\")";
+  if (const auto steps = every->value_exact<std::int64_t>()) {
+    if (*steps < 1 || *steps > 2000000000) return t.reportAt(*every, fmt::format("{}, got {}", expected, *steps));
+    o.checkpointEverySteps = static_cast<long>(*steps);
+    return;
+  }
+  const auto text = every->value_exact<std::string>();
+  if (!text) return t.reportAt(*every, expected);
+  double value = 0;
+  size_t used = 0;
+  try {
+    value = std::stod(*text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  const std::string unit = text->substr(std::min(used, text->size()));
+  const double scale = unit == "s" ? 1 : unit == "min" ? 60 : unit == "h" ? 3600 : 0;
+  const double seconds = value * scale;
+  if (used == 0 || scale == 0 || !(seconds >= 1 && seconds <= 1e7))
+    return t.reportAt(*every, fmt::format("{}; an interval is 1 s to 1e7 s, a number followed by s, min or h, got \"{}\"", expected,
+                                          text->substr(0, 100)));
+  o.checkpointEverySeconds = seconds;
+}
+
 void readOutput(TableReader& t, Scenario& s) {
   OutputSpec& o = s.output;
   const std::string dir = t.getString("dir", "");
@@ -223,6 +253,7 @@ void readOutput(TableReader& t, Scenario& s) {
     }
   }
   o.vtkBinary = t.getChoice("vtk_encoding", "ascii", {"ascii", "binary"}) == "binary";
+  readCheckpointEvery(t, o);
   t.finish();
 }
 

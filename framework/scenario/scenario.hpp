@@ -24,6 +24,10 @@ struct OutputSpec {
   int timeseriesEvery = 1;    // steps between time-series rows
   std::vector<std::string> formats{"vtk", "ice"};
   bool vtkBinary = false;  // output.vtk_encoding = "binary": zlib-compressed appended arrays
+  // output.checkpoint_every (docs/reliability.md "Checkpoints and resume"): a checkpoint every so
+  // many steps, or every so many wall-clock seconds; both 0: none but the one a signal writes.
+  long checkpointEverySteps = 0;
+  double checkpointEverySeconds = 0;
 };
 
 struct PluginSpec {

@@ -159,6 +159,24 @@ void CpuStepper::setUp() {
   if (m_scenario.mortonSort) reorderAlongCurve();
 }
 
+StepperState CpuStepper::saveState() { return StepperState{m_world, m_step, m_time, m_previousContacts, m_rubbleMass, m_floesBroken}; }
+
+void CpuStepper::restoreState(const StepperState& state) {
+  m_world = state.world;
+  m_step = state.step;
+  m_time = state.time;
+  m_previousContacts = state.touching;
+  m_rubbleMass = state.rubbleMass;
+  m_floesBroken = state.floesBroken;
+  // What was derived from the old world goes: every body's vertices are computed afresh (the same
+  // poses give the same vertices), and the broadphase builds its lists from the new world.
+  m_vertexPose.clear();
+  m_broadphase->invalidate();
+  m_vesselId = -1;
+  for (int i = 0; i < m_world.size(); ++i)
+    if (m_world.kind[i] == BodyKind::Vessel) m_vesselId = m_world.id[i];
+}
+
 int CpuStepper::vesselSlot() const {
   if (m_vesselId < 0) return -1;
   for (int i = 0; i < m_world.size(); ++i)

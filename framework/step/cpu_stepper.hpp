@@ -64,6 +64,8 @@ class CpuStepper final : public Stepper {
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
   const std::vector<std::pair<std::int64_t, Real>>* contactForces() const override { return &m_contactForces; }
   int vesselSlot() const;  // -1 without a vessel
+  StepperState saveState() override;
+  void restoreState(const StepperState& state) override;
 
   // Totals since the start.
   double rubbleMass() const override { return m_rubbleMass; }

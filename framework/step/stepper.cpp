@@ -25,6 +25,14 @@ static std::map<std::string, BackendEntry>& backends() {
   return table;
 }
 
+StepperState Stepper::saveState() {
+  throw BackendUnsupported(fmt::format("the {} backend ({} driver) cannot write a checkpoint of this run", backend(), driver()));
+}
+
+void Stepper::restoreState(const StepperState&) {
+  throw BackendUnsupported(fmt::format("the {} backend ({} driver) cannot resume this run from a checkpoint", backend(), driver()));
+}
+
 void registerBackend(BackendEntry entry) { backends()[entry.name] = std::move(entry); }
 
 const BackendEntry* findBackend(const std::string& name) {

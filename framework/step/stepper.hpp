@@ -6,7 +6,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-#include <vector>
 
 #include "framework/api/errors.hpp"
 #include "framework/api/event_api.hpp"
@@ -22,6 +21,21 @@ struct VesselSample {
   Vec2 position;
   Real heading;
   Vec2 velocity;
+};
+
+// What a checkpoint keeps of a stepper (docs/reliability.md "Checkpoints"): with it a stepper made
+// anew from the same scenario goes on exactly as the one that wrote it would have, bit for bit.
+// Everything else a stepper holds (world vertices, boxes, the broadphase's lists, buffers) is
+// derived from these, or only saves work.
+struct StepperState {
+  World world;  // every body, in the slot order of the stepper that saved it
+  long step = 0;
+  Real time = 0;
+  // The id pairs (lower id first, sorted) in contact after the last step: a contact's onset (a
+  // pair that did not touch then) is part of the physics.
+  std::vector<std::pair<std::int64_t, std::int64_t>> touching;
+  double rubbleMass = 0;
+  long floesBroken = 0;
 };
 
 class Stepper {
@@ -52,6 +66,10 @@ class Stepper {
   // impulses / dt, N), by body id, sorted by id, bodies without contact left out; null for a
   // backend that does not keep it (the ParaView frames then have no contact_force array).
   virtual const std::vector<std::pair<std::int64_t, Real>>* contactForces() const { return nullptr; }
+  // Checkpoints: the state after the last step, and a stepper just made from the same scenario set
+  // to one. A backend that cannot (a case stepped together with others) throws BackendUnsupported.
+  virtual StepperState saveState();
+  virtual void restoreState(const StepperState& state);
 };
 
 // A backend that cannot run this scenario (e.g. an event without a driver for it). Bad input when
