@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -318,6 +319,50 @@ TEST(GemRun, AReusedRunFolderHoldsOnlyItsLastRunAndRecordsItsScenario) {
       test::runGem("run " + (out / "scenario.toml").string() + " --quiet --out " + (dir.path() / "again").string(), dir.path() / "log"), 0)
       << test::readFile(dir.path() / "log");
   EXPECT_EQ(test::readFile(dir.path() / "again" / "state.csv"), test::readFile(out / "state.csv"));
+}
+
+// The run's scenario.toml shows the values the scenario left to their defaults (docs/scenario.md
+// 2 documents them): the vessel's size, dof and the speed its thrust gives, the field generator's
+// settings, the output's frame_every and formats; and only those the choices made read.
+TEST(GemRun, TheRecordedScenarioShowsTheDefaultsTheScenarioLeftOut) {
+  test::TempDir dir;
+  const auto scenario = dir.write("sparse.toml",
+                                  "[simulation]\nsteps = 20\n[domain]\nx = [0.0, 60.0]\ny = [-30.0, 30.0]\n[field]\n"
+                                  "concentration = 0.3\n[vessel]\nbollard_thrust = 92e3\n");
+  const auto out = dir.path() / "out";
+  ASSERT_EQ(test::runGem("run " + scenario.string() + " --quiet --no-plots --steps 2 --out " + out.string(), dir.path() / "log"), 0)
+      << test::readFile(dir.path() / "log");
+  const std::string record = test::readFile(out / "scenario.toml");
+  const toml::table recorded = toml::parse(record);
+  EXPECT_EQ(recorded["vessel"]["length"].value<double>(), 100.0) << record;
+  EXPECT_EQ(recorded["vessel"]["beam"].value<double>(), 20.0) << record;
+  EXPECT_EQ(recorded["vessel"]["dof"].value<std::int64_t>(), 1) << record;
+  EXPECT_EQ(recorded["vessel"]["heading_deg"].value<double>(), 0.0) << record;
+  const std::optional<double> openWater = recorded["vessel"]["open_water_speed"].value<double>();
+  ASSERT_TRUE(openWater) << record;
+  EXPECT_NEAR(*openWater, 2.6, 1e-6) << record;  // the thesis's pair for 92 kN
+  EXPECT_EQ(recorded["vessel"]["speed"].value<double>(), openWater) << record;
+  EXPECT_EQ(recorded["vessel"]["position"][0].value<double>(), -60.0) << record;
+  EXPECT_FALSE(recorded["vessel"]["vertices"]) << record;  // the default hull follows length and beam
+  EXPECT_EQ(recorded["field"]["kind"].value<std::string>(), "random_convex") << record;
+  EXPECT_EQ(recorded["field"]["count"].value<std::int64_t>(), 0) << record;
+  EXPECT_NEAR(recorded["field"]["size_mean"].value_or(0.0), 6.9, 1e-6) << record;
+  EXPECT_EQ(recorded["field"]["max_sides"].value<std::int64_t>(), 7) << record;
+  EXPECT_FALSE(recorded["field"]["size"]) << record;  // the hexagons' key
+  EXPECT_EQ(recorded["domain"]["walls"].value<bool>(), false) << record;
+  EXPECT_FALSE(recorded["domain"]["wall_thickness"]) << record;  // no walls: it takes no effect
+  EXPECT_EQ(recorded["output"]["frame_every"].value<std::int64_t>(), 10) << record;
+  EXPECT_EQ(recorded["output"]["timeseries_every"].value<std::int64_t>(), 1) << record;
+  EXPECT_EQ(recorded["output"]["vtk_encoding"].value<std::string>(), "ascii") << record;
+  const toml::array* formats = recorded["output"]["formats"].as_array();
+  ASSERT_TRUE(formats) << record;
+  ASSERT_EQ(formats->size(), 2u) << record;
+  EXPECT_EQ(formats->get(0)->value<std::string>(), "vtk") << record;
+  EXPECT_EQ(recorded["simulation"]["steps"].value<std::int64_t>(), 2) << record;  // --steps, not the file's 20
+  EXPECT_EQ(recorded["simulation"]["morton_sort"].value<bool>(), true) << record;
+  EXPECT_EQ(recorded["simulation"]["stop_when"].value<std::string>(), "duration") << record;
+  EXPECT_FALSE(recorded["simulation"]["duration"]) << record;
+  EXPECT_FALSE(recorded["simulation"]["stop_distance"]) << record;
 }
 
 TEST(GemCli, VersionNamesTheVersionRealTypeAndPluginAbi) {

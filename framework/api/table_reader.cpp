@@ -62,13 +62,26 @@ DefaultsRecorder::~DefaultsRecorder() { t_defaults = m_previous; }
 DefaultsRecorder* DefaultsRecorder::active() { return t_defaults; }
 
 toml::table* DefaultsRecorder::parentOf(const std::string& path) {
-  if (path.find('[') != std::string::npos || path.find('.') == std::string::npos) return nullptr;
+  if (path.find('.') == std::string::npos) return nullptr;
   toml::table* table = m_into;
   size_t start = 0;
   for (size_t dot = path.find('.'); dot != std::string::npos; start = dot + 1, dot = path.find('.', start)) {
     const std::string part = path.substr(start, dot - start);
-    if (!table->contains(part)) table->insert(part, toml::table{});
-    table = table->get(part)->as_table();
+    const size_t bracket = part.find('[');
+    if (bracket == std::string::npos) {
+      if (!table->contains(part)) table->insert(part, toml::table{});
+      table = table->get(part)->as_table();
+    } else {
+      // "floes[3]": element 3 of an array of tables; the elements before it are kept as empty
+      // tables, so that each recorded element sits at its own index (recordScenario merges by index).
+      const std::string name = part.substr(0, bracket);
+      const size_t index = std::stoul(part.substr(bracket + 1));
+      if (!table->contains(name)) table->insert(name, toml::array{});
+      toml::array* elements = table->get(name)->as_array();
+      if (!elements) return nullptr;
+      while (elements->size() <= index) elements->push_back(toml::table{});
+      table = elements->get(index)->as_table();
+    }
     if (!table) return nullptr;
   }
   return table;
@@ -240,6 +253,11 @@ std::optional<Vec2> TableReader::findVec2(const std::string& key) {
   if (!v) return std::nullopt;
   if (v->size() != 2) return report(key, fmt::format("expected [x, y], got {} numbers", v->size())), std::nullopt;
   return Vec2{(*v)[0], (*v)[1]};
+}
+
+Vec2 TableReader::getVec2(const std::string& key, Vec2 fallback) {
+  if (!has(key)) recordDefault(key, toml::array{static_cast<double>(fallback.x), static_cast<double>(fallback.y)});
+  return findVec2(key).value_or(fallback);
 }
 
 std::optional<std::vector<Vec2>> TableReader::findPoints(const std::string& key) {

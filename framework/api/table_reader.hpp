@@ -58,9 +58,9 @@ class ErrorCollector {
 };
 
 // While one is alive on this thread, every key a TableReader reads that the table does not give is
-// written, with the default it took, into `into` at its dotted path (keys inside arrays aside), so
-// that a run's scenario.toml can show every value in force (CpuStepper holds one over the events'
-// tables).
+// written, with the default it took, into `into` at its dotted path ("floes[2].thickness": element
+// 2 of the array floes), so that a run's scenario.toml can show every value in force (loadScenario
+// holds one over the scenario's tables, CpuStepper one over the events' tables).
 class DefaultsRecorder {
  public:
   explicit DefaultsRecorder(toml::table& into);
@@ -76,7 +76,7 @@ class DefaultsRecorder {
   static DefaultsRecorder* active();
 
  private:
-  toml::table* parentOf(const std::string& path);  // null for a path inside an array
+  toml::table* parentOf(const std::string& path);  // null for a top-level key
   toml::table* m_into;
   DefaultsRecorder* m_previous;
 };
@@ -102,6 +102,7 @@ class TableReader {
   // A string that must be one of `choices`.
   std::string getChoice(const std::string& key, const std::string& fallback, const std::vector<std::string>& choices);
   std::optional<Vec2> findVec2(const std::string& key);
+  Vec2 getVec2(const std::string& key, Vec2 fallback);
   // [[x, y], ...]
   std::optional<std::vector<Vec2>> findPoints(const std::string& key);
   std::optional<std::vector<Real>> findReals(const std::string& key);
@@ -123,13 +124,15 @@ class TableReader {
   const std::string& file() const { return m_file; }
   const std::string& path() const { return m_path; }
   std::string keyPath(const std::string& key) const { return m_path.empty() ? key : m_path + "." + key; }
-
- private:
-  const toml::node* node(const std::string& key);
+  // The default a key took when the table does not give it, for the active DefaultsRecorder: the
+  // get* methods call it; a caller reading a key through find* (an array, say) calls it itself.
   template <class T>
   void recordDefault(const std::string& key, T value) const {
     if (DefaultsRecorder* r = DefaultsRecorder::active()) r->record(keyPath(key), std::move(value));
   }
+
+ private:
+  const toml::node* node(const std::string& key);
   std::optional<Real> toReal(const toml::node& n, const std::string& key) const;  // nullopt: reported
   InputError errorAt(const toml::node& node, const std::string& message) const;
   InputError errorFor(const std::string& key, const std::string& message) const;

@@ -65,13 +65,19 @@ void removePlots(const std::filesystem::path& dir, const std::function<bool(cons
   }
 }
 
-// Copies into `into` every key of `from` it does not have, tables merged key by key.
+// Copies into `into` every key of `from` it does not have, tables merged key by key and arrays of
+// tables ([[floes]]) element by element, by index.
 void addMissing(toml::table& into, const toml::table& from) {
   for (const auto& [key, value] : from) {
     if (!into.contains(key)) {
       into.insert(key, value);
     } else if (const toml::table* sub = value.as_table(); sub && into.get(key)->is_table()) {
       addMissing(*into.get(key)->as_table(), *sub);
+    } else if (const toml::array* elements = value.as_array(); elements && into.get(key)->is_array()) {
+      toml::array& intoElements = *into.get(key)->as_array();
+      for (size_t k = 0; k < elements->size() && k < intoElements.size(); ++k)
+        if (const toml::table* element = elements->get(k)->as_table(); element && intoElements.get(k)->is_table())
+          addMissing(*intoElements.get(k)->as_table(), *element);
     }
   }
 }
@@ -81,7 +87,10 @@ void addMissing(toml::table& into, const toml::table& from) {
 void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) {
   namespace fs = std::filesystem;
   toml::table root = scenario.root;
-  // Every event's parameters as they took effect, the defaults the scenario left out included.
+  // Every key as it took effect, the defaults the scenario left out included: those of its tables
+  // (loadScenario) and of every event's parameters (the stepper). Only the keys the choices made
+  // read are there (no stop_distance unless stop_when = "distance", no generator settings beside
+  // a .ice field, the size keys of one generator only), so the record loads as the scenario did.
   if (scenario.defaultsTaken) addMissing(root, *scenario.defaultsTaken);
   auto table = [&](const char* name) -> toml::table& {
     if (!root.contains(name)) root.insert(name, toml::table{});
@@ -91,8 +100,8 @@ void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) 
   // The steps this run takes, whatever set them (duration, --steps, --duration).
   table("simulation").erase("duration");
   table("simulation").insert_or_assign("steps", static_cast<std::int64_t>(scenario.steps));
-  // The [simulation] keys as they resolved, defaults included ("auto" stays "auto": the backend it
-  // picked is in summary.json and gem.log).
+  // The [simulation] keys as this run has them, whatever set them ("auto" stays "auto": the backend
+  // it picked is in summary.json and gem.log).
   toml::table& sim = table("simulation");
   sim.insert_or_assign("dt", static_cast<double>(scenario.dt));
   sim.insert_or_assign("backend", scenario.backend);
@@ -105,7 +114,13 @@ void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) 
   if (scenario.fieldKind == "file") table("field").insert_or_assign("file", scenario.fieldFile.lexically_normal().string());
   std::ostringstream out;
   out << "# The scenario of this run as gem read it: " << scenario.file.string() << "\n";
-  for (const std::string& o : scenario.overrides) out << "# --set " << o << "\n";
+  // An override's value may span lines (a sweep's hull vertices): each line stays a comment, or
+  // the rest of it would be read as TOML.
+  for (const std::string& o : scenario.overrides) {
+    std::string commented;
+    for (const char c : o) commented += c == '\n' ? std::string("\n#   ") : std::string(1, c);
+    out << "# --set " << commented << "\n";
+  }
   out << "# gem " << GEM_VERSION << "; `gem run scenario.toml` repeats the run.\n\n";
   out << toml::toml_formatter{root, toml::toml_formatter::default_flags & ~toml::format_flags::indentation} << "\n";
   // A scenario kept in its own run folder under this name is the user's file: never overwritten.

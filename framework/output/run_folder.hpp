@@ -28,11 +28,13 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
 // frames stay, to be continued.
 void clearRunEnd(const std::filesystem::path& dir);
 
-// Writes dir/scenario.toml: the scenario as this run read it (every --set applied, the [simulation]
-// keys resolved with their defaults, every event's table with the defaults its parameters took and
+// Writes dir/scenario.toml: the scenario as this run read it (every --set applied, every key of
+// its tables resolved with the default it took where the file gave none, every event's table with
 // whether it is on, its seed and step count, the field file and output folder by absolute path), so
-// that `gem run dir/scenario.toml` repeats it. The field, vessel and output tables keep the keys
-// the file gave. Skipped when dir/scenario.toml is the scenario file itself.
+// that `gem run dir/scenario.toml` repeats it and loading it gives the same scenario. Left out: a
+// default hull's vertices (drawn from length and beam) and the broadphase settings not given (a
+// setting written down is one a CUDA run must honour). Skipped when dir/scenario.toml is the
+// scenario file itself.
 void recordScenario(const std::filesystem::path& dir, const Scenario& scenario);
 
 }  // namespace gem

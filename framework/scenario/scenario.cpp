@@ -53,10 +53,14 @@ Domain readDomain(TableReader& t, const Scenario& s) {
   if (auto x = t.findReals("x")) {
     if (x->size() != 2 || !((*x)[0] < (*x)[1])) t.fail("x", "expected [x0, x1] with x0 < x1");
     d.x0 = (*x)[0], d.x1 = (*x)[1];
+  } else {
+    t.recordDefault("x", toml::array{static_cast<double>(d.x0), static_cast<double>(d.x1)});
   }
   if (auto y = t.findReals("y")) {
     if (y->size() != 2 || !((*y)[0] < (*y)[1])) t.fail("y", "expected [y0, y1] with y0 < y1");
     d.y0 = (*y)[0], d.y1 = (*y)[1];
+  } else {
+    t.recordDefault("y", toml::array{static_cast<double>(d.y0), static_cast<double>(d.y1)});
   }
   return d;
 }
@@ -98,7 +102,11 @@ void readField(TableReader& t, Scenario& s) {
     return;
   }
   const Real concentration = t.getPositive("concentration", s.fieldKind == "hexagons" ? Real(0.46) : Real(0.4));
-  const Real thickness = t.getPositive("thickness", Real(0.7));
+  // A random field of thickness groups takes each floe's thickness from its group: field.thickness
+  // is then read only when given, so that a run's scenario.toml shows no default that took no effect.
+  const bool thicknessFromGroups = s.fieldKind == "random_convex" && t.has("groups") && !t.has("thickness");
+  if (thicknessFromGroups) t.accept("thickness");
+  const Real thickness = thicknessFromGroups ? Real(0.7) : t.getPositive("thickness", Real(0.7));
   const Real minGap = t.getNonNegative("min_gap", Real(0.05));
   if (s.fieldKind == "hexagons") {
     HexagonFieldSpec& h = s.hexagonField;
@@ -151,7 +159,7 @@ void readFloes(const toml::array& floes, TableReader& parent, Scenario& s) {
     if (!vertices) t.fail("vertices", "each floe needs vertices = [[x, y], ...]");
     spec.vertices = *vertices;
     spec.thickness = t.getReal("thickness", Real(0.7));
-    spec.velocity = t.findVec2("velocity").value_or(Vec2{0, 0});
+    spec.velocity = t.getVec2("velocity", Vec2{0, 0});
     spec.angularVelocity = t.getReal("angular_velocity", 0);
     const auto& src = ft->source();
     // Where the floe was written: its line in the file, or the --set that gave the floes.
@@ -185,13 +193,15 @@ void readVessel(TableReader& t, Scenario& s) {
   v.beam = t.getPositive("beam", v.beam);
   v.mass = t.getPositive("mass", v.mass);
   v.draft = t.getPositive("draft", v.draft);
-  v.position = t.findVec2("position").value_or(v.position);
+  v.position = t.getVec2("position", v.position);
   v.headingDeg = t.getReal("heading_deg", 0);
   v.dof = static_cast<int>(t.getInt("dof", 1, 1, 3));
   if (v.dof == 2) t.fail("dof", "must be 1 (surge) or 3 (surge, sway, yaw)");
   v.bollardThrust = t.getNonNegative("bollard_thrust", v.bollardThrust);
   v.openWaterSpeed = t.getPositive("open_water_speed", openWaterSpeedFor(v.bollardThrust));
   v.speed = t.getNonNegative("speed", v.openWaterSpeed);  // docs/model.md 7: starts at V_ow
+  // No vertices: the default hull, drawn to length and beam (defaultHull); it stays unwritten in a
+  // run's scenario.toml, so that a changed length or beam still reshapes it.
   auto hull = t.findPoints("vertices");
   auto frames = t.findReals("frame_angle_deg");
   if (hull) {
@@ -251,6 +261,10 @@ void readOutput(TableReader& t, Scenario& s) {
       if (!name || (*name != "vtk" && *name != "ice")) t.failAt(f, "output.formats: valid formats are \"vtk\" and \"ice\"");
       o.formats.push_back(*name);
     }
+  } else {
+    toml::array formatsTaken;
+    for (const std::string& f : o.formats) formatsTaken.push_back(f);
+    t.recordDefault("formats", std::move(formatsTaken));
   }
   o.vtkBinary = t.getChoice("vtk_encoding", "ascii", {"ascii", "binary"}) == "binary";
   readCheckpointEvery(t, o);
@@ -263,13 +277,17 @@ void readOutput(TableReader& t, Scenario& s) {
 // file:line:column. The path is written back absolute, so a copy of root (a sweep case's
 // scenario.toml) still finds it.
 void readPlugins(const toml::array& plugins, TableReader& top, Scenario& s) {
-  for (const toml::node& p : plugins) {
+  for (size_t k = 0; k < plugins.size(); ++k) {
+    const toml::node& p = *plugins.get(k);
     const toml::table* pt = p.as_table();
     if (!pt) top.failAt(p, "plugins: expected [[plugins]] tables");
     TableReader t(pt, "plugins", s.fileName);
     PluginSpec spec;
     if (!t.has("path")) t.failAt(p, "plugins: each [[plugins]] needs a path = \"...\" (to the plugin's .so)");
     spec.path = t.getString("path", "");
+    // Read as "plugins" (the messages name no index), so its default is recorded here by index.
+    if (DefaultsRecorder* recorder = DefaultsRecorder::active(); recorder && !t.has("override"))
+      recorder->record(fmt::format("plugins[{}].override", k), false);
     spec.override = t.getBool("override", false);
     t.finish();
     if (spec.path.is_relative()) spec.path = s.file.parent_path() / spec.path;
@@ -384,7 +402,11 @@ void readScenarioTables(Scenario& s) {
     if (s.stopWhen == "distance" && !t.has("stop_distance"))
       t.fail("stop_when", "stop_when = \"distance\" needs simulation.stop_distance (m)");
     if (s.stopWhen != "distance" && t.has("stop_distance")) t.fail("stop_distance", "only read with stop_when = \"distance\"");
-    s.stopDistance = t.getPositive("stop_distance", Real(1));
+    // Read only where it applies: a recorded default beside another stop rule would be refused.
+    if (s.stopWhen == "distance")
+      s.stopDistance = t.getPositive("stop_distance", Real(1));
+    else
+      t.accept("stop_distance");
     t.finish();
   }
   if (const toml::table* b = top.findTable("broadphase")) readBroadphaseTables(*b, s);
@@ -393,7 +415,12 @@ void readScenarioTables(Scenario& s) {
     s.hasDomain = true;
     s.domain = readDomain(t, s);
     s.walls = t.getBool("walls", false);
-    s.wallThickness = t.getPositive("wall_thickness", s.wallThickness);
+    // Without walls wall_thickness is read only when given (checked all the same): a run's
+    // scenario.toml shows no default that took no effect.
+    if (s.walls || t.has("wall_thickness"))
+      s.wallThickness = t.getPositive("wall_thickness", s.wallThickness);
+    else
+      t.accept("wall_thickness");
     t.finish();
   }
   if (const toml::table* v = top.findTable("vessel")) {
@@ -464,6 +491,8 @@ Scenario loadScenario(const fs::path& file, const std::vector<std::string>& over
   // Every error of the tables at once (each bad value is recorded and its default used), then
   // any that stopped the reading: the user fixes them in one round.
   ErrorCollector errors;
+  // The defaults every table took (the run's scenario.toml writes them beside the keys given).
+  const DefaultsRecorder defaults(*s.defaultsTaken);
   try {
     readScenarioTables(s);
   } catch (const InputError& e) {

@@ -42,9 +42,9 @@ struct Scenario {
   // The same document as read, with its source lines and columns (toml++ drops them when a table
   // is copied), shared by every copy of this Scenario: eventTable() reads it.
   std::shared_ptr<const toml::table> document;
-  // The events' parameters the scenario left out, with the defaults they took, filled when a
-  // stepper parses them (DefaultsRecorder) and written into the run's scenario.toml; shared by
-  // every copy of this Scenario.
+  // The keys the scenario left out, with the defaults they took: its tables' when it is loaded,
+  // the events' parameters' when a stepper parses them (DefaultsRecorder); written into the run's
+  // scenario.toml; shared by every copy of this Scenario.
   std::shared_ptr<toml::table> defaultsTaken = std::make_shared<toml::table>();
   std::vector<std::string> overrides;  // the --set (and sweep) overrides, "key=VALUE", as applied
 
