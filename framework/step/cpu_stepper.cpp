@@ -226,9 +226,23 @@ void CpuStepper::narrowphase() {
                              : std::lower_bound(
                                    m_lastSeparated.cbegin(), m_lastSeparated.cend(), m_pairs[static_cast<size_t>(begin)],
                                    [](const SeparatedPair& s, const CandidatePair& c) { return s.a < c.a || (s.a == c.a && s.b < c.b); });
+    // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
+    // About one in four passes, so a branch would mispredict often: every candidate is written
+    // to the scratch list and kept by advancing the count (boxesOverlap's test, without its
+    // short-circuits), and only the survivors take the branches of mayTouch and after.
+    part.boxSurvivors.resize(static_cast<size_t>(end - begin));
+    int* survivor = part.boxSurvivors.data();
+    int survivors = 0;
+    const Box* boxes = m_boxes.data();
     for (int p = begin; p < end; ++p) {
+      const Box& boxA = boxes[m_pairs[static_cast<size_t>(p)].a];
+      const Box& boxB = boxes[m_pairs[static_cast<size_t>(p)].b];
+      survivor[survivors] = p;
+      survivors += !(boxA.x0 > boxB.x1) & !(boxB.x0 > boxA.x1) & !(boxA.y0 > boxB.y1) & !(boxB.y0 > boxA.y1);
+    }
+    for (int s = 0; s < survivors; ++s) {
+      const int p = survivor[s];
       const int a = m_pairs[static_cast<size_t>(p)].a, b = m_pairs[static_cast<size_t>(p)].b;
-      // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
       if (!mayTouch(m_world.invMass[a], m_world.invMass[b], m_boxes[a], m_boxes[b])) continue;
       const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
       const bool touchedBefore = touchedAtLastStep(a, b, key);

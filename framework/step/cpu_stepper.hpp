@@ -125,6 +125,7 @@ class CpuStepper final : public Stepper {
     std::vector<PairContact> contacts;
     std::vector<std::pair<std::int64_t, std::int64_t>> keys;
     std::vector<SeparatedPair> separated;
+    std::vector<int> boxSurvivors;  // scratch: the candidates whose boxes overlap
   };
   std::vector<NarrowphasePart> m_parts;
   // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads; body(i) for
