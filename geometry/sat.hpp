@@ -53,4 +53,46 @@ GEM_HD inline bool convexOverlap(const Vec2* p, int n, const Vec2* q, int m) {
   return !detail::edgeSeparates(p, n, q, m) && !detail::edgeSeparates(q, m, p, n);
 }
 
+// The CPU narrowphase's rejection of apart pairs, one edge at a time, so that the edge that
+// separated a pair last step can be tried first (docs/performance.md 4.1). These repeat the
+// arithmetic of one round of detail::edgeSeparates operation for operation, so an edge found here
+// is an edge convexOverlap finds too: the pair does not touch, and computeContact would return
+// "not touching". edgeSeparates itself is left as it is, so that what the CUDA compiler makes of
+// computeContact (it fuses multiply-adds) cannot change; the host is built without fused
+// multiply-adds, so there both give the same verdict bit for bit.
+
+// A candidate separating axis: the outward normal of edge `edge` of p (side 0) or of q (side 1).
+struct SeparatingEdge {
+  int side;  // 0: an edge of p, 1: an edge of q, -1: none (the interiors overlap)
+  int edge;
+};
+
+// True when edge i of p (from p[i] to p[i + 1]) separates q, as one round of detail::edgeSeparates.
+GEM_HD inline bool edgeSeparatesAt(const Vec2* p, int n, int i, const Vec2* q, int m) {
+  Vec2 a = p[i], e = p[i + 1 == n ? 0 : i + 1] - a;
+  Vec2 nrm{e.y, -e.x};
+  Real le = l1Norm(e);
+  Real tol = kGeomRelTol * le * (le + l1Norm(a));
+  int j = 0;
+  while (j < m && dot(nrm, q[j] - a) >= -tol) ++j;
+  return j == m;
+}
+
+// True when `axis` (any side and index; an index out of range is simply not tried) separates p and q.
+GEM_HD inline bool separatesAlong(SeparatingEdge axis, const Vec2* p, int n, const Vec2* q, int m) {
+  if (axis.side == 0) return axis.edge >= 0 && axis.edge < n && edgeSeparatesAt(p, n, axis.edge, q, m);
+  if (axis.side == 1) return axis.edge >= 0 && axis.edge < m && edgeSeparatesAt(q, m, axis.edge, p, n);
+  return false;
+}
+
+// The first separating edge in convexOverlap's order (p's edges, then q's), or side -1 exactly
+// when convexOverlap(p, n, q, m) is true.
+GEM_HD inline SeparatingEdge findSeparatingEdge(const Vec2* p, int n, const Vec2* q, int m) {
+  for (int i = 0; i < n; ++i)
+    if (edgeSeparatesAt(p, n, i, q, m)) return {0, i};
+  for (int i = 0; i < m; ++i)
+    if (edgeSeparatesAt(q, m, i, p, n)) return {1, i};
+  return {-1, 0};
+}
+
 }  // namespace gem

@@ -2,7 +2,9 @@
 // The random cross-checks against CGAL's exact kernel are in tests/cgal/geometry_cgal_test.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "geometry/clip.hpp"
@@ -448,4 +450,69 @@ TEST(Geometry, SplitLineMisses) {
   splitByLine(s.data(), 4, {0, -1}, {-1, 0}, l, &nl, r, &nr);
   EXPECT_EQ(nl, 0);
   EXPECT_EQ(nr, 4);
+}
+
+// ---- the CPU narrowphase's rejection by one cached edge ----
+
+namespace {
+
+// A random convex counter-clockwise polygon: 3 to 12 points at sorted angles on a circle.
+Poly randomConvex(std::mt19937& rng, Vec2 centre, Real radius) {
+  std::uniform_real_distribution<Real> unit(0, 1);
+  const int n = 3 + static_cast<int>(unit(rng) * 10);
+  std::vector<Real> angles(n);
+  for (Real& a : angles) a = unit(rng) * 2 * kPi;
+  std::sort(angles.begin(), angles.end());
+  Poly p;
+  for (Real a : angles) p.push_back(centre + radius * Vec2{std::cos(a), std::sin(a)});
+  return p;
+}
+
+}  // namespace
+
+// Whatever edge is tried (the cache may hold a stale or wrong one), an edge that separates means
+// computeContact says "not touching", and the full search finds an edge exactly when
+// convexOverlap finds none. Pairs apart, overlapping, and sharing an edge to within rounding, near
+// the origin and a kilometre away.
+TEST(Geometry, CachedSeparatingEdgeNeverRejectsATouchingPair) {
+  std::mt19937 rng(20261201);
+  std::uniform_real_distribution<Real> unit(0, 1);
+  int rejected = 0, touching = 0, sharedEdges = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Vec2 origin = trial % 2 ? Vec2{1000 * unit(rng), -700 * unit(rng)} : Vec2{0, 0};
+    const Real r = 0.5 + 5 * unit(rng);
+    Poly p = randomConvex(rng, origin, r), q;
+    if (trial % 4 == 3) {
+      // q mirrors p across one of p's edges: the two share that edge, then a nudge of a few ulps
+      // to a few nanometres either way (touching, a sliver, or a hair apart).
+      const int i = static_cast<int>(unit(rng) * p.size()) % static_cast<int>(p.size());
+      const Vec2 a = p[i], e = p[(i + 1) % p.size()] - a, t = (Real(1) / norm(e)) * e;
+      for (auto it = p.rbegin(); it != p.rend(); ++it) q.push_back(a + 2 * dot(*it - a, t) * t - (*it - a));
+      const Real nudge = (unit(rng) - 0.5) * 1e-8 * (trial % 8 == 3 ? 1 : 1e-5);
+      for (Vec2& v : q) v = v + nudge * Vec2{t.y, -t.x};
+      ++sharedEdges;
+    } else {
+      q = randomConvex(rng, origin + 2.5 * r * Vec2{unit(rng) - 0.5, unit(rng) - 0.5}, 0.5 + 5 * unit(rng));
+    }
+    const int n = static_cast<int>(p.size()), m = static_cast<int>(q.size());
+    const bool overlap = convexOverlap(p.data(), n, q.data(), m);
+    const SeparatingEdge found = findSeparatingEdge(p.data(), n, q.data(), m);
+    ASSERT_EQ(found.side < 0, overlap) << "trial " << trial;
+    if (!overlap) {
+      ASSERT_TRUE(separatesAlong(found, p.data(), n, q.data(), m)) << "trial " << trial;
+    }
+    const Contact contact = contactOf(p, q);
+    touching += contact.touching;
+    for (int side = 0; side < 2; ++side)
+      for (int edge = -1; edge <= (side ? m : n); ++edge) {  // out-of-range indices included
+        if (!separatesAlong(SeparatingEdge{side, edge}, p.data(), n, q.data(), m)) continue;
+        ++rejected;
+        ASSERT_FALSE(overlap) << "trial " << trial << " side " << side << " edge " << edge;
+        ASSERT_FALSE(contact.touching) << "trial " << trial << " side " << side << " edge " << edge;
+      }
+  }
+  // The cases are mixed: plenty of each kind.
+  EXPECT_GT(touching, 3000);
+  EXPECT_GT(rejected, 3000);
+  EXPECT_GT(sharedEdges, 3000);
 }

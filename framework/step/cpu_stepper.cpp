@@ -235,22 +235,57 @@ void CpuStepper::narrowphase() {
   m_parts.resize(static_cast<size_t>(tasks));
   auto testPart = [&](int t) {
     NarrowphasePart& part = m_parts[static_cast<size_t>(t)];
-    part.a.clear(), part.b.clear(), part.contacts.clear(), part.keys.clear();
+    part.a.clear(), part.b.clear(), part.contacts.clear(), part.keys.clear(), part.separated.clear();
+    const int begin = static_cast<int>(static_cast<long>(pairs) * t / tasks);
     const int end = static_cast<int>(static_cast<long>(pairs) * (t + 1) / tasks);
-    for (int p = static_cast<int>(static_cast<long>(pairs) * t / tasks); p < end; ++p) {
+    // The last step's separated pairs, in the same (a, b) order as the candidates: one cursor walks
+    // them alongside. A broadphase that lists its pairs out of order only finds fewer of them.
+    auto cached = begin == 0 ? m_lastSeparated.cbegin()
+                             : std::lower_bound(
+                                   m_lastSeparated.cbegin(), m_lastSeparated.cend(), m_pairs[static_cast<size_t>(begin)],
+                                   [](const SeparatedPair& s, const CandidatePair& c) { return s.a < c.a || (s.a == c.a && s.b < c.b); });
+    // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
+    // About one in four passes, so a branch would mispredict often: every candidate is written
+    // to the scratch list and kept by advancing the count (boxesOverlap's test, without its
+    // short-circuits), and only the survivors take the branches of mayTouch and after.
+    part.boxSurvivors.resize(static_cast<size_t>(end - begin));
+    int* survivor = part.boxSurvivors.data();
+    int survivors = 0;
+    const Box* boxes = m_boxes.data();
+    for (int p = begin; p < end; ++p) {
+      const Box& boxA = boxes[m_pairs[static_cast<size_t>(p)].a];
+      const Box& boxB = boxes[m_pairs[static_cast<size_t>(p)].b];
+      survivor[survivors] = p;
+      survivors += !(boxA.x0 > boxB.x1) & !(boxB.x0 > boxA.x1) & !(boxA.y0 > boxB.y1) & !(boxB.y0 > boxA.y1);
+    }
+    for (int s = 0; s < survivors; ++s) {
+      const int p = survivor[s];
       const int a = m_pairs[static_cast<size_t>(p)].a, b = m_pairs[static_cast<size_t>(p)].b;
-      // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
       if (!mayTouch(m_world.invMass[a], m_world.invMass[b], m_boxes[a], m_boxes[b])) continue;
       const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
+      const bool touchedBefore = touchedAtLastStep(a, b, key);
       // Two bodies that have not moved since the last step, and did not touch then, do not touch
       // now: the same polygons give the same answer. Most of a pack rests ahead of the vessel.
       // (A touching pair is always a candidate, whatever the broadphase, so "did not touch then"
       // is exactly "not among the last step's contacts".)
-      const bool touchedBefore = std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
       if (!m_moved[a] && !m_moved[b] && !touchedBefore) continue;
-      const Contact c =
-          computeContact(&m_worldVertices[static_cast<size_t>(a) * kMaxVertices], m_world.vertexCount[a], m_world.position(a),
-                         &m_worldVertices[static_cast<size_t>(b) * kMaxVertices], m_world.vertexCount[b], m_world.position(b));
+      const Vec2* pa = &m_worldVertices[static_cast<size_t>(a) * kMaxVertices];
+      const Vec2* pb = &m_worldVertices[static_cast<size_t>(b) * kMaxVertices];
+      const int na = m_world.vertexCount[a], nb = m_world.vertexCount[b];
+      if (!touchedBefore) {
+        // Apart last step, most likely apart now, and most likely along the same edge: try it
+        // first, then the others. An edge that separates is a "not touching" from computeContact
+        // (sat.hpp), so this only skips work, never changes an answer.
+        while (cached != m_lastSeparated.cend() && (cached->a < a || (cached->a == a && cached->b < b))) ++cached;
+        const bool hit = cached != m_lastSeparated.cend() && cached->a == a && cached->b == b;
+        SeparatingEdge axis = hit ? cached->axis : SeparatingEdge{-1, 0};
+        if (!separatesAlong(axis, pa, na, pb, nb)) axis = findSeparatingEdge(pa, na, pb, nb);
+        if (axis.side >= 0) {
+          part.separated.push_back(SeparatedPair{a, b, axis});
+          continue;
+        }
+      }
+      const Contact c = computeContact(pa, na, m_world.position(a), pb, nb, m_world.position(b));
       if (!c.touching) continue;
       part.a.push_back(a);
       part.b.push_back(b);
@@ -267,14 +302,42 @@ void CpuStepper::narrowphase() {
   m_contactB.clear();
   m_contacts.clear();
   m_currentContacts.clear();
+  m_separated.clear();
   for (const NarrowphasePart& part : m_parts) {
     m_contactA.insert(m_contactA.end(), part.a.begin(), part.a.end());
     m_contactB.insert(m_contactB.end(), part.b.begin(), part.b.end());
     m_contacts.insert(m_contacts.end(), part.contacts.begin(), part.contacts.end());
     m_currentContacts.insert(m_currentContacts.end(), part.keys.begin(), part.keys.end());
+    m_separated.insert(m_separated.end(), part.separated.begin(), part.separated.end());
   }
   std::sort(m_currentContacts.begin(), m_currentContacts.end());
   m_previousContacts.swap(m_currentContacts);
+  m_lastSeparated.swap(m_separated);
+  // Each slot's partners, for touchedAtLastStep: a counting sort of the contacts by slot.
+  m_lastSlotId.assign(m_world.id.begin(), m_world.id.end());
+  m_lastPartnerStart.assign(static_cast<size_t>(n) + 1, 0);
+  for (size_t k = 0; k < m_contactA.size(); ++k) ++m_lastPartnerStart[m_contactA[k] + 1], ++m_lastPartnerStart[m_contactB[k] + 1];
+  for (int i = 0; i < n; ++i) m_lastPartnerStart[i + 1] += m_lastPartnerStart[i];
+  m_lastPartnerId.resize(2 * m_contactA.size());
+  m_partnerFill.assign(m_lastPartnerStart.begin(), m_lastPartnerStart.end() - 1);
+  for (size_t k = 0; k < m_contactA.size(); ++k) {
+    const int a = m_contactA[k], b = m_contactB[k];
+    m_lastPartnerId[static_cast<size_t>(m_partnerFill[a]++)] = m_world.id[b];
+    m_lastPartnerId[static_cast<size_t>(m_partnerFill[b]++)] = m_world.id[a];
+  }
+}
+
+bool CpuStepper::touchedAtLastStep(int a, int b, std::pair<std::int64_t, std::int64_t> key) const {
+  // A slot that still holds the body it held then lists that body's partners, most often none or
+  // one or two. A slot whose body changed (a re-sort, a break) is not asked.
+  const int slots = static_cast<int>(m_lastSlotId.size());
+  for (const auto& [self, other] : {std::pair{a, b}, std::pair{b, a}}) {
+    if (self >= slots || m_lastSlotId[self] != m_world.id[self]) continue;
+    for (int k = m_lastPartnerStart[self]; k < m_lastPartnerStart[self + 1]; ++k)
+      if (m_lastPartnerId[static_cast<size_t>(k)] == m_world.id[other]) return true;
+    return false;
+  }
+  return std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
 }
 
 void CpuStepper::step() {

@@ -13,6 +13,7 @@
 #include "framework/scenario/scenario.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/world/world.hpp"
+#include "geometry/sat.hpp"
 
 namespace gem {
 
@@ -104,6 +105,19 @@ class CpuStepper final : public Stepper {
   std::vector<VelocityChange> m_changes;
   std::vector<MotionBody> m_motionBodies;
   std::vector<std::pair<std::int64_t, std::int64_t>> m_previousContacts, m_currentContacts;
+  // By slot, at the end of the last narrowphase: the id there and the ids it was in contact with
+  // (m_lastPartnerId[m_lastPartnerStart[i] ...]), so that a candidate learns whether it touched
+  // before from a list of one or two instead of a search of m_previousContacts.
+  std::vector<std::int64_t> m_lastSlotId, m_lastPartnerId;
+  std::vector<int> m_lastPartnerStart, m_partnerFill;
+  bool touchedAtLastStep(int a, int b, std::pair<std::int64_t, std::int64_t> key) const;
+  // The pairs whose polygons a full test found apart, in candidate order, with the edge that
+  // separated them: next step that edge is tried first (only ever to reject; sat.hpp).
+  struct SeparatedPair {
+    int a, b;
+    SeparatingEdge axis;
+  };
+  std::vector<SeparatedPair> m_lastSeparated, m_separated;
   // simulation.threads: the pool (null for one thread) and each task's share of the narrowphase,
   // joined in task order so that the contacts are in pair order whatever the thread count.
   std::unique_ptr<ThreadPool> m_pool;
@@ -112,6 +126,8 @@ class CpuStepper final : public Stepper {
     std::vector<int> a, b;
     std::vector<PairContact> contacts;
     std::vector<std::pair<std::int64_t, std::int64_t>> keys;
+    std::vector<SeparatedPair> separated;
+    std::vector<int> boxSurvivors;  // scratch: the candidates whose boxes overlap
   };
   std::vector<NarrowphasePart> m_parts;
   // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads; body(i) for
