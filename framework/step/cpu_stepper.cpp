@@ -171,6 +171,8 @@ void CpuStepper::restoreState(const StepperState& state) {
   // What was derived from the old world goes: every body's vertices are computed afresh (the same
   // poses give the same vertices), and the broadphase builds its lists from the new world.
   m_vertexPose.clear();
+  m_lastSlotId.clear();  // "touched before" then comes from state.touching
+  m_lastSeparated.clear();
   m_broadphase->invalidate();
   m_vesselId = -1;
   for (int i = 0; i < m_world.size(); ++i)
