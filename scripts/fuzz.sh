@@ -34,7 +34,7 @@ export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="print_stack
 log="$build/fuzz-$target.log"
 echo "fuzzing $target for $minutes min; log: $log"
 set +e
-"$build/tests/gem_fuzz_$target" -max_total_time=$((minutes * 60)) -timeout=20 -rss_limit_mb=4096 -print_final_stats=1 \
+"$build/tests/gem_fuzz_$target" -max_total_time=$((minutes * 60)) -timeout=60 -rss_limit_mb=4096 -print_final_stats=1 \
   -artifact_prefix="$artifacts/" "$corpus" > "$log" 2>&1
 status=$?
 set -e

@@ -14,54 +14,18 @@
 #include "framework/output/atomic_file.hpp"
 #include "framework/output/checkpoint.hpp"
 #include "framework/step/cpu_stepper.hpp"
+#include "run_compare.hpp"
 #include "test_support.hpp"
 
 using namespace gem;
 using gem::test::kBusyScene;
 using gem::test::readFile;
 using gem::test::TempDir;
+using namespace gem::test;
 
 namespace {
 
-std::string gemBinary() { return std::string(std::getenv("GEM_BINARY_DIR") ? std::getenv("GEM_BINARY_DIR") : GEM_BINARY_DIR) + "/gem"; }
-
-// Runs a shell script; returns its exit status (-1 when it did not exit).
-int shell(const std::string& script) {
-  const std::string command = "bash -c '" + script + "'";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-// The files a run folder holds (frames/ included), relative, sorted; gem.log and the plots aside.
-std::vector<std::string> filesOf(const std::filesystem::path& dir) {
-  std::vector<std::string> files;
-  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir))
-    if (entry.is_regular_file()) files.push_back(std::filesystem::relative(entry.path(), dir).string());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
-// Every output of `resumed` is byte for byte that of `whole`, summary.json but for the wall time.
-void expectSameRun(const std::filesystem::path& whole, const std::filesystem::path& resumed) {
-  const std::vector<std::string> files = filesOf(whole);
-  EXPECT_EQ(filesOf(resumed), files);
-  for (const std::string& f : files) {
-    // scenario.toml records the runs' own settings (output.checkpoint_every) and gem.log their commands.
-    if (f == "gem.log" || f == "summary.json" || f == ".gem-run.lock" || f == "scenario.toml") continue;
-    EXPECT_TRUE(readFile(whole / f) == readFile(resumed / f)) << f << " differs";
-  }
-  auto summary = readSummaryJson(whole / "summary.json"), again = readSummaryJson(resumed / "summary.json");
-  for (const char* key : {"wall_time_s", "real_time_factor"}) summary.erase(key), again.erase(key);
-  EXPECT_EQ(summary, again);
-}
-
 constexpr const char* kRunOptions = " --quiet --no-plots --steps 20000 --set output.frame_every=500";
-
-// A shell loop that waits (at most 30 s) until `file` exists: a signal is sent only once the run
-// has got that far, whatever the machine's speed.
-std::string waitFor(const std::filesystem::path& file) {
-  return "for i in $(seq 6000); do [ -e " + file.string() + " ] && break; sleep 0.005; done; ";
-}
 
 }  // namespace
 

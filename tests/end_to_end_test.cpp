@@ -22,6 +22,7 @@
 #include "framework/api/plugin_api.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/step/cpu_stepper.hpp"
+#include "run_compare.hpp"
 #include "test_support.hpp"
 
 using namespace gem;
@@ -485,61 +486,9 @@ TEST(GemRun, AScenarioInItsOwnRunFolderIsNotOverwritten) {
 // vessel's equals the time series' ice force magnitude when only the ice touches it.
 TEST(GemRun, FramesCarryEachBodysContactForce) {
   test::TempDir dir;
-  const auto scenario = dir.write("push.toml", R"(
-[simulation]
-dt = 0.1
-steps = 30
-[vessel]
-position = [-60.0, 0.0]
-open_water_speed = 5.0
-[[floes]]
-vertices = [[0.0, -3.0], [6.0, -3.0], [6.0, 3.0], [0.0, 3.0]]
-[[floes]]
-vertices = [[40.0, 20.0], [44.0, 20.0], [44.0, 24.0], [40.0, 24.0]]
-[events.flexural_breaking]
-enabled = false  # a floe split after the gather has new ids, whose force the frame cannot carry
-[output]
-frame_every = 1
-formats = ["vtk"]
-)");
+  const auto scenario = dir.write("push.toml", test::kContactForceScene);
   const auto out = dir.path() / "out";
   ASSERT_EQ(test::runGem("run " + scenario.string() + " --quiet --no-plots --out " + out.string(), dir.path() / "log"), 0)
       << test::readFile(dir.path() / "log");
-  double far = 0;
-  int framesOneOnOne = 0, framesWithContact = 0;
-  for (int f = 1; f <= 30; ++f) {
-    pugi::xml_document vtp;
-    ASSERT_TRUE(vtp.load_file((out / "frames" / fmt::format("frame_{:06d}.vtp", f)).c_str()));
-    pugi::xml_node cells = vtp.child("VTKFile").child("PolyData").child("Piece").child("CellData");
-    auto values = [&](const char* name) {
-      std::istringstream in(cells.find_child_by_attribute("DataArray", "Name", name).text().get());
-      std::vector<double> v;
-      for (double x; in >> x;) v.push_back(x);
-      return v;
-    };
-    const std::vector<double> areas = values("area"), kinds = values("kind"), force = values("contact_force");
-    ASSERT_EQ(force.size(), areas.size());
-    double vessel = 0, floes = 0;
-    int touching = 0;
-    for (size_t i = 0; i < areas.size(); ++i) {
-      if (kinds[i] == 1) {
-        vessel = force[i];
-      } else if (std::abs(areas[i] - 16.0) < 1e-9) {  // the 4 m x 4 m floe far off the vessel's path
-        far = std::max(far, force[i]);
-      } else {
-        floes += force[i];
-        touching += force[i] > 0;
-      }
-    }
-    framesWithContact += vessel > 0;
-    EXPECT_LE(vessel, floes * (1 + 1e-9) + 1e-9) << "frame " << f;  // |sum| <= sum of magnitudes
-    // One floe (or piece) on the vessel alone: the pair's two sides, equal and opposite.
-    if (touching == 1 && vessel > 0) {
-      ++framesOneOnOne;
-      EXPECT_NEAR(vessel, floes, 1e-9 * floes) << "frame " << f;
-    }
-  }
-  EXPECT_GT(framesWithContact, 0);
-  EXPECT_GT(framesOneOnOne, 0);
-  EXPECT_EQ(far, 0);
+  test::expectContactForcesInFrames(out);
 }

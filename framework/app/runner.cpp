@@ -487,7 +487,7 @@ RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const s
       run.record(k);
       stepsRun = k + 1;
       const char* stop = run.stopRuleReached();
-      if (!stop && run.checkpointDue(stepsRun, wallSeconds())) run.saveCheckpoint(wallSeconds());
+      if (!stop && sim.stateOnHost() && run.checkpointDue(stepsRun, wallSeconds())) run.saveCheckpoint(wallSeconds());
       if (options.progress && !options.quiet) {
         const auto now = std::chrono::steady_clock::now();
         if (now - lastProgress > std::chrono::milliseconds(250) || k + 1 == scenario.steps || stop) {
@@ -506,8 +506,15 @@ RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const s
     }
   } catch (const Interrupted& e) {
     // Ctrl-C or SIGTERM between two steps: a checkpoint of the steps run (gem run --resume goes
-    // on from it), every file closed whole, and a summary that says it is not the whole run.
+    // on from it), every file closed whole, and a summary that says it is not the whole run. A
+    // device backend has its state on the host only between copy-back batches: the steps it has
+    // already run (copy_back_every at most) are recorded first, so that every file stops at one step.
     try {
+      while (!sim.stateOnHost() && stepsRun < scenario.steps) {
+        sim.step();
+        run.record(stepsRun);
+        ++stepsRun;
+      }
       run.saveCheckpoint(wallSeconds());
     } catch (const std::exception& failed) {
       std::fprintf(stderr, "gem: no checkpoint written: %s\n", failed.what());

@@ -85,24 +85,26 @@ __device__ inline bool overlapOfPair(int a, int b, const Vec2* worldVertices, co
 // k's a then b, and a body's contacts as b, which all have a < it, come before its contacts as a),
 // then the motion events' view of it. asB(q), q < countB: its contacts as b, in contact order;
 // [firstA, endA): its contacts as a. No atomics: the same sums in the same order on every driver.
+// onBody: the sum of its contact impulses (N s), as the CPU sums it (the frames' contact_force).
 template <class ContactsAsB>
 __device__ inline MotionBody gatherBody(const PairBody& b, VelocityChange total, ContactsAsB asB, int countB, int firstA, int endA,
-                                        const PairContact* contacts, const PairSlot* slots, bool isVessel, Vec2* vesselImpulse) {
-  Vec2 onVessel{0, 0};
+                                        const PairContact* contacts, const PairSlot* slots, bool isVessel, Vec2* vesselImpulse,
+                                        Vec2& onBody) {
+  onBody = Vec2{0, 0};
   for (int q = 0; q < countB; ++q) {
     const int k = asB(q);
     const Vec2 j = slots[k].impulse;
     if (j.x == 0 && j.y == 0) continue;
-    if (isVessel) onVessel += j;
+    onBody += j;
     addContactImpulse(b, j, contacts[k].geometry.point, total);
   }
   for (int k = firstA; k < endA; ++k) {
     const Vec2 j = slots[k].impulse;
     if (j.x == 0 && j.y == 0) continue;
-    if (isVessel) onVessel += -j;
+    onBody += -j;
     addContactImpulse(b, -j, contacts[k].geometry.point, total);
   }
-  if (isVessel) *vesselImpulse = onVessel;
+  if (isVessel) *vesselImpulse = onBody;
   return MotionBody{b.kind, b.dof, b.position, b.angle, b.velocity + total.dv, b.omega + total.domega};
 }
 

@@ -175,6 +175,41 @@ void enqueueCommitContacts(DeviceState& d) {
   GEM_CUDA_CHECK_LAUNCH();
 }
 
+std::vector<std::pair<std::int64_t, std::int64_t>> DeviceStep::touchingPairs() const {
+  const DeviceState& d = *m_state;
+  if (d.worlds != 1) throw std::logic_error("DeviceStep::touchingPairs: one world only");
+  std::vector<unsigned long long> keys;
+  int bits = 32;
+  if (d.resident) {
+    keys = residentPreviousKeys(d);
+  } else {
+    keys.resize(static_cast<size_t>(d.h_stats->previousContacts));  // the batch's end copied the stats
+    d.previousKeys.download(keys.data(), keys.size());
+    bits = d.idBits;
+  }
+  std::vector<std::pair<std::int64_t, std::int64_t>> pairs;
+  pairs.reserve(keys.size());
+  for (const unsigned long long key : keys)
+    pairs.emplace_back(static_cast<std::int64_t>(key >> bits), static_cast<std::int64_t>(key & ((1ull << bits) - 1)));
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+void DeviceStep::setTouchingPairs(const std::vector<std::pair<std::int64_t, std::int64_t>>& pairs) {
+  DeviceState& d = *m_state;
+  if (d.worlds != 1) throw std::logic_error("DeviceStep::setTouchingPairs: one world only");
+  const int bits = d.resident ? 32 : d.idBits;  // d.idBits: set by the upload
+  std::vector<unsigned long long> keys;
+  for (const auto& [lo, hi] : pairs) keys.push_back((static_cast<unsigned long long>(lo) << bits) | static_cast<unsigned long long>(hi));
+  std::sort(keys.begin(), keys.end());
+  if (d.resident) return setResidentPreviousKeys(d, std::move(keys));
+  const int count = static_cast<int>(keys.size());
+  d.previousKeys.ensure(std::max<size_t>(keys.size(), 1));
+  d.previousKeys.uploadAt(0, keys.data(), keys.size());
+  d.h_stats->previousContacts = count;
+  GEM_CUDA_CHECK(cudaMemcpy(&d.stats.get()->previousContacts, &count, sizeof count, cudaMemcpyHostToDevice));
+}
+
 void rekeyContacts(DeviceState& d, int newBits) {
   rekeyKernel<<<blocksFor(d.capacity), kBlock, 0, d.stream>>>(d.previousKeys.get(), d.stats.get(), d.idBits, newBits);
   GEM_CUDA_CHECK_LAUNCH();

@@ -294,7 +294,7 @@ void CudaBatch::ensureStep(long step) {
 }
 
 // Up to copy_back_every steps, ending where the host needs the state: the next frame, the next
-// re-sort along the curve (every kResortPeriod steps), the scenario's last step.
+// re-sort along the curve (every kResortPeriod steps), the next checkpoint, the scenario's last step.
 void CudaBatch::runBatch(long step) {
   const Scenario& s = m_members.front()->scenario();
   // Alone on its device, a batch is copy_back_every steps in one launch. Sharing it (a sweep's
@@ -308,6 +308,7 @@ void CudaBatch::runBatch(long step) {
   };
   if (s.output.frameEvery > 0) stopAtMultipleOf(s.output.frameEvery);
   if (s.mortonSort) stopAtMultipleOf(kResortPeriod);
+  stopAtMultipleOf(s.output.checkpointEverySteps);  // a checkpoint needs the state on the host
   if (step < s.steps) end = std::min(end, s.steps);
   Stopwatch clock;
   m_device->run(step, s.dt, static_cast<int>(end - step), *m_result);

@@ -154,6 +154,48 @@ std::vector<std::unique_ptr<CudaStepper>> CudaStepper::together(const std::vecto
 
 CudaStepper::~CudaStepper() = default;
 
+const std::vector<std::pair<std::int64_t, Real>>* CudaStepper::contactForces() const {
+  if (m_batch->worlds() > 1 || deviceAhead()) return nullptr;
+  const World& w = m_cpu->world();  // its ids (the order does not matter here)
+  const std::vector<Real> impulses = m_batch->device().contactImpulsesById(w.nextId);
+  m_contactForces.clear();
+  for (int i = 0; i < w.size(); ++i) {
+    const Real force = impulses[static_cast<size_t>(w.id[i])] / m_cpu->scenario().dt;  // as the CPU: |impulse| / dt
+    if (force > 0) m_contactForces.emplace_back(w.id[i], force);
+  }
+  std::sort(m_contactForces.begin(), m_contactForces.end());
+  return &m_contactForces;
+}
+
+StepperState CudaStepper::saveState() {
+  if (m_batch->worlds() > 1) throw BackendUnsupported("cases run together on one device write no checkpoint");
+  StepperState state;
+  state.world = hostWorld();  // between batches: the device's state at step m_step
+  state.step = m_step;
+  state.time = m_time;
+  state.touching = m_batch->device().touchingPairs();
+  state.rubbleMass = m_rubbleMass;
+  state.floesBroken = m_floesBroken;
+  return state;
+}
+
+void CudaStepper::restoreState(const StepperState& state) {
+  if (m_batch->worlds() > 1) throw BackendUnsupported("cases run together on one device do not resume from a checkpoint");
+  if (m_step != 0) throw std::logic_error("CudaStepper::restoreState: for a stepper that has not stepped");
+  m_cpu->restoreState(state);  // the host mirror
+  m_step = m_taken = state.step;
+  m_time = state.time;
+  m_rubbleMass = state.rubbleMass;
+  m_floesBroken = state.floesBroken;
+  m_pendingOrder.clear();
+  m_slotOfId.clear();
+  m_hostCurrent = true;
+  // A device state made from the restored mirror, as the constructor made one from the scenario's.
+  m_batch.reset();
+  m_batch = std::make_shared<CudaBatch>(std::vector<CudaStepper*>{this}, m_deviceOrdinal);
+  m_batch->device().setTouchingPairs(state.touching);
+}
+
 void CudaStepper::locateVessel() {
   const World& w = world();
   m_vesselSlot = -1;

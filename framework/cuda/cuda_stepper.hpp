@@ -62,6 +62,13 @@ class CudaStepper final : public Stepper {
   double deviceSeconds() const override;
   int candidateCount() const { return m_candidateCount; }  // over the whole device state
   int casesOnDevice() const;                               // 1 alone, the batch's size when run together
+  // Checkpoints, alone on a device state only; the state is on the host between copy-back batches.
+  bool stateOnHost() const override { return !deviceAhead(); }
+  // Each body's contact force over the last step, alone on a device state and between batches
+  // (frames are); null otherwise.
+  const std::vector<std::pair<std::int64_t, Real>>* contactForces() const override;
+  StepperState saveState() override;
+  void restoreState(const StepperState& state) override;
   // Rebuilds of the device broadphase's kept list (0 for one that keeps none): reads the device.
   long broadphaseRebuilds() const;
   // Tests, alone only: run the topology phase through a whole-world round trip (download, edit,
@@ -110,6 +117,7 @@ class CudaStepper final : public Stepper {
   VesselSample m_vessel{false, {0, 0}, 0, {0, 0}};
   double m_rubbleMass = 0;
   long m_floesBroken = 0;
+  mutable std::vector<std::pair<std::int64_t, Real>> m_contactForces;  // contactForces()' answer
 };
 
 // True when the CUDA runtime sees at least one device (never throws).

@@ -66,6 +66,11 @@ void sizeForBodies(DeviceState& d, std::int64_t nextId) {
     d.idBits = newBits;
   }
 
+  // Room for every id, the earlier values kept and the new ones 0 (a body's value before its first step).
+  const size_t kept = d.contactImpulseOfId.capacity();
+  if (d.contactImpulseOfId.ensureKeeping(static_cast<size_t>(std::max<std::int64_t>(nextId, 1)), kept) || kept == 0)
+    GEM_CUDA_CHECK(cudaMemset(d.contactImpulseOfId.get() + kept, 0, (d.contactImpulseOfId.capacity() - kept) * sizeof(Real)));
+
   const size_t nn = std::max(n, 1);
   d.worldVertices.ensure(nn * kMaxVertices);
   d.boxes.ensure(nn), d.pairBodies.ensure(nn), d.soloBodies.ensure(nn), d.changes.ensure(nn), d.motionBodies.ensure(nn);
@@ -82,6 +87,12 @@ void sizeForBodies(DeviceState& d, std::int64_t nextId) {
 }
 
 int DeviceStep::worlds() const { return m_state->worlds; }
+
+std::vector<Real> DeviceStep::contactImpulsesById(std::int64_t nextId) const {
+  std::vector<Real> impulses(static_cast<size_t>(nextId));
+  m_state->contactImpulseOfId.download(impulses.data(), impulses.size());
+  return impulses;
+}
 const std::vector<int>& DeviceStep::worldOfSlots() const { return m_state->worldHost; }
 
 // Each world's vessel slot, to the device.

@@ -76,6 +76,9 @@ struct DeviceState {
   std::vector<int> vesselHost{-1};
   GraphArray<int> vessel;
   GraphArray<WorldStepRecord> worldStats;  // this step's, per world
+  // One world: each body's |sum of its contact impulses| over the last step, N s, by id (ids are
+  // dense), for the frames' contact_force; 0 for a body without contact.
+  GraphArray<Real> contactImpulseOfId;
   Real cell = 1;
   Real cellSetting = 0;  // uniform_grid's cell_size (0: twice the largest floe radius)
   unsigned tableSize = 64;
@@ -193,5 +196,9 @@ inline int bitsFor(unsigned long long v) {
 void sizeForBodies(DeviceState& d, std::int64_t nextId);
 // Each world's vessel slot, to the device (device_state.cu).
 void uploadVessels(DeviceState& d);
+// The resident driver's contact keys of the last step, (lo << 32) | hi, sorted (world 0), and the
+// same set before its next launch (resident.cu; checkpoints).
+std::vector<unsigned long long> residentPreviousKeys(const DeviceState& d);
+void setResidentPreviousKeys(DeviceState& d, std::vector<unsigned long long> keys);
 
 }  // namespace gem::cuda

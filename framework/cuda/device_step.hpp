@@ -112,6 +112,13 @@ class DeviceStep {
   // copies their results off. Stops early after a step that asked for a break (the host's topology
   // phase comes next). A step that overflowed a buffer is redone, bit-identically, with more room.
   void run(long firstStep, Real dt, int steps, DeviceBatchResult& result);
+  // One world: each body's |sum of its contact impulses| over the last step (N s), by id, ids
+  // [0, nextId) (0 for a body without contact, or gone).
+  std::vector<Real> contactImpulsesById(std::int64_t nextId) const;
+  // Checkpoints (one world only): the id pairs in contact after the last step, lower id first,
+  // sorted (a contact's onset compares against them), and the same set on a state just uploaded.
+  std::vector<std::pair<std::int64_t, std::int64_t>> touchingPairs() const;
+  void setTouchingPairs(const std::vector<std::pair<std::int64_t, std::int64_t>>& pairs);
   // Step graphs captured and instantiated so far, and the host's seconds for them (a change of
   // the body count, a topology edit, makes the next batch capture anew).
   std::pair<long, double> captures() const;

@@ -27,7 +27,8 @@ __device__ inline int lowerBound(const int* v, int n, int x) {
 // capacity finds only real contacts.
 __global__ void gatherKernel(int n, const int* world, const int* vesselSlot, const PairBody* bodies, const VelocityChange* changes,
                              int capacity, const int* contactA, const int* bKeySorted, const int* bIndexSorted, const PairContact* contacts,
-                             const PairSlot* slots, MotionBody* motion, WorldStepRecord* worldStats) {
+                             const PairSlot* slots, MotionBody* motion, WorldStepRecord* worldStats, const std::int64_t* id,
+                             Real* impulseOfId) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   const bool isVessel = i == vesselSlot[world[i]];
@@ -37,9 +38,11 @@ __global__ void gatherKernel(int n, const int* world, const int* vesselSlot, con
   const int firstA = lowerBound(contactA, capacity, i);
   int endA = firstA;
   while (endA < capacity && contactA[endA] == i) ++endA;
+  Vec2 onBody;
   motion[i] = gatherBody(
       bodies[i], changes[i], [&](int q) { return bIndexSorted[firstB + q]; }, endB - firstB, firstA, endA, contacts, slots, isVessel,
-      &worldStats[world[i]].vesselImpulse);
+      &worldStats[world[i]].vesselImpulse, onBody);
+  if (impulseOfId) impulseOfId[id[i]] = norm(onBody);
 }
 
 // The only write of the state; skipped when the step overflowed, so it can simply be run again.
@@ -58,7 +61,8 @@ void enqueueGather(DeviceState& d) {
   const int n = d.n, capacity = d.capacity, block = d.block;
   gatherKernel<<<blocksFor(n, block), block, 0, s>>>(n, d.world.get(), d.vessel.get(), d.pairBodies.get(), d.changes.get(), capacity,
                                                      d.contactA.get(), d.bKeySorted.get(), d.bIndexSorted.get(), d.contacts.get(),
-                                                     d.slots.get(), d.motionBodies.get(), d.worldStats.get());
+                                                     d.slots.get(), d.motionBodies.get(), d.worldStats.get(), d.id.get(),
+                                                     d.worlds == 1 ? d.contactImpulseOfId.get() : nullptr);
   GEM_CUDA_CHECK_LAUNCH();
 }
 

@@ -37,6 +37,9 @@ struct ResidentState {
   DeviceArray<ResidentControl> control{1};
   ResidentControl* h_control = nullptr;  // pinned
   DeviceArray<int> recordCount{kMaxRecordStreams};
+  // A checkpoint's contact keys (world 0), set into previous before the next launch.
+  bool previousPending = false;
+  std::vector<unsigned long long> pendingPrevious;
   long long phaseCycles[kResidentPhases] = {};  // block 0's, over every launch (GEM_CUDA_TIMING=1 prints them)
   long launches = 0, steps = 0;
   ResidentState() { GEM_CUDA_CHECK(cudaMallocHost(&h_control, sizeof(ResidentControl))); }
@@ -132,10 +135,33 @@ void DeviceStep::useResident(const ResidentProgram& program, const std::vector<u
 
 bool DeviceStep::resident() const { return m_state->resident != nullptr; }
 
+std::vector<unsigned long long> residentPreviousKeys(const DeviceState& d) {
+  const ResidentState& r = *d.resident;
+  if (r.previousPending) return r.pendingPrevious;
+  if (r.capacity == 0) return {};  // no launch yet: no contact
+  int count = 0;
+  r.previousCount.download(&count, 1);
+  std::vector<unsigned long long> keys(static_cast<size_t>(count));
+  r.previous.download(keys.data(), keys.size());
+  return keys;
+}
+
+void setResidentPreviousKeys(DeviceState& d, std::vector<unsigned long long> keys) {
+  d.resident->pendingPrevious = std::move(keys);
+  d.resident->previousPending = true;
+}
+
 void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatchResult& result) {
   ResidentState& r = *d.resident;
   if (!r.membersBuilt || r.worldOfMembers != d.worldHost) buildMembers(d, r);
   if (r.capacity == 0) sizeScratch(d, r, r.startCapacity > 0 ? r.startCapacity : 4 * r.mostBodies + 256);
+  if (r.previousPending) {
+    const int count = static_cast<int>(r.pendingPrevious.size());
+    if (count > r.capacity) sizeScratch(d, r, count + count / 2 + 256);
+    r.previous.uploadAt(0, r.pendingPrevious.data(), r.pendingPrevious.size());
+    r.previousCount.uploadAt(0, &count, 1);
+    r.previousPending = false;
+  }
   // Records of a whole launch: room for a row per pair at first; a launch that fills a buffer
   // stops there, and a single step that passes one grows them all.
   d.recordCapacity = std::max(d.recordCapacity, r.capacity);
@@ -165,6 +191,7 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     a.x = d.x.get(), a.y = d.y.get(), a.angle = d.angle.get(), a.vx = d.vx.get(), a.vy = d.vy.get(), a.omega = d.omega.get();
     a.vessel = d.vessel.get();
     a.motion = d.motionBodies.get();
+    a.impulseOfId = d.worlds == 1 ? d.contactImpulseOfId.get() : nullptr;
     a.members = r.members.get(), a.memberBegin = r.memberBegin.get(), a.worlds = d.worlds;
     a.capacity = r.capacity, a.capacitySort = r.capacitySort, a.bodySort = r.bodySort;
     a.sweepKeys = r.sweepKeys.get(), a.pairKeys = r.pairKeys.get(), a.idKeys = r.idKeys.get(), a.bKeys = r.bKeys.get();

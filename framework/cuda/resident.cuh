@@ -68,6 +68,7 @@ struct ResidentArgs {
   Real *x, *y, *angle, *vx, *vy, *omega;
   const int* vessel;  // per world: its vessel's slot, -1 none
   MotionBody* motion;
+  Real* impulseOfId;  // one world: |its contact impulses| by body id (the frames' contact_force); else null
   // Worlds: world w's bodies are members[memberBegin[w] .. memberBegin[w + 1]), ascending slots.
   const int *members, *memberBegin;
   int worlds;

@@ -423,9 +423,11 @@ __device__ void secondHalf(const ResidentArgs& a, int w, int contacts, const Ste
     const int firstA = lowerBoundOf(s.contactA, contacts, slot);
     int endA = firstA;
     while (endA < contacts && s.contactA[endA] == slot) ++endA;
+    Vec2 onBody;
     MotionBody body = gatherBody(
         p.pairBodies[slot], p.changes[slot], [&](int q) { return static_cast<int>(s.bs[firstB + q] & 0xffffffffu); }, endB - firstB, firstA,
-        endA, s.contacts, s.slots, isVessel, &record.vesselImpulse);
+        endA, s.contacts, s.slots, isVessel, &record.vesselImpulse, onBody);
+    if (a.impulseOfId) a.impulseOfId[p.pairBodies[slot].id] = norm(onBody);
     for (int e = 0; e < a.program.motionCount; ++e)
       Events::visit(a.program.motion[e].kind, MotionCall{row, a.program.motion[e].paramsOffset, body, ctx});
     a.motion[slot] = body;

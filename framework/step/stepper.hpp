@@ -68,6 +68,9 @@ class Stepper {
   virtual const std::vector<std::pair<std::int64_t, Real>>* contactForces() const { return nullptr; }
   // Checkpoints: the state after the last step, and a stepper just made from the same scenario set
   // to one. A backend that cannot (a case stepped together with others) throws BackendUnsupported.
+  // Whether the state after the last step is on the host now (a device backend's is only between
+  // two copy-back batches): a checkpoint is written then.
+  virtual bool stateOnHost() const { return true; }
   virtual StepperState saveState();
   virtual void restoreState(const StepperState& state);
 };
