@@ -520,6 +520,7 @@ RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const s
       std::fprintf(stderr, "gem: no checkpoint written: %s\n", failed.what());
     }
     run.finish(wallSeconds(), stepsRun, signalName(e.signal()), false);
+    stopIfInterrupted(stepsRun);  // its message names the step the files stop at
     throw;
   } catch (...) {
     run.abandon();
