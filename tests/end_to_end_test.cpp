@@ -107,9 +107,9 @@ TEST(GemRun, WritesEveryOutputOfTheContract) {
   TempDir dir;
   const auto scenario = dir.write("busy.toml", kBusyScene);
   const auto out = dir.path() / "run";
-  const int status = test::runGem(
-      "run " + scenario.string() + " --steps 60 --out " + out.string() + " --set output.frame_every=20 --broadphase uniform_grid",
-      dir.path() / "log.txt");
+  const int status = test::runGem("run " + scenario.string() + " --steps 60 --backend cpu --out " + out.string() +
+                                      " --set output.frame_every=20 --broadphase uniform_grid",
+                                  dir.path() / "log.txt");
   const std::string log = test::readFile(dir.path() / "log.txt");
   ASSERT_EQ(status, 0) << log;
   EXPECT_NE(log.find("real time"), std::string::npos);

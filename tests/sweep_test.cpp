@@ -389,7 +389,7 @@ INSTANTIATE_TEST_SUITE_P(
                        }
                        return lists;
                      }(),
-                 {"bad_sweep.toml:4:", "1e+09 cases", "at most 1000000"}},
+                 {"bad_sweep.toml:4:", "1e+09 cases", "at most 100000"}},
         BadSweep{"varied_in_set_and_parameters",
                  "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n[[cases]]\nname = \"a\"\nset = { "
                  "vessel.bollard_thrust = 2.0 }\n",

@@ -191,6 +191,12 @@ inline int bitsFor(unsigned long long v) {
   return bits;
 }
 
+// The host's plain cudaMemcpy and cudaMemset calls (uploads, a regrowth that keeps its contents)
+// go to the legacy default stream, and a host-to-device copy or a memset may return before the
+// device has done it; the simulation's stream is non-blocking, so nothing orders its work after
+// them. Called before work is enqueued on d.stream: that work then sees every upload whole.
+inline void awaitHostCopies() { GEM_CUDA_CHECK(cudaStreamSynchronize(cudaStreamLegacy)); }
+
 // Everything that follows from n and the ids: the hash table, the key widths, the per-step buffers
 // (device_state.cu).
 void sizeForBodies(DeviceState& d, std::int64_t nextId);

@@ -123,6 +123,7 @@ std::vector<int> DeviceStep::reorderAlongCurve(bool* broadphaseFollowed) {
   // Each world's centroid box: exact (min and max round nothing), as the host's loop.
   GraphArray<unsigned long long>& bounds = d.resortBounds;
   bounds.ensure(4 * static_cast<size_t>(d.worlds));
+  awaitHostCopies();
   curveBoundsInitKernel<<<blocksFor(4 * d.worlds), kBlock, 0, s>>>(d.worlds, bounds.get());
   GEM_CUDA_CHECK_LAUNCH();
   curveBoundsKernel<<<blocksFor(n), kBlock, 0, s>>>(n, d.x.get(), d.y.get(), d.world.get(), bounds.get());
@@ -180,6 +181,7 @@ void DeviceStep::downloadKinematics(const std::vector<int>& deviceSlots, const s
   GraphArray<Real>& rows = d.fetchRows;
   slots.upload(deviceSlots.data(), deviceSlots.size());
   rows.ensure(6 * deviceSlots.size());
+  awaitHostCopies();  // slots: the kernel's indices
   gatherKinematicsKernel<<<blocksFor(count), kBlock, 0, d.stream>>>(count, slots.get(), d.x.get(), d.y.get(), d.angle.get(), d.vx.get(),
                                                                     d.vy.get(), d.omega.get(), rows.get());
   GEM_CUDA_CHECK_LAUNCH();
@@ -210,6 +212,7 @@ bool DeviceStep::editBodies(const std::vector<int>& removedSlots, const World& f
   removed.ensure(std::max<size_t>(removedSlots.size(), 1));
   removed.uploadAt(0, removedSlots.data(), removedSlots.size());
   order.ensure(static_cast<size_t>(std::max(kept, 1)));
+  awaitHostCopies();  // removed: read by the kernel below
   keptOrderKernel<<<blocksFor(before), kBlock, 0, s>>>(before, removed.get(), removedCount, order.get());
   GEM_CUDA_CHECK_LAUNCH();
   const int* o = order.get();
@@ -278,6 +281,7 @@ bool DeviceStep::editBodies(const std::vector<int>& removedSlots, const World& f
   d.n = n;
   sizeForBodies(d, from.nextId);
   // A strategy's per-body storage follows the edit on the device, or (false) the caller uploads it.
+  awaitHostCopies();  // the new bodies' rows, which the strategy's kernels read
   const bool followed = !d.broadphase || d.broadphase->edited(o, kept, from, firstAdded, s);
   d.dropGraph();  // n changed: the graph's launches were sized for the old count
   return followed;

@@ -180,6 +180,7 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     const char* v = std::getenv("GEM_RESIDENT_CLIP_LANES");
     return std::clamp(v ? std::atoi(v) : kResidentClipLanes, 1, 32);
   }();
+  awaitHostCopies();  // members, params, the kept pairs: read by the launches below
   long next = firstStep;
   int remaining = steps;
   while (remaining > 0) {

@@ -329,6 +329,7 @@ void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& resu
   while (remaining > 0) {
     *d.h_control = BatchControl{next, dt, std::min(remaining, d.ringSize)};
     if (!useGraph) {
+      awaitHostCopies();
       runBatchUncaptured(d);
     } else {
       if (!d.graph) {
@@ -337,6 +338,7 @@ void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& resu
         ++d.captures;
         d.captureSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       }
+      awaitHostCopies();  // the capture's sizing too (previousKeys.ensureKeeping copies on the device)
       GEM_CUDA_CHECK(cudaGraphLaunch(d.graph, d.stream));
     }
     GEM_CUDA_CHECK(cudaStreamSynchronize(d.stream));

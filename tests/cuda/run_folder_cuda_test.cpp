@@ -7,8 +7,8 @@
 
 #include "cuda_test_support.hpp"
 #include "framework/output/checkpoint.hpp"
-#include "run_compare.hpp"
-#include "test_support.hpp"
+#include "../run_compare.hpp"
+#include "../test_support.hpp"
 
 using namespace gem;
 using namespace gem::test;
