@@ -386,8 +386,6 @@ class ScenarioRun {
     in.get(m_speed), in.get(m_netThrust), in.get(m_speedInIce), in.get(m_netThrustInIce);
     in.get(m_fieldLow), in.get(m_fieldHigh), in.get(m_vesselReach), in.get(m_reachedField), in.get(m_lastVesselPosition);
     in.get(m_travelled);
-    // What the stopped run wrote at its end (summary, state, plots) describes a run that is not over.
-    clearRunEnd(m_dir);
     const std::filesystem::path timeseries = m_dir / "timeseries.csv";
     const auto timeseriesTemp = in.get<std::string>();
     m_timeseries = std::make_unique<AtomicFile>(timeseries, earlierTempPath(timeseries, timeseriesTemp), in.get<std::uint64_t>());
@@ -412,6 +410,9 @@ class ScenarioRun {
     if (in.get<bool>()) m_vtk = std::make_unique<VtkSeriesWriter>(m_dir, m_scenario.output.vtkBinary, in);
     if (in.get<bool>()) m_ice = std::make_unique<IceFileWriter>(m_dir / "frames.ice", in);
     if (!in.atEnd()) throw InputError(name + ": damaged (bytes past its end)");
+    // What the stopped run wrote at its end (summary, state, plots) describes a run that is not
+    // over: gone, once the resume is sure to go ahead.
+    clearRunEnd(m_dir);
   }
 
   // scenario.toml as the run folder holds it (a checkpoint belongs to that text).
