@@ -15,11 +15,14 @@
 namespace fs = std::filesystem;
 using namespace gem;
 
+// On the CPU, where the cases run one at a time in the file's order (--jobs 1): on a GPU the three
+// 5-step cases would run together in one device state, "never" among them.
 TEST(SweepInterrupt, StopsTheRunningCaseWholeAndGathersTheCompleteOnes) {
   test::TempDir dir;
   dir.write("base.toml", test::kTinyChannel);
   const fs::path file = dir.write("study.toml", R"([sweep]
 base = "base.toml"
+set = { "simulation.backend" = "cpu" }
 [[cases]]
 name = "short_a"
 set = { "simulation.steps" = 5 }

@@ -521,3 +521,39 @@ TEST(Sweep, CasesRunTogetherWriteTheOutputsOfSingleRuns) {
     EXPECT_EQ(readSummaryJson(dir.path() / "refused" / "cases" / name / "summary.json").at("cases_on_device"), "1");
   }
 }
+
+// A case whose world cannot be built, in a unit of cases that run together, fails alone as it
+// would in a run of its own: the others still run together and are gathered (a device sweep once
+// failed the whole unit with that one case's message).
+TEST(Sweep, ACaseThatCannotBeBuiltFailsAloneAndTheOthersStillRunTogether) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("study.toml", R"([sweep]
+base = "base.toml"
+set = { "simulation.steps" = 10, "simulation.backend" = "cuda" }
+[[cases]]
+name = "good"
+[[cases]]
+name = "bad"
+set = { floes = [{ vertices = [[-20.0, -2.0], [-10.0, -2.0], [-10.0, 2.0], [-20.0, 2.0]] }] }
+[[cases]]
+name = "also_good"
+set = { "vessel.bollard_thrust" = 46e3 }
+)");
+  TogetherBackend backend;
+  SweepOptions o;
+  o.sweepFile = file.string();
+  o.outDir = (dir.path() / "out").string();
+  o.jobs = 1;
+  o.quiet = true;
+  EXPECT_EQ(runSweep(o), 1);
+  ASSERT_EQ(backend.batches.size(), 1u);
+  EXPECT_EQ(backend.batches[0]->members.size(), 2u);
+  EXPECT_FALSE(backend.batches[0]->outOfStep);
+  const auto csv = lines(dir.path() / "out" / "summary.csv");
+  ASSERT_EQ(csv.size(), 3u);
+  EXPECT_EQ(csvCells(csv[1])[0], "good");
+  EXPECT_EQ(csvCells(csv[2])[0], "also_good");
+  EXPECT_FALSE(fs::exists(dir.path() / "out" / "cases" / "bad" / "summary.json"));
+  EXPECT_EQ(readSummaryJson(dir.path() / "out" / "cases" / "good" / "summary.json").at("cases_on_device"), "2");
+}

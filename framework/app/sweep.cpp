@@ -24,6 +24,7 @@
 #include "framework/app/interrupt.hpp"
 #include "framework/app/runner.hpp"
 #include "framework/scenario/scenario.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/scenario/sweep_file.hpp"
 #include "framework/analysis/sweep_summary.hpp"
@@ -341,6 +342,8 @@ int runSweep(const SweepOptions& options) {
           state.together[k] = static_cast<double>(unit.size()) * static_cast<double>(step) / static_cast<double>(std::max(steps, 1L));
         };
         std::vector<std::unique_ptr<Stepper>> steppers;
+        std::vector<size_t> members(unit.size());  // the unit's cases that step together (indices into unit)
+        for (size_t j = 0; j < unit.size(); ++j) members[j] = j;
         try {
           steppers = backend->makeTogether(pointers);
         } catch (const BackendUnsupported& e) {
@@ -351,8 +354,23 @@ int runSweep(const SweepOptions& options) {
           runOptions.quiet = true;
           for (size_t j = 0; j < unit.size(); ++j) failures[j] = message([&] { runScenario(scenarios[j], runOptions); });
           return;
+        } catch (const std::exception&) {
+          // A case whose world cannot be built (a floe on the vessel, say) fails with its own
+          // message, as it would alone, and the others still run together. Only a failure that is
+          // no one case's fails them all.
+          std::vector<const Scenario*> buildable;
+          members.clear();
+          for (size_t j = 0; j < unit.size(); ++j) {
+            failures[j] = message([&] { buildWorld(scenarios[j]); });
+            if (failures[j].empty()) members.push_back(j), buildable.push_back(pointers[j]);
+          }
+          if (members.size() == unit.size()) throw;
+          if (members.empty()) return;
+          pointers = std::move(buildable);
+          steppers = backend->makeTogether(pointers);
         }
-        failures = runScenariosTogether(pointers, std::move(steppers), progress);
+        const std::vector<std::string> outcomes = runScenariosTogether(pointers, std::move(steppers), progress);
+        for (size_t m = 0; m < members.size(); ++m) failures[members[m]] = outcomes[m];
       });
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - unitStart).count();
       {
