@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "framework/step/cpu_stepper.hpp"
@@ -98,6 +100,23 @@ TEST(ThreadPool, RunsEveryTaskOnceAndRethrowsTheFirstError) {
   std::atomic<int> after{0};
   pool.run(5, [&](int) { ++after; });  // the pool still works after an error
   EXPECT_EQ(after.load(), 5);
+}
+
+// The workers spin a while for the next round, then sleep; the caller likewise for a round's end.
+// Rounds with pauses longer than the spin between them, and tasks longer than it, take the sleeping
+// paths; rounds back to back, the spinning ones.
+TEST(ThreadPool, RoundsAfterTheWorkersSleptAndTasksThatOutlastTheSpin) {
+  ThreadPool pool(3);
+  for (int round = 0; round < 40; ++round) {
+    if (round % 4 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    const int tasks = 1 + round % 5;
+    std::vector<std::atomic<int>> seen(static_cast<size_t>(tasks));
+    pool.run(tasks, [&](int k) {
+      if (round % 3 == 0 && k == tasks - 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      ++seen[static_cast<size_t>(k)];
+    });
+    for (const auto& s : seen) ASSERT_EQ(s.load(), 1) << "round " << round;
+  }
 }
 
 TEST(Threads, TheScenarioKeyAndTheCommandLineOption) {
