@@ -17,6 +17,16 @@ int parallelTasks(long n, int grain) {
   return static_cast<int>(std::min<long>(n / grain, 4L * t_runner->size()));
 }
 
+void parallelEach(int tasks, const std::function<void(int)>& task) {
+  if (!t_runner || t_runner->size() <= 1 || tasks <= 1) {
+    for (int t = 0; t < tasks; ++t) task(t);
+    return;
+  }
+  ParallelRunner* runner = t_runner;
+  const ParallelScope inner(nullptr);
+  runner->run(tasks, task);
+}
+
 int parallelRanges(long n, int grain, const std::function<void(int, long, long)>& range) {
   const int tasks = parallelTasks(n, grain);
   if (tasks <= 1) {

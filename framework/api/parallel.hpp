@@ -41,4 +41,8 @@ int parallelTasks(long n, int grain);
 // order, on the runner's threads; tasks is parallelTasks(n, grain). Returns tasks.
 int parallelRanges(long n, int grain, const std::function<void(int, long, long)>& range);
 
+// task(0 .. tasks - 1) on the runner's threads, however few the tasks (a pass over parts that
+// parallelRanges made earlier).
+void parallelEach(int tasks, const std::function<void(int)>& task);
+
 }  // namespace gem
