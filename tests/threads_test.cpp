@@ -4,11 +4,18 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstring>
+#include <memory>
+#include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "broadphase/kept_list/neighbour_list.hpp"
+#include "framework/api/parallel.hpp"
+#include "framework/api/registry.hpp"
 #include "framework/step/cpu_stepper.hpp"
 #include "framework/step/thread_pool.hpp"
 #include "test_support.hpp"
@@ -21,6 +28,7 @@ struct ThreadedRun {
   std::vector<Real> state;
   long contacts = 0, impactRows = 0, broken = 0;
   int candidates = 0;  // the last step's
+  long rebuilds = 0;   // the broadphase's
 };
 
 ThreadedRun runWithThreads(const Scenario& base, int threads, int steps) {
@@ -36,6 +44,7 @@ ThreadedRun runWithThreads(const Scenario& base, int threads, int steps) {
   EXPECT_EQ(sim.threads(), threads);
   r.broken = sim.floesBroken();
   r.candidates = sim.candidateCount();
+  r.rebuilds = sim.broadphase().rebuilds();
   const World& w = sim.world();
   r.ids = w.id;
   for (const std::vector<Real>* v : {&w.x, &w.y, &w.angle, &w.vx, &w.vy, &w.omega}) r.state.insert(r.state.end(), v->begin(), v->end());
@@ -50,6 +59,7 @@ void expectSame(const ThreadedRun& one, const ThreadedRun& many, int threads) {
   EXPECT_EQ(one.contacts, many.contacts);
   EXPECT_EQ(one.impactRows, many.impactRows);
   EXPECT_EQ(one.broken, many.broken);
+  EXPECT_EQ(one.rebuilds, many.rebuilds);
 }
 
 // A field large enough that every parallel phase runs on the pool (CpuStepper::kParallelBodies).
@@ -62,7 +72,64 @@ TEST(Threads, ALargeFieldStepsBitForBitOnOneTwoAndFourThreads) {
   ASSERT_GE(one.candidates, CpuStepper::kParallelPairs) << "too few pairs for the narrowphase to run on the pool";
   EXPECT_GT(one.contacts, 500) << "the scene must touch a lot, or it guards nothing";
   EXPECT_GT(one.impactRows, 0);
+  EXPECT_GE(one.rebuilds, 2) << "the kept list was never rebuilt: its parallel build went untested";
   for (int threads : {2, 4}) expectSame(one, runWithThreads(s, threads, 120), threads);
+}
+
+// The kept lists' build (the sweep, the counting sort, the clean-up) and their per-step filter (the
+// listed pairs, the direct pass) run over ranges of bodies and pairs on the stepper's pool
+// (framework/api/parallel.hpp). On a field past every range's threshold, with floes moved so that
+// the lists are rebuilt at some calls and only direct at others, every strategy gives the same list
+// and the same candidates, bit for bit, on one thread and on two, three and four.
+TEST(Threads, KeptListsBuildAndFilterTheSameOnAnyThreadCount) {
+  test::TempDir dir;
+  const Scenario s = test::scenarioFromToml(dir, test::kBusyScene, {"domain.x=[0.0, 700.0]", "domain.y=[-200.0, 200.0]"});
+  const World start = buildWorld(s);
+  ASSERT_GE(start.size(), 4 * NeighbourList::kBodyGrain) << "too few bodies for the body passes to be split";
+  for (const char* name : {"variable_radius", "fixed_radius", "triangulation_mesh"}) {
+    SCOPED_TRACE(name);
+    World world = start;
+    auto one = Registry::global().broadphase(name).make(s.broadphaseSettings);
+    std::vector<std::unique_ptr<Broadphase>> many;
+    std::vector<std::unique_ptr<ThreadPool>> pools;
+    for (int threads : {2, 3, 4}) {
+      many.push_back(Registry::global().broadphase(name).make(s.broadphaseSettings));
+      pools.push_back(std::make_unique<ThreadPool>(threads));
+    }
+    std::mt19937 random(7);
+    bool sawDirect = false;
+    for (int call = 0; call < 12; ++call) {
+      // Odd calls move 3 floes past half the skin (direct, no rebuild), even ones 40 (a rebuild).
+      std::uniform_int_distribution<int> body(0, world.size() - 1);
+      for (int moved = 0; moved < (call % 2 ? 3 : 40); ++moved) {
+        const int i = body(random);
+        if (world.kind[i] != BodyKind::Floe) continue;
+        world.x[i] += Real(1.5);
+        world.y[i] -= Real(0.75);
+      }
+      std::vector<CandidatePair> expected;
+      one->findCandidates(world, expected);
+      const auto& list = dynamic_cast<const KeptListBroadphase&>(*one).list();
+      ASSERT_GE(static_cast<int>(list.pairs().size()), 4 * NeighbourList::kPairGrain) << "too few listed pairs for them to be split";
+      sawDirect = sawDirect || list.directCount() > 1;  // more than the vessel
+      for (size_t k = 0; k < many.size(); ++k) {
+        SCOPED_TRACE(::testing::Message() << pools[k]->size() << " threads, call " << call);
+        std::vector<CandidatePair> pairs;
+        {
+          const ParallelScope lend(pools[k].get());
+          many[k]->findCandidates(world, pairs);
+        }
+        ASSERT_EQ(pairs.size(), expected.size());
+        EXPECT_EQ(0, std::memcmp(pairs.data(), expected.data(), pairs.size() * sizeof(CandidatePair)));
+        const auto& listed = dynamic_cast<const KeptListBroadphase&>(*many[k]).list().pairs();
+        ASSERT_EQ(listed.size(), list.pairs().size());
+        EXPECT_EQ(0, std::memcmp(listed.data(), list.pairs().data(), listed.size() * sizeof(ListedPair)));
+        EXPECT_EQ(many[k]->rebuilds(), one->rebuilds());
+      }
+    }
+    EXPECT_GE(one->rebuilds(), 6) << "the lists were not rebuilt: the build's parallel parts went untested";
+    EXPECT_TRUE(sawDirect) << "no floe was direct: the direct pass went untested";
+  }
 }
 
 TEST(Threads, ABrokenFieldStepsBitForBitOnThreeThreads) {
@@ -98,6 +165,23 @@ TEST(ThreadPool, RunsEveryTaskOnceAndRethrowsTheFirstError) {
   std::atomic<int> after{0};
   pool.run(5, [&](int) { ++after; });  // the pool still works after an error
   EXPECT_EQ(after.load(), 5);
+}
+
+// The workers spin a while for the next round, then sleep; the caller likewise for a round's end.
+// Rounds with pauses longer than the spin between them, and tasks longer than it, take the sleeping
+// paths; rounds back to back, the spinning ones.
+TEST(ThreadPool, RoundsAfterTheWorkersSleptAndTasksThatOutlastTheSpin) {
+  ThreadPool pool(3);
+  for (int round = 0; round < 40; ++round) {
+    if (round % 4 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    const int tasks = 1 + round % 5;
+    std::vector<std::atomic<int>> seen(static_cast<size_t>(tasks));
+    pool.run(tasks, [&](int k) {
+      if (round % 3 == 0 && k == tasks - 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      ++seen[static_cast<size_t>(k)];
+    });
+    for (const auto& s : seen) ASSERT_EQ(s.load(), 1) << "round " << round;
+  }
 }
 
 TEST(Threads, TheScenarioKeyAndTheCommandLineOption) {

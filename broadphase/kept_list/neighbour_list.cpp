@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "framework/api/errors.hpp"
+#include "framework/api/parallel.hpp"
 
 namespace gem {
 
@@ -38,54 +40,128 @@ bool NeighbourList::update(const World& world) {
   return false;
 }
 
-void NeighbourList::begin() { m_raw.clear(); }
+void NeighbourList::begin(int parts) {
+  m_raw.resize(static_cast<size_t>(parts));
+  for (std::vector<ListedPair>& part : m_raw) part.clear();
+}
 
-// A counting sort by a (O(bodies + pairs)), then an insertion sort of each row by b: rows hold a
-// handful of pairs, so this beats std::sort's log factor at every rebuild.
+// A counting sort by a (O(bodies + pairs)), then each row sorted by b: most rows hold a handful of
+// pairs, and an insertion sort beats std::sort's log factor on them; a long row (a wall's: its
+// bounding circle covers the field, so at 10^5 floes it lists every floe, in sweep order) takes
+// std::sort, which an insertion sort would make quadratic (it was a third of a 10^5-floe step).
+// Equal pairs are equal records (add() leaves reach2 0), so either sort gives the same rows.
+// In parallel: each part counts its pairs by a, the row starts are split among the parts in part
+// order, and each part scatters its own pairs; the rows come out as one pass over the parts in
+// order would leave them, then they are sorted range by range.
 void NeighbourList::sortRaw(int bodyCount) {
-  m_pairs.resize(m_raw.size());
-  m_count.assign(static_cast<size_t>(bodyCount) + 1, 0);
-  for (const ListedPair& p : m_raw) ++m_count[p.a + 1];
-  for (int k = 0; k < bodyCount; ++k) m_count[k + 1] += m_count[k];
-  for (const ListedPair& p : m_raw) m_pairs[m_count[p.a]++] = p;
-  // m_count[a] is now the end of row a, and the start of row a + 1.
-  int begin = 0;
-  for (int a = 0; a < bodyCount; ++a) {
-    const int end = m_count[a];
-    for (int k = begin + 1; k < end; ++k) {
-      const ListedPair v = m_pairs[k];
-      int q = k - 1;
-      while (q >= begin && m_pairs[q].b > v.b) {
-        m_pairs[q + 1] = m_pairs[q];
-        --q;
-      }
-      m_pairs[q + 1] = v;
+  const int parts = static_cast<int>(m_raw.size());
+  const size_t n = static_cast<size_t>(bodyCount);
+  size_t total = 0;
+  for (const std::vector<ListedPair>& part : m_raw) total += part.size();
+  m_pairs.resize(total);
+  m_partCount.resize(static_cast<size_t>(parts) * n);
+  m_count.resize(n + 1);
+  parallelEach(parts, [&](int t) {
+    int* count = m_partCount.data() + static_cast<size_t>(t) * n;
+    std::fill(count, count + n, 0);
+    for (const ListedPair& p : m_raw[static_cast<size_t>(t)]) ++count[p.a];
+  });
+  parallelRanges(bodyCount, kBodyGrain, [&](int, long begin, long end) {
+    for (long a = begin; a < end; ++a) {
+      int row = 0;
+      for (int t = 0; t < parts; ++t) row += m_partCount[static_cast<size_t>(t) * n + static_cast<size_t>(a)];
+      m_count[static_cast<size_t>(a) + 1] = row;
     }
-    begin = end;
-  }
+  });
+  m_count[0] = 0;
+  for (size_t a = 0; a < n; ++a) m_count[a + 1] += m_count[a];
+  // m_count[a] is now the start of row a; each part's share of it follows the earlier parts'.
+  parallelRanges(bodyCount, kBodyGrain, [&](int, long begin, long end) {
+    for (long a = begin; a < end; ++a) {
+      int at = m_count[static_cast<size_t>(a)];
+      for (int t = 0; t < parts; ++t) {
+        int& count = m_partCount[static_cast<size_t>(t) * n + static_cast<size_t>(a)];
+        const int rows = count;
+        count = at;
+        at += rows;
+      }
+    }
+  });
+  parallelEach(parts, [&](int t) {
+    int* at = m_partCount.data() + static_cast<size_t>(t) * n;
+    for (const ListedPair& p : m_raw[static_cast<size_t>(t)]) m_pairs[static_cast<size_t>(at[p.a]++)] = p;
+  });
+  parallelRanges(bodyCount, kBodyGrain, [&](int, long first, long last) {
+    for (long a = first; a < last; ++a) {
+      const int begin = m_count[static_cast<size_t>(a)], end = m_count[static_cast<size_t>(a) + 1];
+      if (end - begin > kShortRow) {
+        std::sort(m_pairs.begin() + begin, m_pairs.begin() + end, [](const ListedPair& p, const ListedPair& q) { return p.b < q.b; });
+        continue;
+      }
+      for (int k = begin + 1; k < end; ++k) {
+        const ListedPair v = m_pairs[static_cast<size_t>(k)];
+        int q = k - 1;
+        while (q >= begin && m_pairs[static_cast<size_t>(q)].b > v.b) {
+          m_pairs[static_cast<size_t>(q) + 1] = m_pairs[static_cast<size_t>(q)];
+          --q;
+        }
+        m_pairs[static_cast<size_t>(q) + 1] = v;
+      }
+    }
+  });
 }
 
 void NeighbourList::finish(const World& world) {
   const int n = world.size();
   bool sorted = true;
-  for (size_t k = 1; k < m_raw.size() && sorted; ++k)
-    sorted = m_raw[k - 1].a < m_raw[k].a || (m_raw[k - 1].a == m_raw[k].a && m_raw[k - 1].b < m_raw[k].b);
-  if (sorted)
-    m_pairs.swap(m_raw);
-  else
-    sortRaw(n);
-  // Drop wall-wall pairs and duplicates, and fix each pair's reach for the per-step filter.
-  size_t out = 0;
-  for (size_t k = 0; k < m_pairs.size(); ++k) {
-    ListedPair p = m_pairs[k];
-    if (world.kind[p.a] == BodyKind::Wall && world.kind[p.b] == BodyKind::Wall) continue;
-    if (world.kind[p.a] == BodyKind::Vessel || world.kind[p.b] == BodyKind::Vessel) continue;  // direct
-    if (out > 0 && m_pairs[out - 1].a == p.a && m_pairs[out - 1].b == p.b) continue;
-    const Real reach = world.radius[p.a] + world.radius[p.b];
-    p.reach2 = reach * reach;
-    m_pairs[out++] = p;
+  const ListedPair* last = nullptr;
+  for (const std::vector<ListedPair>& part : m_raw) {
+    for (const ListedPair& p : part) {
+      if (last && !(last->a < p.a || (last->a == p.a && last->b < p.b))) {
+        sorted = false;
+        break;
+      }
+      last = &p;
+    }
+    if (!sorted) break;
   }
-  m_pairs.resize(out);
+  if (!sorted) {
+    sortRaw(n);
+  } else if (m_raw.size() == 1) {
+    m_pairs.swap(m_raw[0]);
+  } else {
+    m_pairs.clear();
+    for (const std::vector<ListedPair>& part : m_raw) m_pairs.insert(m_pairs.end(), part.begin(), part.end());
+  }
+  // Drop wall-wall pairs and duplicates, and fix each pair's reach for the per-step filter, range by
+  // range into m_kept, then the ranges' survivors joined in order. The pairs are sorted, so a
+  // duplicate follows its twin: "equal to the pair before it" is "equal to the last one kept".
+  const long listed = static_cast<long>(m_pairs.size());
+  m_kept.resize(m_pairs.size());
+  m_rangeCount.assign(static_cast<size_t>(parallelTasks(listed, kPairGrain)), 0);
+  auto keep = [&](int t, long begin, long end) {
+    size_t out = static_cast<size_t>(begin);
+    for (long k = begin; k < end; ++k) {
+      ListedPair p = m_pairs[static_cast<size_t>(k)];
+      if (world.kind[p.a] == BodyKind::Wall && world.kind[p.b] == BodyKind::Wall) continue;
+      if (world.kind[p.a] == BodyKind::Vessel || world.kind[p.b] == BodyKind::Vessel) continue;  // direct
+      if (k > 0 && m_pairs[static_cast<size_t>(k) - 1].a == p.a && m_pairs[static_cast<size_t>(k) - 1].b == p.b) continue;
+      const Real reach = world.radius[p.a] + world.radius[p.b];
+      p.reach2 = reach * reach;
+      m_kept[out++] = p;
+    }
+    m_rangeCount[static_cast<size_t>(t)] = out - static_cast<size_t>(begin);
+  };
+  parallelRanges(listed, kPairGrain, keep);
+  size_t kept = 0;
+  for (size_t& count : m_rangeCount) kept += std::exchange(count, kept);  // now each range's offset
+  parallelRanges(listed, kPairGrain, [&](int t, long begin, long) {
+    const size_t at = m_rangeCount[static_cast<size_t>(t)];
+    const size_t next = static_cast<size_t>(t) + 1 < m_rangeCount.size() ? m_rangeCount[static_cast<size_t>(t) + 1] : kept;
+    std::copy(m_kept.begin() + begin, m_kept.begin() + begin + static_cast<std::ptrdiff_t>(next - at),
+              m_pairs.begin() + static_cast<std::ptrdiff_t>(at));
+  });
+  m_pairs.resize(kept);
   m_x0.assign(world.x.begin(), world.x.end());
   m_y0.assign(world.y.begin(), world.y.end());
   m_angle0.assign(world.angle.begin(), world.angle.end());
@@ -101,41 +177,79 @@ void NeighbourList::finish(const World& world) {
 void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePair>& out) {
   // Branch-free: every listed pair is written to a scratch row and kept by advancing the count;
   // about a third pass, so a branch would mispredict often. The scratch never shrinks. Pairs of a
-  // direct body are skipped here: the direct pass below finds them.
+  // direct body are skipped here: the direct pass below finds them. In parallel ranges, each
+  // compacting into its own stretch of the scratch; the stretches are joined in order below.
+  const long listed = static_cast<long>(m_pairs.size());
   if (m_filtered.size() < m_pairs.size()) m_filtered.resize(m_pairs.size());
   const Real* x = world.x.data();
   const Real* y = world.y.data();
   const char* direct = m_direct.data();
-  CandidatePair* dst = m_filtered.data();
-  size_t count = 0;
-  for (const ListedPair& p : m_pairs) {
-    const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
-    dst[count] = {p.a, p.b};
-    count += (dx * dx + dy * dy <= p.reach2) & !(direct[p.a] | direct[p.b]);
-  }
-  if (m_directList.empty()) {
-    out.assign(m_filtered.begin(), m_filtered.begin() + static_cast<std::ptrdiff_t>(count));
-    return;
-  }
+  const int tasks = parallelTasks(listed, kPairGrain);
+  m_rangeCount.assign(static_cast<size_t>(tasks), 0);
+  std::vector<long> first(static_cast<size_t>(tasks));
+  parallelRanges(listed, kPairGrain, [&](int t, long begin, long end) {
+    CandidatePair* dst = m_filtered.data() + begin;
+    size_t count = 0;
+    for (long k = begin; k < end; ++k) {
+      const ListedPair& p = m_pairs[static_cast<size_t>(k)];
+      const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
+      dst[count] = {p.a, p.b};
+      count += (dx * dx + dy * dy <= p.reach2) & !(direct[p.a] | direct[p.b]);
+    }
+    m_rangeCount[static_cast<size_t>(t)] = count;
+    first[static_cast<size_t>(t)] = begin;
+  });
+
   // Direct bodies (the vessel, and floes that moved more than half the skin since the build) are
   // tested against every body: one pass each, a microsecond per thousand bodies, instead of a
-  // rebuild of the whole list every few steps while the vessel shoves floes at its own speed.
-  const Real* radius = world.radius.data();
-  const int n = world.size();
+  // rebuild of the whole list every few steps while the vessel shoves floes at its own speed. The
+  // pass is split over ranges of bodies; the pairs are sorted afterwards, so their order is one.
   m_directPairs.clear();
-  for (int v : m_directList) {
-    for (int j = 0; j < n; ++j) {
-      if (j == v || (direct[j] && j < v)) continue;  // a pair of two direct bodies is found once
-      if (world.kind[v] == BodyKind::Wall && world.kind[j] == BodyKind::Wall) continue;
-      const Real dx = x[v] - x[j], dy = y[v] - y[j], reach = radius[v] + radius[j];
-      if (dx * dx + dy * dy <= reach * reach) m_directPairs.push_back(j < v ? CandidatePair{j, v} : CandidatePair{v, j});
-    }
+  if (!m_directList.empty()) {
+    const Real* radius = world.radius.data();
+    const int n = world.size();
+    const int bodyTasks = parallelTasks(n, kBodyGrain);
+    m_directParts.resize(static_cast<size_t>(bodyTasks));
+    parallelRanges(n, kBodyGrain, [&](int t, long begin, long end) {
+      std::vector<CandidatePair>& part = m_directParts[static_cast<size_t>(t)];
+      part.clear();
+      for (int v : m_directList) {
+        for (int j = static_cast<int>(begin); j < end; ++j) {
+          if (j == v || (direct[j] && j < v)) continue;  // a pair of two direct bodies is found once
+          if (world.kind[v] == BodyKind::Wall && world.kind[j] == BodyKind::Wall) continue;
+          const Real dx = x[v] - x[j], dy = y[v] - y[j], reach = radius[v] + radius[j];
+          if (dx * dx + dy * dy <= reach * reach) part.push_back(j < v ? CandidatePair{j, v} : CandidatePair{v, j});
+        }
+      }
+    });
+    for (const std::vector<CandidatePair>& part : m_directParts) m_directPairs.insert(m_directPairs.end(), part.begin(), part.end());
   }
   auto before = [](CandidatePair p, CandidatePair q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
   std::sort(m_directPairs.begin(), m_directPairs.end(), before);
-  out.resize(count + m_directPairs.size());
-  std::merge(m_filtered.begin(), m_filtered.begin() + static_cast<std::ptrdiff_t>(count), m_directPairs.begin(), m_directPairs.end(),
-             out.begin(), before);
+
+  // The join: range t's pairs, merged with the direct pairs that fall before the next range's first
+  // pair, go after everything of the earlier ranges. A pair is never both listed and direct.
+  std::vector<size_t> offset(static_cast<size_t>(tasks) + 1, 0), directFrom(static_cast<size_t>(tasks) + 1, m_directPairs.size());
+  for (int t = 0; t < tasks; ++t)
+    offset[static_cast<size_t>(t) + 1] = offset[static_cast<size_t>(t)] + m_rangeCount[static_cast<size_t>(t)];
+  for (int t = tasks - 1; t >= 1; --t) {
+    directFrom[static_cast<size_t>(t)] = directFrom[static_cast<size_t>(t) + 1];
+    if (m_rangeCount[static_cast<size_t>(t)] > 0)
+      directFrom[static_cast<size_t>(t)] =
+          static_cast<size_t>(std::lower_bound(m_directPairs.begin(), m_directPairs.end(),
+                                               m_filtered[static_cast<size_t>(first[static_cast<size_t>(t)])], before) -
+                              m_directPairs.begin());
+  }
+  directFrom[0] = 0;
+  out.resize(offset[static_cast<size_t>(tasks)] + m_directPairs.size());
+  auto join = [&](int t) {
+    const auto from = m_filtered.begin() + first[static_cast<size_t>(t)];
+    const auto direct0 = m_directPairs.begin() + static_cast<std::ptrdiff_t>(directFrom[static_cast<size_t>(t)]);
+    const auto direct1 = m_directPairs.begin() + static_cast<std::ptrdiff_t>(directFrom[static_cast<size_t>(t) + 1]);
+    std::merge(from, from + static_cast<std::ptrdiff_t>(m_rangeCount[static_cast<size_t>(t)]), direct0, direct1,
+               out.begin() + static_cast<std::ptrdiff_t>(offset[static_cast<size_t>(t)] + directFrom[static_cast<size_t>(t)]), before);
+  };
+  parallelEach(tasks, join);
 }
 
 void KeptListBroadphase::findCandidates(const World& world, std::vector<CandidatePair>& pairs) {
@@ -174,18 +288,24 @@ void AxisSweep::build(const World& world, const std::vector<Real>& h, Real floor
   if (moves > budget) std::sort(m_order.begin(), m_order.end(), [&](int p, int q) { return m_lo[p] < m_lo[q]; });
 
   m_slot.resize(n), m_x.resize(n), m_y.resize(n), m_h.resize(n), m_sortedLo.resize(n), m_hi.resize(n);
-  for (int k = 0; k < n; ++k) {
-    const int i = m_order[k];
-    m_slot[k] = i, m_x[k] = x[i], m_y[k] = world.y[i], m_h[k] = h[i], m_sortedLo[k] = m_lo[i];
-    m_hi[k] = x[i] + std::max(floor / 2, h[i]);
-  }
-  for (int k = 0; k < n; ++k) {
-    const Real hi = m_hi[k];
-    for (int q = k + 1; q < n && m_sortedLo[q] <= hi; ++q) {
-      const Real dx = m_x[k] - m_x[q], dy = m_y[k] - m_y[q], reach = std::max(floor, m_h[k] + m_h[q]);
-      if (dx * dx + dy * dy <= reach * reach) list.add(m_slot[k], m_slot[q]);
+  parallelRanges(n, NeighbourList::kBodyGrain, [&](int, long begin, long end) {
+    for (int k = static_cast<int>(begin); k < end; ++k) {
+      const int i = m_order[k];
+      m_slot[k] = i, m_x[k] = x[i], m_y[k] = world.y[i], m_h[k] = h[i], m_sortedLo[k] = m_lo[i];
+      m_hi[k] = x[i] + std::max(floor / 2, h[i]);
     }
-  }
+  });
+  // The sweep, over contiguous ranges of sorted positions, each range into its own part.
+  list.begin(parallelTasks(n, kGrain));
+  parallelRanges(n, kGrain, [&](int t, long begin, long end) {
+    for (int k = static_cast<int>(begin); k < end; ++k) {
+      const Real hi = m_hi[k];
+      for (int q = k + 1; q < n && m_sortedLo[q] <= hi; ++q) {
+        const Real dx = m_x[k] - m_x[q], dy = m_y[k] - m_y[q], reach = std::max(floor, m_h[k] + m_h[q]);
+        if (dx * dx + dy * dy <= reach * reach) list.add(t, m_slot[k], m_slot[q]);
+      }
+    }
+  });
 }
 
 BroadphaseSettings checkedSettings(const BroadphaseSettings& settings) {

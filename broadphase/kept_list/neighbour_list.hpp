@@ -48,14 +48,21 @@ class NeighbourList {
   bool update(const World& world);
   int directCount() const { return static_cast<int>(m_directList.size()); }
   static constexpr int kMaxDirect = 8;
+  // Items a parallel range takes at least (framework/api/parallel.hpp): pairs of a stream (a few
+  // nanoseconds each), bodies of an O(1) pass.
+  static constexpr int kPairGrain = 4096, kBodyGrain = 1024;
   void invalidate() { m_valid = false; }
   long rebuilds() const { return m_rebuilds; }
 
   // Building: begin, add each pair once (a != b, either order), finish. finish() drops wall-wall
   // pairs (two immovable bodies never interact), sorts by (a, b) when the pairs did not come in
-  // order, and records the reference state of every body.
-  void begin();
-  void add(int a, int b) { m_raw.push_back({a < b ? a : b, a < b ? b : a, 0}); }
+  // order, and records the reference state of every body. A build split over parallel ranges
+  // (framework/api/parallel.hpp) adds each range's pairs to a part of its own, begin(parts) and
+  // add(part, a, b): the parts in order are the pairs in the order of one pass, so the list is the
+  // same whatever the thread count.
+  void begin(int parts = 1);
+  void add(int a, int b) { add(0, a, b); }
+  void add(int part, int a, int b) { m_raw[static_cast<size_t>(part)].push_back({a < b ? a : b, a < b ? b : a, 0}); }
   void finish(const World& world);
 
   // This step's candidates: the listed pairs whose bounding circles overlap now, in list order
@@ -65,13 +72,19 @@ class NeighbourList {
 
  private:
   void sortRaw(int bodyCount);
-
+  static constexpr int kShortRow = 32;  // rows up to this long are insertion-sorted
   Real m_skin;
   bool m_valid = false;
   long m_rebuilds = 0;
-  std::vector<ListedPair> m_raw, m_pairs;
+  std::vector<std::vector<ListedPair>> m_raw;  // the build's parts
+  std::vector<ListedPair> m_pairs, m_kept;
   std::vector<CandidatePair> m_filtered;
   std::vector<int> m_count;
+  // The parallel counting sort's counts, part by part (part x bodies), and each range's count of
+  // the filters' survivors.
+  std::vector<int> m_partCount;
+  std::vector<size_t> m_rangeCount;
+  std::vector<std::vector<CandidatePair>> m_directParts;
   // Reference state at the last build, by slot.
   std::vector<Real> m_x0, m_y0, m_angle0;
   std::vector<std::int64_t> m_id0;
@@ -115,7 +128,10 @@ Real largestFloeRadius(const World& world);
 // x, y, h, so its inner loop walks memory in order.
 class AxisSweep {
  public:
+  // The sweep runs over contiguous ranges of the sorted bodies on the caller's parallel runner, each
+  // range into a part of the list (NeighbourList::begin(parts)).
   void build(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list);
+  static constexpr int kGrain = 512;  // bodies a range takes at least (each tests its x-neighbours)
 
  private:
   std::vector<int> m_order, m_slot;

@@ -354,8 +354,12 @@ void CpuStepper::step() {
   const int n = m_world.size();
   const int vesselDof = m_scenario.vessel.dof;
 
-  // 1-2. Candidates, then contacts.
-  m_broadphase->findCandidates(m_world, m_pairs);
+  // 1-2. Candidates, then contacts. The broadphase may borrow the pool (framework/api/parallel.hpp):
+  // the kept lists' build and filter run over ranges joined in order.
+  {
+    const ParallelScope lend(m_pool.get());
+    m_broadphase->findCandidates(m_world, m_pairs);
+  }
   narrowphase();
 
   // 3. Two-body events write into each contact's slot.

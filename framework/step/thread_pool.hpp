@@ -3,45 +3,66 @@
 // returns when every one is done. Which thread runs a task never matters to the results: each
 // task writes its own part, and the stepper joins the parts in task order (docs/architecture.md
 // "Determinism").
+//
+// A round is cheap (docs/performance.md 3.8): the caller publishes it by bumping one atomic word
+// (the round's number and how many workers take part), the workers spin on that word for a short
+// while before they sleep on a condition variable, and the caller, which takes tasks too, spins on
+// the count of workers still busy the same way. A step at 10^5 floes runs about ten rounds, most of
+// them a few hundred microseconds apart: the workers then never sleep, and a round costs a few
+// cache-line transfers instead of a mutex, a futex wake and a context switch per worker.
 #pragma once
 #include <atomic>
 #include <condition_variable>
+#include <cstdint>
 #include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
 #include <vector>
 
+#include "framework/api/parallel.hpp"
+
 namespace gem {
 
-class ThreadPool {
+class ThreadPool final : public ParallelRunner {
  public:
   // threads: all of them, the caller included (at least 1: then run() is a plain loop).
   explicit ThreadPool(int threads);
-  ~ThreadPool();
+  ~ThreadPool() override;
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;
 
-  int size() const { return static_cast<int>(m_workers.size()) + 1; }
+  int size() const override { return static_cast<int>(m_workers.size()) + 1; }
   // Only tasks - 1 workers are woken to take part (fewer tasks than threads, fewer threads busy).
   // The first exception a task threw is rethrown here, once every task has ended.
-  void run(int tasks, const std::function<void(int)>& task);
+  void run(int tasks, const std::function<void(int)>& task) override;
 
  private:
   void work(int index);
   void drain();
 
+  // The round word: the round's number times kRoundUnit plus the number of workers taking part
+  // (the first of them by index). One word, so a worker never pairs one round's number with
+  // another's participants.
+  static constexpr std::uint64_t kRoundUnit = 1u << 16;
+
   std::vector<std::thread> m_workers;
-  std::mutex m_mutex;
-  std::condition_variable m_wake, m_done;
+  // Read by the workers only after they see a new round word (release / acquire), written by the
+  // caller only while no worker is in a round.
   const std::function<void(int)>* m_task = nullptr;
   int m_tasks = 0;
-  std::atomic<int> m_next{0};
-  int m_participants = 0;  // the workers taking part in the current round: the first tasks - 1
-  int m_running = 0;       // of them, those that have not ended it
-  long m_round = 0;
-  bool m_stop = false;
-  std::exception_ptr m_error;
+  alignas(64) std::atomic<std::uint64_t> m_round{0};
+  alignas(64) std::atomic<int> m_next{0};
+  alignas(64) std::atomic<int> m_running{0};  // the round's workers that have not ended it
+  // Sleepers: the workers waiting on m_wake, and whether the caller waits on m_done. The side that
+  // changes the condition checks them afterwards and takes the mutex to notify only when someone
+  // sleeps (both sides use sequentially consistent operations, so one of them always sees the other).
+  alignas(64) std::atomic<int> m_sleepingWorkers{0};
+  std::atomic<bool> m_callerSleeping{false};
+  std::atomic<bool> m_stop{false};
+  std::mutex m_mutex;
+  std::condition_variable m_wake, m_done;
+  std::exception_ptr m_error;  // under m_mutex
 };
 
 // The threads a run uses for simulation.threads = `requested` (0: every core of the machine).
