@@ -27,13 +27,13 @@ class FixedRadius final : public KeptListBroadphase {
     // |c_a - c_b| <= max(fixed, (R_a + skin / 2) + (R_b + skin / 2)).
     m_half.resize(n);
     for (int i = 0; i < n; ++i) m_half[i] = world.radius[i] + skin / 2;
-    m_sweep.build(world, m_half, fixed, list);
+    m_pairsWithinReach.build(world, m_half, fixed, list);
   }
 
  private:
   Real m_fixedRadius;
   std::vector<Real> m_half;
-  AxisSweep m_sweep;
+  PairsWithinReach m_pairsWithinReach;
 };
 
 }  // namespace

@@ -41,7 +41,7 @@ class TriangulationMesh final : public KeptListBroadphase {
     const Real skin = list.skin();
     m_half.resize(n);
     for (int i = 0; i < n; ++i) m_half[i] = world.radius[i] + skin / 2;
-    m_sweep.build(world, m_half, 0, list);
+    m_pairsWithinReach.build(world, m_half, 0, list);
     refreshTriangles(world);
   }
 
@@ -132,7 +132,7 @@ class TriangulationMesh final : public KeptListBroadphase {
 
   std::vector<Real> m_half;
   std::vector<CandidatePair> m_circles;
-  AxisSweep m_sweep;
+  PairsWithinReach m_pairsWithinReach;
   std::unordered_map<std::int64_t, TriangleSet> m_cache;
   std::vector<int> m_triStart, m_vertStart, m_tri;  // m_tri: 3 vertex indices per triangle
   std::vector<Vec2> m_world;

@@ -1,9 +1,9 @@
 // variable_radius: the thesis's chosen strategy (5.4, Figure 5.8). A pair is listed when
 // |c_a - c_b| <= R_a + R_b + skin, R the bounding radius about the centroid; the list is kept over
 // steps under the rebuild rule of neighbour_list.hpp and filtered each step by R_a + R_b.
-// Built by sweep and prune along x (the thesis's GPU kernel tested every pair, one thread per floe;
-// the list is the same): O(n + pairs whose x spans overlap), which is lean in a channel, long in x,
-// but about n^1.5 in a square field; uniform_grid builds the very same list in O(n + pairs).
+// Built by PairsWithinReach (neighbour_list.hpp), a sweep along x or a uniform grid, whichever
+// tests fewer pairs (the thesis's GPU kernel tested every pair, one thread per floe; the list is
+// the same).
 #include "broadphase/kept_list/neighbour_list.hpp"
 #include "framework/api/registry.hpp"
 
@@ -23,12 +23,12 @@ class VariableRadius final : public KeptListBroadphase {
     m_half.resize(n);
     // |c_a - c_b| <= (R_a + skin / 2) + (R_b + skin / 2).
     for (int i = 0; i < n; ++i) m_half[i] = world.radius[i] + skin / 2;
-    m_sweep.build(world, m_half, 0, list);
+    m_pairsWithinReach.build(world, m_half, 0, list);
   }
 
  private:
   std::vector<Real> m_half;
-  AxisSweep m_sweep;
+  PairsWithinReach m_pairsWithinReach;
 };
 
 }  // namespace

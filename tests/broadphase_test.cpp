@@ -16,7 +16,9 @@
 
 #include "broadphase/kept_list/neighbour_list.hpp"
 #include "framework/api/errors.hpp"
+#include "framework/api/parallel.hpp"
 #include "framework/api/registry.hpp"
+#include "framework/step/thread_pool.hpp"
 #include "framework/world/world.hpp"
 
 namespace gem {
@@ -229,6 +231,66 @@ TEST(Broadphase, RandomWorldsSupersetOfTruth) {
 
 // The kept lists themselves, right after a build: exactly the pairs within R_a + R_b + skin (and,
 // for fixed_radius, also those within the fixed radius), never two walls, never the vessel.
+// The kept lists' build has two exact methods, a sweep along x and a uniform grid with the few
+// very large bodies tested against all (neighbour_list.hpp, PairsWithinReach): on fields that
+// give the grid every case (walls across the field, giant floes, bodies at about the reach of each
+// other, a huge box), both list exactly the pairs the rule accepts, on 1 to
+// 4 threads. The cheaper one runs: a square field of thousands of floes takes the grid, a channel
+// long in x the sweep.
+TEST(Broadphase, KeptListBuildsBySweepAndByGridListTheSamePairs) {
+  for (int field = 0; field < 3; ++field) {
+    World w = randomWorld(29 + field, field == 2 ? 300 : 5000, field == 2 ? Real(1e7) : Real(900));
+    if (field == 1) {
+      w.addBody(spec(BodyKind::Floe, regularPolygon({450, 450}, 60, 8, 0)));  // two giants
+      w.addBody(spec(BodyKind::Floe, regularPolygon({200, 700}, 45, 6, 0)));
+      // Two floes at about their reach (centres 2 (R + skin / 2) apart along x).
+      w.addBody(spec(BodyKind::Floe, regularPolygon({100, 100}, 1, 4, 0)));
+      w.addBody(spec(BodyKind::Floe, regularPolygon({100, 100}, 1, 4, 0)));
+      w.x[static_cast<size_t>(w.size() - 1)] = 100 + 2 * (w.radius[static_cast<size_t>(w.size() - 1)] + Real(0.75));
+    }
+    std::vector<Real> h(static_cast<size_t>(w.size()));
+    for (int i = 0; i < w.size(); ++i) h[static_cast<size_t>(i)] = w.radius[static_cast<size_t>(i)] + Real(0.75);
+    for (Real floor : {Real(0), Real(12)}) {
+      SCOPED_TRACE(::testing::Message() << "field " << field << " floor " << floor);
+      PairSet expected;
+      for (int a = 0; a < w.size(); ++a)
+        for (int b = a + 1; b < w.size(); ++b) {
+          if (w.kind[a] == BodyKind::Wall && w.kind[b] == BodyKind::Wall) continue;
+          if (w.kind[a] == BodyKind::Vessel || w.kind[b] == BodyKind::Vessel) continue;  // direct
+          const Real dx = w.x[a] - w.x[b], dy = w.y[a] - w.y[b], reach = std::max(floor, h[a] + h[b]);
+          if (dx * dx + dy * dy <= reach * reach) expected.push_back({a, b});
+        }
+      for (auto method : {PairsWithinReach::Method::Sweep, PairsWithinReach::Method::Grid})
+        for (int threads : {1, 2, 4}) {
+          ThreadPool pool(threads);
+          const ParallelScope lend(&pool);
+          PairsWithinReach build;
+          build.use(method);
+          NeighbourList list(Real(1.5));
+          build.build(w, h, floor, list);
+          list.finish(w);
+          EXPECT_EQ(build.lastBuiltByGrid(), method == PairsWithinReach::Method::Grid);
+          PairSet listed;
+          for (const ListedPair& p : list.pairs()) listed.push_back({p.a, p.b});
+          EXPECT_EQ(listed, expected) << (method == PairsWithinReach::Method::Grid ? "grid" : "sweep") << ", " << threads << " threads";
+        }
+    }
+  }
+  // Which one runs by itself.
+  std::vector<Real> h;
+  auto chosen = [&](const World& w) {
+    h.assign(w.radius.begin(), w.radius.end());
+    PairsWithinReach build;
+    NeighbourList list(Real(1.5));
+    build.build(w, h, 0, list);
+    return build.lastBuiltByGrid();
+  };
+  EXPECT_TRUE(chosen(randomWorld(5, 20000, 2000)));  // square: the sweep's tests grow as n^1.5
+  World channel;
+  for (int k = 0; k < 8000; ++k) channel.addBody(spec(BodyKind::Floe, regularPolygon({Real(3) * k, Real(k % 3)}, 1, 5, 0)));
+  EXPECT_FALSE(chosen(channel));  // one row along x: the sweep meets only its neighbours
+}
+
 TEST(Broadphase, KeptListsHoldExactlyTheSkinPairs) {
   World w = randomWorld(17, 300, 140);
   Real largestFloe = 0;

@@ -59,7 +59,7 @@ __global__ void listResetKernel(ListView list, BroadphaseBodies b) {
   }
 }
 
-// 3b. AxisSweep::build's rule: |c_a - c_b| <= max(floor, h_a + h_b), found by walking forward
+// 3b. PairsWithinReach's rule (neighbour_list.hpp): |c_a - c_b| <= max(floor, h_a + h_b), found by walking forward
 // from each body while the next span starts before this one ends. The always-direct bodies are
 // left out (the direct pass covers them); each pair keeps (R_a + R_b)^2 for the filter.
 __global__ void listSweepKernel(ListView list, BroadphaseBodies b) {

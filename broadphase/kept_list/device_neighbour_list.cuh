@@ -7,7 +7,7 @@
 //             list is stale, a flag in device memory says "rebuild".
 //   2 order   the bodies sorted by the low end of their x span (CUB, every step: a graph cannot skip
 //             a CUB call, and it is cheap next to the rest).
-//   3 build   reference state and sweep and prune along x (AxisSweep::build's rule); both
+//   3 build   reference state and sweep and prune along x (PairsWithinReach's rule, neighbour_list.hpp); both
 //             kernels return at once when the flag is clear, which is almost every step.
 //   4 filter  one thread per listed pair: bounding circles overlap now (R_a + R_b), neither direct.
 //   5 direct  one thread per (direct body, body): the vessel, the walls and the floes that moved

@@ -261,7 +261,26 @@ void KeptListBroadphase::findCandidates(const World& world, std::vector<Candidat
   filter(world, pairs);
 }
 
-void AxisSweep::build(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list) {
+void PairsWithinReach::build(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list) {
+  const int n = world.size();
+  if (n < 2) {
+    list.begin();
+    return;
+  }
+  const double sweepTests = sortAlongX(world, h, floor);
+  // Below a few thousand bodies the grid cannot pay for its binning; a grid test gathers its body's
+  // data, about twice a sweep test.
+  if (m_method == Method::Cheaper)
+    m_byGrid = n >= 4096 && 2 * binInGrid(world, h, floor) < sweepTests;
+  else if ((m_byGrid = m_method == Method::Grid))
+    binInGrid(world, h, floor);
+  if (m_byGrid)
+    scanGrid(world, h, floor, list);
+  else
+    sweep(world, h, floor, list);
+}
+
+double PairsWithinReach::sortAlongX(const World& world, const std::vector<Real>& h, Real floor) {
   const int n = world.size();
   const Real* x = world.x.data();
   m_lo.resize(n);
@@ -295,7 +314,16 @@ void AxisSweep::build(const World& world, const std::vector<Real>& h, Real floor
       m_hi[k] = x[i] + std::max(floor / 2, h[i]);
     }
   });
-  // The sweep, over contiguous ranges of sorted positions, each range into its own part.
+  // The sweep's tests: for each body, the later spans that start inside its own (a binary search).
+  double tests = 0;
+  for (int k = 0; k < n; ++k)
+    tests += static_cast<double>(std::upper_bound(m_sortedLo.begin() + k + 1, m_sortedLo.end(), m_hi[k]) - (m_sortedLo.begin() + k + 1));
+  return tests;
+}
+
+void PairsWithinReach::sweep(const World&, const std::vector<Real>&, Real floor, NeighbourList& list) {
+  const int n = static_cast<int>(m_slot.size());
+  // Over contiguous ranges of sorted positions, each range into its own part.
   list.begin(parallelTasks(n, kGrain));
   parallelRanges(n, kGrain, [&](int t, long begin, long end) {
     for (int k = static_cast<int>(begin); k < end; ++k) {
@@ -306,6 +334,122 @@ void AxisSweep::build(const World& world, const std::vector<Real>& h, Real floor
       }
     }
   });
+}
+
+namespace {
+
+// The cell of coordinate v along an axis of `count` cells from `origin`: clamped, so that a
+// position outside the box still lands in a cell.
+int cellAlong(Real v, Real origin, Real cell, int count) {
+  const Real c = std::floor((v - origin) / cell);
+  if (!(c >= 0)) return 0;
+  return c >= static_cast<Real>(count - 1) ? count - 1 : static_cast<int>(c);
+}
+
+}  // namespace
+
+double PairsWithinReach::binInGrid(const World& world, const std::vector<Real>& h, Real floor) {
+  const int n = world.size();
+  const Real* x = world.x.data();
+  const Real* y = world.y.data();
+  m_extent.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) m_extent[i] = std::max(floor / 2, h[i]);
+  // Large: more than twice the 99th percentile of the extents (walls, the odd giant floe). The
+  // cell: twice the largest of the others, so any pair of them within reach is in adjacent cells.
+  m_scratch.assign(m_extent.begin(), m_extent.end());
+  const auto percentile = m_scratch.begin() + static_cast<std::ptrdiff_t>((n - 1) * 99 / 100);
+  std::nth_element(m_scratch.begin(), percentile, m_scratch.end());
+  const Real cut = 2 * *percentile;
+  m_large.clear();
+  m_isLarge.assign(static_cast<size_t>(n), 0);
+  Real largest = 0, x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  bool any = false;
+  for (int i = 0; i < n; ++i) {
+    // A body at no finite place is tested the plain way too.
+    if (m_extent[i] > cut || !std::isfinite(x[i]) || !std::isfinite(y[i])) {
+      m_large.push_back(i), m_isLarge[static_cast<size_t>(i)] = 1;
+      continue;
+    }
+    largest = std::max(largest, m_extent[i]);
+    x0 = any ? std::min(x0, x[i]) : x[i], x1 = any ? std::max(x1, x[i]) : x[i];
+    y0 = any ? std::min(y0, y[i]) : y[i], y1 = any ? std::max(y1, y[i]) : y[i];
+    any = true;
+  }
+  // A hair wider than 2 e: a pair exactly at reach stays within one cell of each other however the
+  // division rounds. Past 4 n + 1024 cells (a sparse field in a huge box), coarser cells.
+  const Real scale = std::max({Real(1), std::fabs(x0), std::fabs(x1), std::fabs(y0), std::fabs(y1)});
+  Real cell = std::max(2 * largest * (1 + Real(1e-9)), Real(1e-9) * scale);
+  auto cellsAlong = [&](Real span) { return std::min<Real>(std::floor(span / cell) + 1, Real(1 << 30)); };
+  const Real most = 4 * static_cast<Real>(n) + 1024;
+  while (cellsAlong(x1 - x0) * cellsAlong(y1 - y0) > most) cell *= 2;
+  m_nx = static_cast<int>(cellsAlong(x1 - x0)), m_ny = static_cast<int>(cellsAlong(y1 - y0));
+
+  // The counting sort of the ordinary bodies by cell.
+  m_cellOf.assign(static_cast<size_t>(n), -1);
+  m_cellStart.assign(static_cast<size_t>(m_nx) * static_cast<size_t>(m_ny) + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    if (m_isLarge[static_cast<size_t>(i)]) continue;
+    const int c = cellAlong(y[i], y0, cell, m_ny) * m_nx + cellAlong(x[i], x0, cell, m_nx);
+    m_cellOf[static_cast<size_t>(i)] = c;
+    ++m_cellStart[static_cast<size_t>(c) + 1];
+  }
+  for (size_t c = 1; c < m_cellStart.size(); ++c) m_cellStart[c] += m_cellStart[c - 1];
+  m_sorted.resize(static_cast<size_t>(m_cellStart.back()));
+  std::vector<int> fill(m_cellStart.begin(), m_cellStart.end() - 1);
+  for (int i = 0; i < n; ++i)
+    if (const int c = m_cellOf[static_cast<size_t>(i)]; c >= 0) m_sorted[static_cast<size_t>(fill[static_cast<size_t>(c)]++)] = i;
+
+  // The grid's tests: each cell's bodies against its 9 cells' (about half of them are skipped as
+  // found from the other side), and each large body against every body.
+  double tests = static_cast<double>(m_large.size()) * n;
+  for (int cy = 0; cy < m_ny; ++cy)
+    for (int cx = 0; cx < m_nx; ++cx) {
+      const int c = cy * m_nx + cx, here = m_cellStart[static_cast<size_t>(c) + 1] - m_cellStart[static_cast<size_t>(c)];
+      if (!here) continue;
+      int around = 0;
+      for (int gy = std::max(cy - 1, 0); gy <= std::min(cy + 1, m_ny - 1); ++gy)
+        around += m_cellStart[static_cast<size_t>(gy * m_nx + std::min(cx + 1, m_nx - 1)) + 1] -
+                  m_cellStart[static_cast<size_t>(gy * m_nx + std::max(cx - 1, 0))];
+      tests += 0.5 * here * around;
+    }
+  return tests;
+}
+
+void PairsWithinReach::scanGrid(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list) {
+  const int n = world.size(), nx = m_nx, ny = m_ny, ordinary = static_cast<int>(m_sorted.size());
+  const Real* x = world.x.data();
+  const Real* y = world.y.data();
+  // The rule's exact test (the sweep's, operand for operand up to the order of a sum and a square).
+  auto within = [&](int a, int b) {
+    const Real dx = x[a] - x[b], dy = y[a] - y[b], reach = std::max(floor, h[a] + h[b]);
+    return dx * dx + dy * dy <= reach * reach;
+  };
+  // Each ordinary body against the later bodies (by slot) of its 9 cells, cell by cell; then each
+  // large body against every body (a pair of two large ones once).
+  const int gridTasks = parallelTasks(ordinary, kGrain);
+  const int largeTasks = m_large.empty() ? 0 : parallelTasks(n, kGrain);
+  list.begin(gridTasks + largeTasks);
+  parallelRanges(ordinary, kGrain, [&](int t, long begin, long end) {
+    for (long p = begin; p < end; ++p) {
+      const int i = m_sorted[static_cast<size_t>(p)];
+      const int c = m_cellOf[static_cast<size_t>(i)], cx = c % nx, cy = c / nx;
+      // The 3 cells of a row are consecutive in the sorted bodies: one run each.
+      for (int gy = std::max(cy - 1, 0); gy <= std::min(cy + 1, ny - 1); ++gy) {
+        const int from = m_cellStart[static_cast<size_t>(gy * nx + std::max(cx - 1, 0))];
+        const int to = m_cellStart[static_cast<size_t>(gy * nx + std::min(cx + 1, nx - 1)) + 1];
+        for (int q = from; q < to; ++q) {
+          const int j = m_sorted[static_cast<size_t>(q)];
+          if (j > i && within(i, j)) list.add(t, i, j);
+        }
+      }
+    }
+  });
+  if (largeTasks)
+    parallelRanges(n, kGrain, [&](int t, long begin, long end) {
+      for (int l : m_large)
+        for (int j = static_cast<int>(begin); j < end; ++j)
+          if (j != l && !(m_isLarge[static_cast<size_t>(j)] && j < l) && within(l, j)) list.add(gridTasks + t, l, j);
+    });
 }
 
 BroadphaseSettings checkedSettings(const BroadphaseSettings& settings) {
