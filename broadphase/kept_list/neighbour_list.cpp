@@ -267,20 +267,38 @@ void PairsWithinReach::build(const World& world, const std::vector<Real>& h, Rea
     list.begin();
     return;
   }
-  const double sweepTests = sortAlongX(world, h, floor);
-  // Below a few thousand bodies the grid cannot pay for its binning; a grid test gathers its body's
-  // data, about twice a sweep test.
-  if (m_method == Method::Cheaper)
-    m_byGrid = n >= 4096 && 2 * binInGrid(world, h, floor) < sweepTests;
-  else if ((m_byGrid = m_method == Method::Grid))
-    binInGrid(world, h, floor);
-  if (m_byGrid)
+  // Below a few thousand bodies the grid cannot pay for its binning. Above, the grid bins and counts
+  // its tests, the sweep's are estimated from a sample (without its sort), and the cheaper runs; a
+  // grid test gathers its body's data, about twice a sweep test.
+  m_byGrid = m_method == Method::Grid ||
+             (m_method == Method::Cheaper && n >= 4096 && 2 * binInGrid(world, h, floor) < estimateSweep(world, h, floor));
+  if (m_byGrid) {
+    if (m_method == Method::Grid) binInGrid(world, h, floor);
     scanGrid(world, h, floor, list);
-  else
+  } else {
+    sortAlongX(world, h, floor);
     sweep(world, h, floor, list);
+  }
 }
 
-double PairsWithinReach::sortAlongX(const World& world, const std::vector<Real>& h, Real floor) {
+double PairsWithinReach::estimateSweep(const World& world, const std::vector<Real>& h, Real floor) {
+  // Every 16th body's span start, sorted; each sampled body's later span starts inside its span,
+  // counted in the sample and scaled by 16 twice (its own weight, and the sample's).
+  const int n = world.size();
+  constexpr int kEvery = 16;
+  m_scratch.clear();
+  for (int i = 0; i < n; i += kEvery) m_scratch.push_back(world.x[i] - std::max(floor / 2, h[i]));
+  std::sort(m_scratch.begin(), m_scratch.end());
+  double tests = 0;
+  for (int i = 0; i < n; i += kEvery) {
+    const Real e = std::max(floor / 2, h[i]), lo = world.x[i] - e, hi = world.x[i] + e;
+    tests += static_cast<double>(std::upper_bound(m_scratch.begin(), m_scratch.end(), hi) -
+                                 std::upper_bound(m_scratch.begin(), m_scratch.end(), lo));
+  }
+  return tests * kEvery * kEvery;
+}
+
+void PairsWithinReach::sortAlongX(const World& world, const std::vector<Real>& h, Real floor) {
   const int n = world.size();
   const Real* x = world.x.data();
   m_lo.resize(n);
@@ -314,11 +332,6 @@ double PairsWithinReach::sortAlongX(const World& world, const std::vector<Real>&
       m_hi[k] = x[i] + std::max(floor / 2, h[i]);
     }
   });
-  // The sweep's tests: for each body, the later spans that start inside its own (a binary search).
-  double tests = 0;
-  for (int k = 0; k < n; ++k)
-    tests += static_cast<double>(std::upper_bound(m_sortedLo.begin() + k + 1, m_sortedLo.end(), m_hi[k]) - (m_sortedLo.begin() + k + 1));
-  return tests;
 }
 
 void PairsWithinReach::sweep(const World&, const std::vector<Real>&, Real floor, NeighbourList& list) {

@@ -123,7 +123,7 @@ Real largestFloeRadius(const World& world);
 // The build of variable_radius, fixed_radius and triangulation_mesh: lists every pair with
 // |c_a - c_b| <= max(floor, h_a + h_b), h one length per body and floor one length for all. With
 // e = max(floor / 2, h), a pair the rule accepts has |c_a - c_b| <= e_a + e_b. Two exact methods
-// find them; each first counts the pair tests it would make, and the cheaper one runs (the list is
+// find them; each first counts (the sweep: estimates) the pair tests it would make, and the cheaper one runs (the list is
 // the same either way: NeighbourList::finish sorts it):
 // - a sweep along x: each body spans [x - e, x + e] and meets the bodies whose spans start inside
 //   its own. Lean in a channel, long in x; about n^1.5 tests in a square field.
@@ -146,7 +146,8 @@ class PairsWithinReach {
   bool lastBuiltByGrid() const { return m_byGrid; }
 
  private:
-  double sortAlongX(const World& world, const std::vector<Real>& h, Real floor);  // returns the sweep's tests
+  double estimateSweep(const World& world, const std::vector<Real>& h, Real floor);  // its tests, from a sample
+  void sortAlongX(const World& world, const std::vector<Real>& h, Real floor);
   void sweep(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list);
   double binInGrid(const World& world, const std::vector<Real>& h, Real floor);  // returns the grid's tests
   void scanGrid(const World& world, const std::vector<Real>& h, Real floor, NeighbourList& list);

@@ -413,14 +413,15 @@ void CpuStepper::step() {
 
   // 4. Solo events, from the state at the start of the step.
   m_soloBodies.resize(n);
-  for (int i = 0; i < n; ++i) {
-    const PairBody& p = m_pairBodies[i];
-    m_soloBodies[i] = SoloBody{p.kind, p.dof, p.position, p.angle, p.velocity, p.omega, p.mass, p.area, p.thickness};
-  }
-  m_changes.assign(n, VelocityChange{{0, 0}, 0});
-  // Each body's solo events, in their order, over contiguous ranges of bodies (a body's change is
-  // its own: the ranges never meet).
+  m_changes.resize(n);
+  // Each body's solo events, in their order, over contiguous ranges of bodies (a body's view and
+  // change are its own: the ranges never meet).
   forEachRange(n, [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      const PairBody& p = m_pairBodies[i];
+      m_soloBodies[i] = SoloBody{p.kind, p.dof, p.position, p.angle, p.velocity, p.omega, p.mass, p.area, p.thickness};
+      m_changes[i] = VelocityChange{{0, 0}, 0};
+    }
     const SoloPhaseData soloData{m_soloBodies.data() + begin, m_changes.data() + begin, end - begin, ctx};
     for (auto& e : m_events)
       if (e.phase == EventPhase::Solo) e.instance->runSolo(soloData);
