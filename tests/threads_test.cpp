@@ -27,6 +27,10 @@ struct ThreadedRun {
   std::vector<std::int64_t> ids;
   std::vector<Real> state;
   long contacts = 0, impactRows = 0, broken = 0;
+  int mostContacts = 0;  // in one step
+  // Every record's tag (event, contact, world), stream by stream, step by step: the rows' order
+  // and the contacts they name (the pair events run over ranges of contacts, their rows joined).
+  std::vector<std::int32_t> tags;
   int candidates = 0;  // the last step's
   long rebuilds = 0;   // the broadphase's
 };
@@ -39,7 +43,14 @@ ThreadedRun runWithThreads(const Scenario& base, int threads, int steps) {
   for (int k = 0; k < steps; ++k) {
     sim.step();
     r.contacts += sim.contactCount();
-    for (int q = 0; q < sim.records().streams().count(); ++q) r.impactRows += sim.records().rowCount(q);
+    r.mostContacts = std::max(r.mostContacts, sim.contactCount());
+    for (int q = 0; q < sim.records().streams().count(); ++q) {
+      r.impactRows += sim.records().rowCount(q);
+      for (int row = 0; row < sim.records().rowCount(q); ++row) {
+        const RecordTag& tag = sim.records().tag(q, row);
+        r.tags.insert(r.tags.end(), {q, tag.event, tag.contact, tag.world});
+      }
+    }
   }
   EXPECT_EQ(sim.threads(), threads);
   r.broken = sim.floesBroken();
@@ -58,6 +69,7 @@ void expectSame(const ThreadedRun& one, const ThreadedRun& many, int threads) {
   EXPECT_EQ(0, std::memcmp(one.state.data(), many.state.data(), one.state.size() * sizeof(Real)));
   EXPECT_EQ(one.contacts, many.contacts);
   EXPECT_EQ(one.impactRows, many.impactRows);
+  EXPECT_EQ(one.tags, many.tags);
   EXPECT_EQ(one.broken, many.broken);
   EXPECT_EQ(one.rebuilds, many.rebuilds);
 }
@@ -130,6 +142,20 @@ TEST(Threads, KeptListsBuildAndFilterTheSameOnAnyThreadCount) {
     EXPECT_GE(one->rebuilds(), 6) << "the lists were not rebuilt: the build's parallel parts went untested";
     EXPECT_TRUE(sawDirect) << "no floe was direct: the direct pass went untested";
   }
+}
+
+// A pack driven against a wall by a strong current: thousands of contacts a step, so the pair
+// events run over ranges of contacts on the pool, their records joined in order
+// (CpuStepper::kParallelContacts).
+TEST(Threads, APackPressedAgainstAWallStepsBitForBitOnOneAndThreeThreads) {
+  test::TempDir dir;
+  const Scenario s =
+      test::scenarioFromToml(dir, std::string(test::kBusyScene) + "[events.current]\nspeed = 3.0\nspeed_direction_deg = -90.0\n",
+                             {"simulation.steps=150", "field.concentration=0.8", "domain.x=[0.0, 300.0]", "domain.y=[-150.0, 150.0]"});
+  const ThreadedRun one = runWithThreads(s, 1, 150);
+  ASSERT_GE(one.mostContacts, CpuStepper::kParallelContacts) << "too few contacts for the pair events to run on the pool";
+  EXPECT_GT(one.impactRows, 0);
+  expectSame(one, runWithThreads(s, 3, 150), 3);
 }
 
 TEST(Threads, ABrokenFieldStepsBitForBitOnThreeThreads) {

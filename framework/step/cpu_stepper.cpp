@@ -1,6 +1,7 @@
 #include "framework/step/cpu_stepper.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <optional>
 #include <cmath>
 #include <map>
@@ -370,45 +371,86 @@ void CpuStepper::step() {
   });
   const int contacts = static_cast<int>(m_contacts.size());
   m_slots.assign(contacts, PairSlot{{0, 0}});
-  // Records: each stream has room for one row per contact at first; an event may push more (a
-  // log of several rows), and then the buffer grows and the phase runs again (pair events only
-  // write their slots and records, so running them again is running them once).
+  // The pair events, event by event, each over contiguous ranges of contacts (a contact's slot is
+  // its own; an event's apply is a function of its contact, as on the device). Each range pushes
+  // its records into buffers of its own, with the contact numbered within the range; they are
+  // joined below event by event, range by range, the numbers shifted to the step's: the very rows,
+  // in the very order, of one pass over all contacts. Each stream has room for one row per contact
+  // at first; an event may push more (a log of several rows), and then the buffers grow and the
+  // phase runs again (pair events only write their slots and records, so running them again is
+  // running them once).
   const int streams = m_streams.count();
-  if (static_cast<int>(m_recordRoom.size()) != streams) m_recordRoom.assign(static_cast<size_t>(streams), 0);
-  m_recordRows.resize(static_cast<size_t>(streams));
-  std::vector<int> counts(static_cast<size_t>(streams));
+  const int ranges = m_pool && contacts >= kParallelContacts ? std::min(contacts / kContactGrain, 4 * m_pool->size()) : 1;
+  auto rangeStart = [&](int t) { return static_cast<int>(static_cast<long>(contacts) * t / ranges); };
+  const size_t cells = static_cast<size_t>(ranges) * static_cast<size_t>(streams);
+  m_pairRecordRows.resize(std::max(m_pairRecordRows.size(), cells));
+  m_pairRecordRoom.resize(std::max(m_pairRecordRoom.size(), cells), 0);
+  std::vector<int> counts(cells);
+  std::vector<int> ends;  // per pair event, range and stream: the rows pushed by then
   for (;;) {
-    RecordSink sink{};
-    for (int s = 0; s < streams; ++s) {
-      int& room = m_recordRoom[static_cast<size_t>(s)];
-      room = std::max(room, contacts);
-      m_recordRows[static_cast<size_t>(s)].resize(static_cast<size_t>(room) * static_cast<size_t>(m_streams.info(s).stride));
-      counts[static_cast<size_t>(s)] = 0;
-      sink.streams[s] =
-          RecordBuffer{m_recordRows[static_cast<size_t>(s)].data(), m_streams.info(s).stride, room, &counts[static_cast<size_t>(s)]};
-    }
-    PairPhaseData pairData{
-        m_pairBodies.data(), m_contactA.data(), m_contactB.data(), m_contacts.data(), m_slots.data(), contacts, ctx, sink, 0};
-    for (auto& e : m_events)
-      if (e.phase == EventPhase::Pair) {
+    std::vector<RecordSink> sinks(static_cast<size_t>(ranges));
+    for (int t = 0; t < ranges; ++t)
+      for (int s = 0; s < streams; ++s) {
+        const size_t c = static_cast<size_t>(t) * static_cast<size_t>(streams) + static_cast<size_t>(s);
+        int& room = m_pairRecordRoom[c];
+        room = std::max(room, rangeStart(t + 1) - rangeStart(t));
+        m_pairRecordRows[c].resize(static_cast<size_t>(room) * static_cast<size_t>(m_streams.info(s).stride));
+        counts[c] = 0;
+        sinks[static_cast<size_t>(t)].streams[s] = RecordBuffer{m_pairRecordRows[c].data(), m_streams.info(s).stride, room, &counts[c]};
+      }
+    ends.clear();
+    int event = 0;
+    for (auto& e : m_events) {
+      if (e.phase != EventPhase::Pair) continue;
+      const size_t first = ends.size();
+      ends.resize(first + cells);
+      auto range = [&](int t) {
+        const int begin = rangeStart(t);
+        const PairPhaseData pairData{m_pairBodies.data(),
+                                     m_contactA.data() + begin,
+                                     m_contactB.data() + begin,
+                                     m_contacts.data() + begin,
+                                     m_slots.data() + begin,
+                                     rangeStart(t + 1) - begin,
+                                     ctx,
+                                     sinks[static_cast<size_t>(t)],
+                                     event};
         e.instance->runPairs(pairData);
-        ++pairData.event;
-      }
-    bool overflow = false;
-    for (int s = 0; s < streams; ++s)
-      if (counts[static_cast<size_t>(s)] > m_recordRoom[static_cast<size_t>(s)]) {
-        m_recordRoom[static_cast<size_t>(s)] = counts[static_cast<size_t>(s)];
-        overflow = true;
-      }
-    if (overflow) {
-      m_slots.assign(contacts, PairSlot{{0, 0}});
-      continue;
+        for (int s = 0; s < streams; ++s) {
+          const size_t c = static_cast<size_t>(t) * static_cast<size_t>(streams) + static_cast<size_t>(s);
+          ends[first + c] = counts[c];
+        }
+      };
+      if (ranges > 1)
+        m_pool->run(ranges, range);
+      else
+        range(0);
+      ++event;
     }
-    break;
+    bool overflow = false;
+    for (size_t c = 0; c < cells; ++c)
+      if (counts[c] > m_pairRecordRoom[c]) m_pairRecordRoom[c] = counts[c], overflow = true;
+    if (!overflow) break;
+    m_slots.assign(contacts, PairSlot{{0, 0}});
   }
-  // Rows are in the CPU's order as pushed: event by event, contact by contact.
   m_records.clear();
-  for (int s = 0; s < streams; ++s) m_records.append(s, m_recordRows[static_cast<size_t>(s)].data(), counts[static_cast<size_t>(s)]);
+  const int events = static_cast<int>(ends.size() / std::max<size_t>(cells, 1));
+  for (int s = 0; s < streams; ++s) {
+    const size_t stride = static_cast<size_t>(m_streams.info(s).stride);
+    for (int event = 0; event < events; ++event)
+      for (int t = 0; t < ranges; ++t) {
+        const size_t c = static_cast<size_t>(t) * static_cast<size_t>(streams) + static_cast<size_t>(s);
+        const int from = event ? ends[static_cast<size_t>(event - 1) * cells + c] : 0, to = ends[static_cast<size_t>(event) * cells + c];
+        unsigned char* rows = m_pairRecordRows[c].data();
+        for (int row = from; t > 0 && row < to; ++row) {  // the contact's number in the step
+          RecordTag tag;
+          std::memcpy(&tag, rows + static_cast<size_t>(row) * stride, sizeof tag);
+          tag.contact += rangeStart(t);
+          std::memcpy(rows + static_cast<size_t>(row) * stride, &tag, sizeof tag);
+        }
+        m_records.append(s, rows + static_cast<size_t>(from) * stride, to - from);
+      }
+  }
   deliverLogs(m_records);
 
   // 4. Solo events, from the state at the start of the step.

@@ -59,6 +59,8 @@ class CpuStepper final : public Stepper {
   int threads() const { return m_pool ? m_pool->size() : 1; }  // after the first step
   // The sizes from which a phase runs on the pool at all (docs/performance.md 3.8).
   static constexpr int kParallelBodies = 2048, kParallelPairs = 2048;
+  // Contacts from which the pair events run over ranges of contacts, kContactGrain at least a range.
+  static constexpr int kParallelContacts = 512, kContactGrain = 128;
   // Bodies or pairs a task takes at least: a small field wakes few threads (on 16 cores, waking all
   // of them for the 456-hexagon field made its step 1.3x slower than one thread's).
   static constexpr int kGrain = 512;
@@ -143,10 +145,12 @@ class CpuStepper final : public Stepper {
   }
   // The gather's contacts of each body, in contact order (k x 2 + side, side 1 for b).
   std::vector<int> m_bodyContactStart, m_bodyContactFill, m_bodyContacts;
-  RecordStreams m_streams;                               // opened by the events as their Params are parsed
-  StepRecords m_records;                                 // the last step's rows
-  std::vector<std::vector<unsigned char>> m_recordRows;  // per stream: the pair phase's buffer
-  std::vector<int> m_recordRoom;                         // per stream: rows the buffer holds
+  RecordStreams m_streams;  // opened by the events as their Params are parsed
+  StepRecords m_records;    // the last step's rows
+  // The pair phase's record buffers, per range of contacts and stream (range x streams + stream),
+  // and the rows each holds.
+  std::vector<std::vector<unsigned char>> m_pairRecordRows;
+  std::vector<int> m_pairRecordRoom;
   Vec2 m_vesselIceForce{0, 0};
   std::vector<Real> m_contactForceOfSlot;                      // |sum of a body's contact impulses| / dt, N
   std::vector<std::pair<std::int64_t, Real>> m_contactForces;  // the non-zero ones by id (contactForces())
