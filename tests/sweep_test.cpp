@@ -265,14 +265,8 @@ TEST(Sweep, FieldFileStaysValidInTheCaseScenario) {
   EXPECT_NO_THROW(loadScenario(scenario));
 }
 
-TEST(Sweep, FailingCaseExitsOneAndOthersAreGathered) {
-  TempDir dir;
-  dir.write("base.toml", kBase);
-  // "bad" puts a floe on the vessel: valid input, refused when the run builds its world.
-  const fs::path file = dir.write("study.toml", R"([sweep]
-base = "base.toml"
-set = { "simulation.steps" = 10 }
-[[cases]]
+// Three cases; "bad" puts a floe on the vessel: valid input, refused when the run builds its world.
+const char* const kCasesOneCannotBeBuilt = R"([[cases]]
 name = "good"
 [[cases]]
 name = "bad"
@@ -280,7 +274,13 @@ set = { floes = [{ vertices = [[-20.0, -2.0], [-10.0, -2.0], [-10.0, 2.0], [-20.
 [[cases]]
 name = "also_good"
 set = { "vessel.bollard_thrust" = 46e3 }
-)");
+)";
+
+TEST(Sweep, FailingCaseExitsOneAndOthersAreGathered) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file =
+      dir.write("study.toml", std::string("[sweep]\nbase = \"base.toml\"\nset = { \"simulation.steps\" = 10 }\n") + kCasesOneCannotBeBuilt);
   const fs::path out = dir.path() / "out", log = dir.path() / "log.txt";
   ASSERT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --jobs 2", log), 1);
   EXPECT_NE(test::readFile(log).find("case bad failed"), std::string::npos) << test::readFile(log);
@@ -528,18 +528,9 @@ TEST(Sweep, CasesRunTogetherWriteTheOutputsOfSingleRuns) {
 TEST(Sweep, ACaseThatCannotBeBuiltFailsAloneAndTheOthersStillRunTogether) {
   TempDir dir;
   dir.write("base.toml", kBase);
-  const fs::path file = dir.write("study.toml", R"([sweep]
-base = "base.toml"
-set = { "simulation.steps" = 10, "simulation.backend" = "cuda" }
-[[cases]]
-name = "good"
-[[cases]]
-name = "bad"
-set = { floes = [{ vertices = [[-20.0, -2.0], [-10.0, -2.0], [-10.0, 2.0], [-20.0, 2.0]] }] }
-[[cases]]
-name = "also_good"
-set = { "vessel.bollard_thrust" = 46e3 }
-)");
+  const fs::path file = dir.write(
+      "study.toml", std::string("[sweep]\nbase = \"base.toml\"\nset = { \"simulation.steps\" = 10, \"simulation.backend\" = \"cuda\" }\n") +
+                        kCasesOneCannotBeBuilt);
   TogetherBackend backend;
   SweepOptions o;
   o.sweepFile = file.string();
