@@ -28,11 +28,19 @@ std::string valueText(const toml::node& v) {
   if (auto s = v.value_exact<std::string>()) return *s;
   std::string out;
   if (const toml::array* a = v.as_array()) {
-    for (const toml::node& e : *a) out += (out.empty() ? "[" : ",") + valueText(e);
+    for (const toml::node& e : *a) {
+      out += out.empty() ? '[' : ',';  // appended one by one: GCC 12 warns falsely (-Wrestrict) on "x" + string&&
+      out += valueText(e);
+    }
     return out.empty() ? "[]" : out + "]";
   }
   if (const toml::table* t = v.as_table()) {
-    for (const auto& [k, e] : *t) out += (out.empty() ? "{" : ",") + std::string(k.str()) + "=" + valueText(e);
+    for (const auto& [k, e] : *t) {
+      out += out.empty() ? '{' : ',';
+      out += k.str();
+      out += '=';
+      out += valueText(e);
+    }
     return out.empty() ? "{}" : out + "}";
   }
   return "";
