@@ -18,6 +18,7 @@
 
 #include "framework/output/atomic_file.hpp"
 #include "framework/output/csv.hpp"
+#include "framework/output/output_path.hpp"
 #include "framework/api/errors.hpp"
 #include "framework/field/field_generator.hpp"
 #include "bench/geometry_bench.hpp"
@@ -609,13 +610,10 @@ void runTable(const TableRun& run, const std::string& name) {
 
 // --csv: a file for one table; a directory with TABLE.csv for "all", or when it is a directory
 // already or ends in '/'.
+bool csvIsFolder(const BenchOptions& o) { return o.table == "all" || o.csv.back() == '/' || fs::is_directory(o.csv); }
 std::string csvPathFor(const BenchOptions& o, const std::string& table) {
   if (o.csv.empty()) return "";
-  if (o.table == "all" || o.csv.back() == '/' || fs::is_directory(o.csv)) {
-    fs::create_directories(o.csv);
-    return (fs::path(o.csv) / (table + ".csv")).string();
-  }
-  return o.csv;
+  return csvIsFolder(o) ? (fs::path(o.csv) / (table + ".csv")).string() : o.csv;
 }
 
 }  // namespace
@@ -637,6 +635,13 @@ int runBench(const BenchOptions& o) {
   if (o.threads < 1 || o.threads > 1024) throw InputError(fmt::format("gem bench --threads {}: from 1 to 1024", o.threads));
   g_cpuThreads = o.threads;
   for (const std::string& b : o.broadphases) Registry::global().broadphase(b);
+  // Where the CSV goes, made and checked before any timing.
+  if (!o.csv.empty()) {
+    if (csvIsFolder(o))
+      requireOutputFolder(o.csv, "gem bench --csv");
+    else
+      requireOutputFile(o.csv, "gem bench --csv");
+  }
 
   CaseScenarios scenarios;
   if (o.table != "all") {

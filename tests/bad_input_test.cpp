@@ -147,11 +147,43 @@ TEST(BadInputCli, NotAScenarioFileAndBadNumbersOnTheCommandLine) {
   // A file where the run folder (or a folder above it) should be: exit 2 naming it.
   const auto file = dir.write("a_file", "x");
   EXPECT_EQ(gem::test::runGem("run " + good.string() + " --quiet --out " + (file / "run").string(), log), 2);
-  EXPECT_NE(gem::test::readFile(log).find(file.string() + ": a file, not a folder"), std::string::npos) << gem::test::readFile(log);
+  EXPECT_NE(gem::test::readFile(log).find(file.string() + " is a file, not a folder"), std::string::npos) << gem::test::readFile(log);
   // A 5 MB token in an unknown key is not echoed whole.
   const auto huge = dir.write("huge.toml", kSim + "[simulation.extra]\n" + std::string(5000000, 'k') + " = 1\n");
   EXPECT_EQ(gem::test::runGem("check " + huge.string(), log), 2);
   EXPECT_LT(std::filesystem::file_size(log), 2000u) << "the message echoes the whole token";
+}
+
+// Every output place named on the command line (--out, --csv) is checked before any work: a file
+// where a folder must be is exit 2, one line naming the option and the path, and nothing is run
+// (no benchmark row, no calibration impact, no case folder).
+TEST(BadInputCli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeAnyWork) {
+  TempDir dir;
+  const auto file = dir.write("a_file", "x");
+  const std::string blocked = (file / "below").string();
+  const auto log = dir.path() / "log.txt";
+  const auto sweepFile = dir.write("study.toml", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n");
+  dir.write("base.toml", kSim);
+  const struct {
+    std::string arguments, option;
+  } cases[] = {
+      {"bench --cases 100 --steps 10 --csv " + blocked + "/x.csv", "gem bench --csv"},
+      {"bench --cases 100 --steps 10 --csv " + blocked + "/", "gem bench --csv"},
+      {"calibrate --out " + blocked, "gem calibrate --out"},
+      {"sweep " + sweepFile.string() + " --out " + blocked, "gem sweep --out"},
+      {"movie " + dir.path().string() + " --out " + blocked + "/m.mp4", "gem movie --out"},
+      {"view " + dir.path().string() + " --out " + blocked + "/v.html", "gem view --out"},
+  };
+  for (const auto& c : cases) {
+    EXPECT_EQ(gem::test::runGem(c.arguments, log), 2) << c.arguments;
+    const std::string text = gem::test::readFile(log);
+    EXPECT_NE(text.find(c.option), std::string::npos) << c.arguments << ": " << text;
+    EXPECT_NE(text.find(file.string() + " is a file, not a folder"), std::string::npos) << c.arguments << ": " << text;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message, nothing run before it: " << text;
+  }
+  // A folder where the page should be.
+  EXPECT_EQ(gem::test::runGem("view " + dir.path().string() + " --out " + dir.path().string(), log), 2);
+  EXPECT_NE(gem::test::readFile(log).find("a folder, not a file"), std::string::npos) << gem::test::readFile(log);
 }
 
 // A bad value given by --set is blamed on the --set, not on the scenario file that never held it:

@@ -25,6 +25,7 @@
 #include "framework/app/run_log.hpp"
 #include "framework/app/runner.hpp"
 #include "framework/output/checkpoint.hpp"
+#include "framework/output/output_path.hpp"
 #include "framework/scenario/scenario.hpp"
 #include "framework/step/cpu_stepper.hpp"
 #include "framework/app/mpi_work.hpp"
@@ -366,6 +367,11 @@ int main(int argc, char** argv) {
     catchInterrupts();  // Ctrl-C and SIGTERM stop a run between two steps, its files kept whole
     if (*run) return commandRun(args);
     if (*check) return commandCheck(args);
+    // Output places named on the command line, checked before any work (framework/output/output_path.hpp).
+    if (*sweepCommand && !sweep.outDir.empty()) requireOutputFolder(sweep.outDir, "gem sweep --out");
+    if (*calibrateCommand) requireOutputFolder(calibrationOut, "gem calibrate --out");
+    if (*movieCommand && !movieOut.empty()) requireOutputFile(movieOut, "gem movie --out");
+    if (*viewCommand && !view.out.empty()) requireOutputFile(view.out, "gem view --out");
     if (*benchCommand) return runBench(bench);
     if (*sweepCommand) return runSweep(sweep);
     if (*analyzeCommand) return runAnalyze(analyze);

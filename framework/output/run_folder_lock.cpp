@@ -11,18 +11,14 @@
 #include <fmt/format.h>
 
 #include "framework/api/errors.hpp"
+#include "framework/output/output_path.hpp"
 
 namespace gem {
 
 RunFolderLock::RunFolderLock(const std::filesystem::path& dir) : m_file(dir / ".gem-run.lock") {
-  // The run folder must be a folder: a file in its place (or in the place of a folder above it) is
-  // bad input, said with the path, not a filesystem exception.
-  std::error_code ec;
-  for (std::filesystem::path p = dir; !p.empty() && p != p.root_path(); p = p.parent_path())
-    if (std::filesystem::exists(p, ec) && !std::filesystem::is_directory(p, ec))
-      throw InputError(fmt::format("{}: a file, not a folder: the run folder {} cannot be made there", p.string(), dir.string()));
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw InputError(fmt::format("{}: cannot make the run folder: {}", dir.string(), ec.message()));
+  // The run folder must be a folder this process can write: a file in its place (or in the place
+  // of a folder above it) is bad input, said with the path, not a filesystem exception.
+  requireOutputFolder(dir, "the run folder");
   m_fd = ::open(m_file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (m_fd < 0) throw InputError(fmt::format("{}: cannot open the run folder's lock: {}", dir.string(), std::strerror(errno)));
   if (::flock(m_fd, LOCK_EX | LOCK_NB) != 0) {

@@ -1,0 +1,35 @@
+#include "framework/output/output_path.hpp"
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
+
+namespace fs = std::filesystem;
+
+namespace gem {
+namespace {
+
+// `folder` made and writable, for `what` ("gem sweep --out runs/x"), which it holds or is.
+void makeWritableFolder(const fs::path& folder, const std::string& what) {
+  std::error_code ec;
+  for (fs::path p = folder; !p.empty() && p != p.root_path(); p = p.parent_path())
+    if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw InputError(fmt::format("{}: {} is a file, not a folder", what, p.string()));
+  fs::create_directories(folder, ec);
+  if (ec) throw InputError(fmt::format("{}: cannot make the folder {}: {}", what, folder.string(), ec.message()));
+  if (::access(folder.c_str(), W_OK | X_OK) != 0) throw InputError(fmt::format("{}: cannot write in the folder {}", what, folder.string()));
+}
+
+}  // namespace
+
+void requireOutputFolder(const fs::path& dir, const std::string& option) { makeWritableFolder(dir, option + " " + dir.string()); }
+
+void requireOutputFile(const fs::path& file, const std::string& option) {
+  const std::string what = option + " " + file.string();
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) throw InputError(fmt::format("{}: a folder, not a file", what));
+  makeWritableFolder(file.parent_path().empty() ? fs::path(".") : file.parent_path(), what);
+}
+
+}  // namespace gem
