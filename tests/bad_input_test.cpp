@@ -186,6 +186,25 @@ TEST(BadInputCli, AnOutputPlaceThatCannotBeWrittenIsRefusedBeforeAnyWork) {
   EXPECT_NE(gem::test::readFile(log).find("a folder, not a file"), std::string::npos) << gem::test::readFile(log);
 }
 
+// Numeric options out of their range are refused with a short message naming the option and the
+// range (CLI11's open-ended checks printed the largest double as the bound), before any work.
+TEST(BadInputCli, ANumericOptionOutOfRangeNamesItsRange) {
+  TempDir dir;
+  dir.write("base.toml", kSim);
+  const auto sweepFile = dir.write("study.toml", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n");
+  const auto log = dir.path() / "log.txt";
+  const std::string out = " --out " + (dir.path() / "out").string();
+  for (const std::string arguments :
+       {"sweep " + sweepFile.string() + " --jobs -2" + out, "sweep " + sweepFile.string() + " --batch -1" + out,
+        "sweep " + sweepFile.string() + " --case-index -1" + out, "view " + dir.path().string() + " --every 0"}) {
+    EXPECT_EQ(gem::test::runGem(arguments, log), 2) << arguments;
+    const std::string text = gem::test::readFile(log);
+    EXPECT_NE(text.find("not in range"), std::string::npos) << arguments << ": " << text;
+    EXPECT_LT(text.size(), 200u) << arguments << ": " << text;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "summary.csv")) << arguments;
+  }
+}
+
 // A bad value given by --set is blamed on the --set, not on the scenario file that never held it:
 // scenario keys, event parameters, unknown keys and bodies.
 TEST(BadInputCli, ABadSetValueNamesTheSet) {

@@ -337,19 +337,21 @@ int main(int argc, char** argv) {
   viewCommand->add_option("dir", view.dir, "run folder (with frames.ice)")->required();
   viewCommand->add_option("--out", view.out, "the page (default DIR/view.html)");
   viewCommand->add_option("--every", view.every, "keep every N-th frame and the last (default: all, thinned above 300 MB)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1000000000));
   viewCommand->add_flag("--quiet", view.quiet, "print nothing but errors");
 
   SweepOptions sweep;
   CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
   sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
   sweepCommand->add_option("--out", sweep.outDir, "sweep folder (default runs/NAME)");
-  sweepCommand->add_option("--jobs", sweep.jobs, "cases run at once (default: all cores)");
-  sweepCommand->add_option("--case-index", sweep.caseIndex, "run only case I (0-based), e.g. in a job array");
+  // Bounded ranges: CLI11's PositiveNumber and NonNegativeNumber print the largest double in their message.
+  sweepCommand->add_option("--jobs", sweep.jobs, "cases run at once (default 0: all cores)")->check(CLI::Range(0, 65536));
+  sweepCommand->add_option("--case-index", sweep.caseIndex, "run only case I (0-based), e.g. in a job array")
+      ->check(CLI::Range(0L, 100000L));
   sweepCommand
       ->add_option("--batch", sweep.batch,
                    "on a GPU, the most cases run together in one device state (default 0: automatic; 1: one case at a time)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 100000));
   sweepCommand->add_flag("--quiet", sweep.quiet, "no progress");
   sweepCommand->add_option("--set", sweep.set, "override a scenario key in every case: --set simulation.dt=0.05")->take_all();
   sweepCommand->add_option("--backend", sweep.backend, "auto, cpu or cuda, for every case");
