@@ -49,6 +49,24 @@ GEM_HD inline void emitVertex(ClipVertex* dst, int* k, Vec2 p, signed char in, s
   }
 }
 
+// The merge tolerance of clipConvex for polygons p (n vertices) and q (m): vertices closer than
+// this are one vertex. Relative to the smaller body (the overlap's scale) and to the coordinate
+// magnitude (the rounding of world coordinates).
+GEM_HD inline Real clipTolerance(const Vec2* p, int n, const Vec2* q, int m) {
+  Real extP, magP, extQ, magQ;
+  extentAndMagnitude(p, n, &extP, &magP);
+  extentAndMagnitude(q, m, &extQ, &magQ);
+  return kGeomRelTol * (minR(extP, extQ) + maxR(magP, magQ));
+}
+
+// Which side of the clip line through a along e the point x lies on: >= 0 is inside (left of a
+// counter-clockwise edge of Q), < 0 outside.
+GEM_HD inline Real clipSide(Vec2 a, Vec2 e, Vec2 x) { return cross(e, x - a); }
+
+// Where the segment prev -> cur, with sides sPrev and sCur of opposite signs, crosses the clip
+// line. The signs differ, so the denominator is never zero.
+GEM_HD inline Vec2 clipCrossing(Vec2 prev, Real sPrev, Vec2 cur, Real sCur) { return prev + (sPrev / (sPrev - sCur)) * (cur - prev); }
+
 // Closes the ring: merges the last vertex into the first while they coincide.
 GEM_HD inline int closeRing(ClipVertex* v, int k, Real tol) {
   while (k > 1 && nearPoint(v[k - 1].p, v[0].p, tol)) {
@@ -67,12 +85,7 @@ GEM_HD inline int closeRing(ClipVertex* v, int k, Real tol) {
 // tagged 0 and the crossings are where the other boundary leaves it.
 GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVertex* out) {
   if (n < 3 || m < 3) return 0;
-  Real extP, magP, extQ, magQ;
-  detail::extentAndMagnitude(p, n, &extP, &magP);
-  detail::extentAndMagnitude(q, m, &extQ, &magQ);
-  // Vertices closer than this are one vertex: relative to the smaller body (the overlap's scale)
-  // and to the coordinate magnitude (the rounding of world coordinates).
-  Real tol = kGeomRelTol * (detail::minR(extP, extQ) + detail::maxR(magP, magQ));
+  const Real tol = detail::clipTolerance(p, n, q, m);
 
   ClipVertex tmp[kMaxClipVertices];
   ClipVertex* src = out;
@@ -86,7 +99,7 @@ GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVer
     // Signed test: cross(e, x - a) >= 0 is inside (left of a counter-clockwise edge).
     bool anyOut = false, anyIn = false;
     for (int i = 0; i < k && !(anyOut && anyIn); ++i) {
-      if (cross(e, src[i].p - a) < Real(0)) {
+      if (detail::clipSide(a, e, src[i].p) < Real(0)) {
         anyOut = true;
       } else {
         anyIn = true;
@@ -97,20 +110,17 @@ GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVer
 
     int kk = 0;
     Vec2 prev = src[k - 1].p;
-    Real sPrev = cross(e, prev - a);
+    Real sPrev = detail::clipSide(a, e, prev);
     for (int i = 0; i < k; ++i) {
       ClipVertex cur = src[i];
-      Real sCur = cross(e, cur.p - a);
-      // Signs differ on a crossing, so the denominator is never zero.
+      Real sCur = detail::clipSide(a, e, cur.p);
       if (sCur >= Real(0)) {
         if (sPrev < Real(0)) {  // entering Q's half-plane: arrive along Q, leave along the edge
-          Vec2 x = prev + (sPrev / (sPrev - sCur)) * (cur.p - prev);
-          detail::emitVertex(dst, &kk, x, 1, cur.inEdge, tol);
+          detail::emitVertex(dst, &kk, detail::clipCrossing(prev, sPrev, cur.p, sCur), 1, cur.inEdge, tol);
         }
         detail::emitVertex(dst, &kk, cur.p, cur.inEdge, cur.outEdge, tol);
       } else if (sPrev >= Real(0)) {  // leaving: arrive along the edge, continue along Q
-        Vec2 x = prev + (sPrev / (sPrev - sCur)) * (cur.p - prev);
-        detail::emitVertex(dst, &kk, x, cur.inEdge, 1, tol);
+        detail::emitVertex(dst, &kk, detail::clipCrossing(prev, sPrev, cur.p, sCur), cur.inEdge, 1, tol);
       }
       prev = cur.p;
       sPrev = sCur;

@@ -66,14 +66,27 @@ GEM_HD inline int apexVertex(const ClipVertex* v, int k, signed char tag, Vec2 c
 // the right of cross0 -> cross1. This is exact from the tags; only when the chosen pair does not
 // have one crossing of each kind (possible with more than 2) does the tie-break
 // dot(n, cQ - cP) >= 0 decide.
+//
+// computeContact is the separating-axis test, clipConvex, then contactOfOverlap: a driver that
+// finds the overlap polygon another way (the resident CUDA driver clips a pair with a whole warp)
+// calls contactOfOverlap on it, so the contact itself is written once.
+GEM_HD inline Contact contactOfOverlap(const ClipVertex* v, int k, const Vec2* p, int n, Vec2 centroidP, const Vec2* q, int m,
+                                       Vec2 centroidQ);
+
 GEM_HD inline Contact computeContact(const Vec2* p, int n, Vec2 centroidP, const Vec2* q, int m, Vec2 centroidQ) {
-  Contact ct{};
-  ct.apexVertexQ = ct.apexVertexP = -1;
   // Most candidate pairs from a broadphase are apart: the separating-axis test rejects them
   // faster than the clipping does.
-  if (!convexOverlap(p, n, q, m)) return ct;
+  if (!convexOverlap(p, n, q, m)) return contactOfOverlap(nullptr, 0, p, n, centroidP, q, m, centroidQ);
   ClipVertex v[kMaxClipVertices];
-  int k = clipConvex(p, n, q, m, v);
+  const int k = clipConvex(p, n, q, m, v);
+  return contactOfOverlap(v, k, p, n, centroidP, q, m, centroidQ);
+}
+
+// The contact of p and q from their overlap polygon v[0..k) as clipConvex writes it (k < 3: none).
+GEM_HD inline Contact contactOfOverlap(const ClipVertex* v, int k, const Vec2* p, int n, Vec2 centroidP, const Vec2* q, int m,
+                                       Vec2 centroidQ) {
+  Contact ct{};
+  ct.apexVertexQ = ct.apexVertexP = -1;
   if (k < 3) return ct;
 
   // Area, centroid and bounding box of the overlap in one pass, about v[0] for precision.

@@ -101,9 +101,12 @@ GEM_HD inline Real interiorAngle(const Vec2* v, int n, int i) {
 
 // World vertices of a body: body-frame vertices (about the centroid) rotated by angle and
 // shifted to the centroid position (what A.24 to A.30 do in polar form).
+// One vertex of toWorld: c and s are the cosine and sine of the body's angle.
+GEM_HD inline Vec2 toWorldPoint(Vec2 local, Vec2 position, Real c, Real s) { return position + rotate(local, c, s); }
+
 GEM_HD inline void toWorld(const Vec2* local, int n, Vec2 position, Real angle, Vec2* world) {
   Real c = std::cos(angle), s = std::sin(angle);
-  for (int i = 0; i < n; ++i) world[i] = position + rotate(local[i], c, s);
+  for (int i = 0; i < n; ++i) world[i] = toWorldPoint(local[i], position, c, s);
 }
 
 // World-aligned bounding box: the narrowphase's first, cheapest rejection.

@@ -194,7 +194,7 @@ TEST(BadInputCli, ANumericOptionOutOfRangeNamesItsRange) {
   const auto sweepFile = dir.write("study.toml", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n");
   const auto log = dir.path() / "log.txt";
   const std::string out = " --out " + (dir.path() / "out").string();
-  for (const std::string arguments :
+  for (const std::string& arguments :
        {"sweep " + sweepFile.string() + " --jobs -2" + out, "sweep " + sweepFile.string() + " --batch -1" + out,
         "sweep " + sweepFile.string() + " --case-index -1" + out, "view " + dir.path().string() + " --every 0"}) {
     EXPECT_EQ(gem::test::runGem(arguments, log), 2) << arguments;

@@ -43,14 +43,11 @@ struct DeviceState;
 PrepareArgs prepareArgsOf(DeviceState& d, unsigned largeKey, bool grid);
 
 #if defined(__CUDACC__)
-// Phase 1 for body i: as CpuStepper::narrowphase's box loop and CpuStepper::step's view loops.
-__device__ inline void prepareBody(const PrepareArgs& a, int i) {
-  Vec2* v = a.worldVertices + static_cast<size_t>(i) * kMaxVertices;
-  const int count = a.vertexCount[i];
-  toWorld(a.local + static_cast<size_t>(i) * kMaxVertices, count, Vec2{a.x[i], a.y[i]}, a.angle[i], v);
-  const Box box = boundingBox(v, count);
+// Phase 1 for body i after its world vertices (toWorld) are written and its box found: the box,
+// the events' views (which point at the world vertices), the cell key.
+__device__ inline void finishBody(const PrepareArgs& a, int i, const Box& box) {
   a.boxes[i] = box;
-  PairBody b = pairBodyOf(a, i, a.dof[i], v, count);
+  PairBody b = pairBodyOf(a, i, a.dof[i], a.worldVertices + static_cast<size_t>(i) * kMaxVertices, a.vertexCount[i]);
   b.id -= static_cast<std::int64_t>(a.world[i]) * a.idStride;
   a.pairBodies[i] = b;
   a.soloBodies[i] = SoloBody{b.kind, b.dof, b.position, b.angle, b.velocity, b.omega, b.mass, b.area, b.thickness};
@@ -59,6 +56,16 @@ __device__ inline void prepareBody(const PrepareArgs& a, int i) {
   // A small body lives in the cell of its box's lower-left corner; large ones stay out of the grid.
   a.cellKey[i] = a.isLarge[i] ? a.largeKey : cellHash(cellCoord(box.x0, a.cell), cellCoord(box.y0, a.cell), a.world[i], a.mask);
   a.slot[i] = i;
+}
+
+// Phase 1 for body i: as CpuStepper::narrowphase's box loop and CpuStepper::step's view loops. A
+// driver may run it in pieces (the resident kernel turns a world's vertices in one flat loop over
+// all of them): toWorldPoint for each vertex, then finishBody with the box of the result.
+__device__ inline void prepareBody(const PrepareArgs& a, int i) {
+  Vec2* v = a.worldVertices + static_cast<size_t>(i) * kMaxVertices;
+  const int count = a.vertexCount[i];
+  toWorld(a.local + static_cast<size_t>(i) * kMaxVertices, count, Vec2{a.x[i], a.y[i]}, a.angle[i], v);
+  finishBody(a, i, boundingBox(v, count));
 }
 
 // Phase 3 for candidate pair (a, b): the prefilter (phases.hpp), then the contact geometry. Bodies

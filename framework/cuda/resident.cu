@@ -41,6 +41,11 @@ struct ResidentState {
   bool previousPending = false;
   std::vector<unsigned long long> pendingPrevious;
   long long phaseCycles[kResidentPhases] = {};  // block 0's, over every launch (GEM_CUDA_TIMING=1 prints them)
+  long long pairCounts[3] = {};                 // its first world's candidate pairs, overlapping pairs, contacts
+  // World vertices a launch's shared memory has room for: 8 a body at first, then what the largest
+  // world needed (ResidentControl::verticesNeeded); GEM_RESIDENT_STAGE_VERTICES=0 keeps them in
+  // global memory (for side-by-side timings; the results are the same).
+  int vertexRoom = -1;
   long launches = 0, steps = 0;
   ResidentState() { GEM_CUDA_CHECK(cudaMallocHost(&h_control, sizeof(ResidentControl))); }
   ~ResidentState() {
@@ -57,7 +62,10 @@ struct ResidentState {
     for (int k = 0; k < kResidentPhases; ++k)
       std::fprintf(stderr, "%s %s %.2f", k ? "," : "", kResidentPhaseNames[k],
                    1e3 * static_cast<double>(phaseCycles[k]) / kHz / static_cast<double>(steps));
-    std::fprintf(stderr, " (us a step)\n");
+    std::fprintf(stderr, " (us a step); world 0: %.1f candidate pairs, %.1f overlapping, %.1f contacts a step\n",
+                 static_cast<double>(pairCounts[0]) / static_cast<double>(steps),
+                 static_cast<double>(pairCounts[1]) / static_cast<double>(steps),
+                 static_cast<double>(pairCounts[2]) / static_cast<double>(steps));
   }
 };
 
@@ -171,14 +179,18 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
   int device = 0, multiprocessors = 1;
   GEM_CUDA_CHECK(cudaGetDevice(&device));
   GEM_CUDA_CHECK(cudaDeviceGetAttribute(&multiprocessors, cudaDevAttrMultiProcessorCount, device));
-  const std::size_t shared = residentSharedBytes(r.mostBodies);
+  if (r.vertexRoom < 0) {
+    const char* stage = std::getenv("GEM_RESIDENT_STAGE_VERTICES");
+    r.vertexRoom = stage && std::strcmp(stage, "0") == 0 ? 0 : 8 * r.mostBodies;
+  }
+  const std::size_t shared = residentSharedBytes(r.mostBodies, r.vertexRoom);
   const int grid = std::max(1, std::min(d.worlds, multiprocessors * std::max(1, residentBlocksPerMultiprocessor(shared))));
 
-  // GEM_RESIDENT_CLIP_LANES: the lanes of a warp that clip (a tuning knob for the measurements in
-  // docs/performance.md; the results do not depend on it).
-  static const int clipLanes = [] {
-    const char* v = std::getenv("GEM_RESIDENT_CLIP_LANES");
-    return std::clamp(v ? std::atoi(v) : kResidentClipLanes, 1, 32);
+  // GEM_RESIDENT_CLIP=thread: the contact geometry a thread a pair, as before the warp's clipping
+  // (a switch for the side-by-side figures in docs/performance.md; the results are the same).
+  static const bool clipByThread = [] {
+    const char* v = std::getenv("GEM_RESIDENT_CLIP");
+    return v && std::strcmp(v, "thread") == 0;
   }();
   awaitHostCopies();  // members, params, the kept pairs: read by the launches below
   long next = firstStep;
@@ -206,7 +218,8 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
       a.sink.streams[q] = RecordBuffer{d.records[q].get(), d.recordStride[q], d.recordCapacity, r.recordCount.get() + q};
     a.haltStreams = d.haltStreams;
     a.firstStep = next, a.dt = dt, a.steps = batch;
-    a.clipLanes = clipLanes;
+    a.clipByThread = clipByThread;
+    a.sharedBytes = shared;
     a.ring = d.ring.get(), a.worldRing = d.worldRing.get(), a.control = r.control.get();
     launchResident(a, grid, shared, d.stream);
     GEM_CUDA_CHECK(cudaMemcpyAsync(r.h_control, r.control.get(), sizeof(ResidentControl), cudaMemcpyDeviceToHost, d.stream));
@@ -221,6 +234,8 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     ++r.launches;
     r.steps += done;
     for (int k = 0; k < kResidentPhases; ++k) r.phaseCycles[k] += control.phaseCycles[k];
+    for (int k = 0; k < 3; ++k) r.pairCounts[k] += control.pairCounts[k];
+    if (r.vertexRoom > 0 && control.verticesNeeded > r.vertexRoom) r.vertexRoom = control.verticesNeeded + control.verticesNeeded / 8;
 
     // The completed steps' records, appended; their ends shifted past what earlier launches added.
     const StepRecord last = done > 0 ? d.h_ring[done - 1] : StepRecord{};

@@ -27,8 +27,6 @@ namespace gem::cuda {
 // needs set the whole kernel's) one such block fills a multiprocessor's registers: one world a
 // multiprocessor at a time (docs/performance.md 4.4).
 constexpr int kResidentBlock = 512;
-// Lanes of each warp that clip contact pairs: all of them (1 and 4 were measured, 4.4).
-constexpr int kResidentClipLanes = 32;
 // The most events of each phase the kernel runs (a scenario has a handful).
 constexpr int kResidentMaxEvents = 16;
 
@@ -43,6 +41,9 @@ struct ResidentProgram {
   ResidentEventCall pair[kResidentMaxEvents], solo[kResidentMaxEvents], motion[kResidentMaxEvents];
 };
 
+// The phases the kernel times (ResidentControl::phaseCycles, kResidentPhaseNames).
+constexpr int kResidentPhases = 14;
+
 // What the worlds of a launch share on the device: the step's counters, double-buffered by the
 // step's parity so that one can be read while the next step fills the other.
 struct ResidentControl {
@@ -52,16 +53,15 @@ struct ResidentControl {
   int stepsDone, haltReason;
   // Where block 0's time went, in clock cycles, by phase (kResidentPhaseNames): GEM_CUDA_TIMING=1
   // prints them when the state goes.
-  long long phaseCycles[12];
+  long long phaseCycles[kResidentPhases];
+  long long pairCounts[3];  // block 0's first world, over the launch: candidate pairs, overlapping, contacts
+  int verticesNeeded;       // the most vertices a world had (the next launch's shared memory for them)
 };
-// The phases the kernel times (ResidentControl::phaseCycles).
-constexpr int kResidentPhases = 12;
-inline constexpr const char* kResidentPhaseNames[kResidentPhases] = {"prepare",         "sweep sort",
-                                                                     "pairs",           "pair sort",
-                                                                     "separating axes", "contact geometry and onset",
-                                                                     "events",          "sorts",
-                                                                     "first barrier",   "gather, motion, write-back",
-                                                                     "second barrier",  "step edges"};
+// The phases' names, in the kernel's order.
+inline constexpr const char* kResidentPhaseNames[kResidentPhases] = {
+    "world vertices",   "boxes and views", "sweep sort", "pairs", "pair sort",     "separating axes",
+    "contact geometry", "onset",           "events",     "sorts", "first barrier", "gather, motion, write-back",
+    "second barrier",   "step edges"};
 
 struct ResidentArgs {
   PrepareArgs prepare;  // the world's arrays, cellKey nullptr
@@ -91,7 +91,8 @@ struct ResidentArgs {
   long firstStep;
   Real dt;
   int steps;
-  int clipLanes;  // lanes of each warp that compute contact geometry (the rest wait)
+  bool clipByThread;        // contact geometry a thread a pair (contactOfPair) instead of a warp a pair
+  std::size_t sharedBytes;  // the launch's dynamic shared memory (residentSharedBytes)
   StepRecord* ring;
   WorldStepRecord* worldRing;
   ResidentControl* control;
@@ -102,10 +103,21 @@ enum ResidentPhase : int { kResidentPair = 0, kResidentSolo = 1, kResidentMotion
 // resident_events.cu: the built-in events the kernel holds. Returns the event's kind and the size
 // of its Params, or -1 when the kernel does not hold an event of that name and phase.
 int residentEventKind(const std::string& name, ResidentPhase phase, std::size_t* paramsSize);
-// Shared memory for the sweep of a world of up to `bodies` bodies (its keys, boxes and inverse
-// masses), or 0 past kResidentSharedBytes: the sweep then reads them from global memory.
-std::size_t residentSharedBytes(int bodies);
+// A launch's dynamic shared memory holds, for the world a block steps: the sweep's keys, the boxes
+// and inverse masses (bodySort of each), the offsets of each body's vertices (bodySort + 1), then
+// as many of the world's vertices as fit in the rest (the narrowphase reads them there).
 constexpr std::size_t kResidentSharedBytes = 160 * 1024;
+// The bytes before the vertices, 16-aligned.
+__host__ __device__ constexpr std::size_t residentBodyBytes(int bodySort) {
+  return (static_cast<std::size_t>(bodySort) * (sizeof(unsigned long long) + sizeof(Box) + sizeof(Real)) +
+          (static_cast<std::size_t>(bodySort) + 1) * sizeof(int) + 15) /
+         16 * 16;
+}
+// The dynamic shared memory of a launch whose largest world has `bodies` bodies and room for
+// `vertices` of its vertices, at most kResidentSharedBytes: without the vertices when they do not
+// fit (the narrowphase reads them from global memory), 0 when the bodies' part does not either.
+// Only what is used is asked for: the rest of the multiprocessor's 256 KB is its L1 cache.
+std::size_t residentSharedBytes(int bodies, int vertices);
 // The kernel, launched (cooperatively when grid > 1) on the stream with `shared` bytes of dynamic
 // shared memory (residentSharedBytes of the largest world).
 void launchResident(const ResidentArgs& args, int grid, std::size_t shared, cudaStream_t stream);

@@ -50,11 +50,12 @@ int residentEventKind(const std::string& name, ResidentPhase phase, std::size_t*
   return -1;
 }
 
-std::size_t residentSharedBytes(int bodies) {
+std::size_t residentSharedBytes(int bodies, int vertices) {
   int sorted = 1;
   while (sorted < bodies) sorted <<= 1;
-  const std::size_t bytes = static_cast<std::size_t>(sorted) * (sizeof(unsigned long long) + sizeof(Box) + sizeof(Real));
-  return bytes <= kResidentSharedBytes ? bytes : 0;
+  const std::size_t withVertices = residentBodyBytes(sorted) + static_cast<std::size_t>(vertices) * sizeof(Vec2);
+  if (withVertices <= kResidentSharedBytes) return withVertices;
+  return residentBodyBytes(sorted) <= kResidentSharedBytes ? residentBodyBytes(sorted) : 0;
 }
 
 // Dynamic shared memory past 48 KB must be asked for, once per size.

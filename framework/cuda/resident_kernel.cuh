@@ -20,6 +20,7 @@
 #include <cstring>
 
 #include "framework/cuda/resident.cuh"
+#include "framework/cuda/warp_contact.cuh"
 #include "framework/step/phases.hpp"
 
 namespace gem::cuda::resident {
@@ -115,7 +116,11 @@ struct BlockShared {
   int scan[33];
   int count;
   long long cycles[kResidentPhases], stamp;  // block 0's time by phase (ResidentControl::phaseCycles)
-  unsigned long long sort[kSharedSort];
+  long long pairCounts[3];                   // world 0's (ResidentControl::pairCounts)
+  union {
+    unsigned long long sort[kSharedSort];                 // blockSort's keys
+    ClipVertex clip[kResidentBlock / 32][kWarpClipRoom];  // each warp's overlap polygon (phase 3)
+  };
 };
 
 // The end of phase k in block 0: its cycles since the last mark go to phase k.
@@ -172,11 +177,34 @@ __device__ inline void bitonicSort(unsigned long long* keys, int m) {
     }
 }
 
+// Up to this many keys a rank sort (every thread counts the keys below its own: one pass between
+// two barriers) takes less time than the bitonic network's log^2 rounds, each ending at a barrier
+// (the contacts' sorts). Its work grows as the square: the 824-floe world's sweep (824 keys) took
+// 38 us a step by rank, 12 us by the network (docs/performance.md 4.4).
+constexpr int kRankSort = 256;
+
+// keys[0..n) sorted ascending through copy (n entries of shared memory); ties keep their order.
+__device__ inline void rankSort(unsigned long long* keys, int n, unsigned long long* copy) {
+  for (int i = threadIdx.x; i < n; i += blockDim.x) copy[i] = keys[i];
+  __syncthreads();
+  for (int i = threadIdx.x; i < n; i += blockDim.x) {
+    const unsigned long long key = copy[i];
+    int rank = 0;
+    for (int j = 0; j < n; ++j) {
+      const unsigned long long other = copy[j];
+      rank += (other < key || (other == key && j < i)) ? 1 : 0;
+    }
+    keys[rank] = key;
+  }
+  __syncthreads();
+}
+
 // keys[0..n) sorted ascending; keys has room for the next power of two of n (the padding).
 __device__ inline void blockSort(unsigned long long* keys, int n, BlockShared& sh) {
   int m = 1;
   while (m < n) m <<= 1;
   if (n <= 1) return;
+  if (n <= kRankSort) return rankSort(keys, n, sh.sort);
   if (__isShared(keys)) {  // already in shared memory (the sweep's keys, staged): in place
     for (int i = n + threadIdx.x; i < m; i += blockDim.x) keys[i] = ~0ull;
     __syncthreads();
@@ -259,28 +287,77 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
   const PrepareArgs& p = a.prepare;
   const int n = s.n;
   // The sweep's keys, boxes and inverse masses by the body's place in the world: in shared memory
-  // when the launch has room for them (residentSharedBytes), else in global memory.
+  // when the launch has room for them (residentSharedBytes), else in global memory. The world's
+  // vertices too, after them, when they fit in the rest: vertices[vertexAt[i] .. vertexAt[i + 1])
+  // are those of the body at place i.
   Box* boxes = nullptr;
   Real* invMass = nullptr;
+  int* vertexAt = nullptr;
+  Vec2* vertices = nullptr;
   if (dynamic) {
     s.sweep = reinterpret_cast<unsigned long long*>(dynamic);
     boxes = reinterpret_cast<Box*>(s.sweep + a.bodySort);
     invMass = reinterpret_cast<Real*>(boxes + a.bodySort);
+    vertexAt = reinterpret_cast<int*>(invMass + a.bodySort);
+    vertices = reinterpret_cast<Vec2*>(dynamic + residentBodyBytes(a.bodySort));
   }
-  // 1. Prepare, and the sweep's keys: the box's left edge rounded down (a float sorts as its double
-  // does, ties aside), then the body's place in the world.
-  for (int i = threadIdx.x; i < n; i += blockDim.x) {
-    const int slot = s.members[i];
-    prepareBody(p, slot);
-    const Box box = p.boxes[slot];
-    if (boxes) boxes[i] = box, invMass[i] = p.invMass[slot];
-    s.sweep[i] = (static_cast<unsigned long long>(orderedBits(__double2float_rd(box.x0))) << 32) | static_cast<unsigned>(i);
-  }
+  // 1. Prepare (body_phases.cuh), and the sweep's keys: the box's left edge rounded down (a float
+  // sorts as its double does, ties aside), then the body's place in the world.
+  auto sweepKey = [](const Box& box, int i) {
+    return (static_cast<unsigned long long>(orderedBits(__double2float_rd(box.x0))) << 32) | static_cast<unsigned>(i);
+  };
   if (threadIdx.x == 0) sh.count = 0;
-  __syncthreads();
-  mark(sh, 0);
-  blockSort(s.sweep, n, sh);
+  if (!dynamic) {  // a world too large for shared memory: each body whole on one thread
+    for (int i = threadIdx.x; i < n; i += blockDim.x) {
+      const int slot = s.members[i];
+      prepareBody(p, slot);
+      s.sweep[i] = sweepKey(p.boxes[slot], i);
+    }
+    __syncthreads();
+    mark(sh, 0);
+  } else {
+    // In passes, so that no thread walks a body's vertices one global read after another:
+    // (a) each body's vertex count and turn (cosine, sine, position: kept in its box's place until
+    // (c)); (b) every vertex of the world turned into the world frame, a vertex a thread, into
+    // global memory (the events' views point there) and, when they fit, into shared memory, where
+    // the narrowphase's long chains of dependent reads wait a few dozen cycles each instead of an
+    // L2 round trip; (c) each body's box and views (finishBody). The arithmetic is toWorld's.
+    for (int i = threadIdx.x; i < n; i += blockDim.x) {
+      const int slot = s.members[i];
+      const Real angle = p.angle[slot];
+      vertexAt[i] = p.vertexCount[slot];
+      boxes[i] = Box{std::cos(angle), std::sin(angle), p.x[slot], p.y[slot]};
+    }
+    if (threadIdx.x == 0) vertexAt[n] = 0;
+    __syncthreads();
+    const int total = blockExclusiveScan(vertexAt, n + 1, sh);
+    if (threadIdx.x == 0) atomicMax(&a.control->verticesNeeded, total);
+    // The same on every thread (the total is): past the room, the narrowphase reads global memory.
+    if (static_cast<std::size_t>(total) * sizeof(Vec2) > a.sharedBytes - residentBodyBytes(a.bodySort)) vertices = nullptr;
+    for (int k = threadIdx.x; k < total; k += blockDim.x) {
+      const int i = lowerBoundOf(vertexAt, n + 1, k + 1) - 1;  // the body whose vertices k is among
+      const Box turn = boxes[i];
+      const size_t at = static_cast<size_t>(s.members[i]) * kMaxVertices + static_cast<size_t>(k - vertexAt[i]);
+      const Vec2 v = toWorldPoint(p.local[at], Vec2{turn.x1, turn.y1}, turn.x0, turn.y0);
+      p.worldVertices[at] = v;
+      if (vertices) vertices[k] = v;
+    }
+    __syncthreads();
+    mark(sh, 0);
+    for (int i = threadIdx.x; i < n; i += blockDim.x) {
+      const int slot = s.members[i];
+      const Vec2* v = vertices ? vertices + vertexAt[i] : p.worldVertices + static_cast<size_t>(slot) * kMaxVertices;
+      const Box box = boundingBox(v, vertexAt[i + 1] - vertexAt[i]);
+      finishBody(p, slot, box);
+      boxes[i] = box;
+      invMass[i] = p.invMass[slot];
+      s.sweep[i] = sweepKey(box, i);
+    }
+    __syncthreads();
+  }
   mark(sh, 1);
+  blockSort(s.sweep, n, sh);
+  mark(sh, 2);
 
   // 2. Pairs: a warp per body in sweep order; its lanes walk the bodies after it while their left
   // edge (rounded down) is not past its right edge (rounded up): every pair whose boxes overlap
@@ -313,7 +390,7 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
     }
   }
   __syncthreads();
-  mark(sh, 2);
+  mark(sh, 3);
   const int pairs = sh.count;
   if (threadIdx.x == 0) {
     atomicAdd(&a.control->candidates[parity], pairs);
@@ -322,17 +399,21 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
   }
   if (pairs > a.capacity) return -1;
   blockSort(s.pairs, pairs, sh);
-  mark(sh, 3);
+  mark(sh, 4);
 
   // 3. Narrowphase in two passes: the separating-axis test over every pair, then the contact
   // geometry (clipping) over the pairs that overlap only, so that the few long clipping chains
   // are spread over the block instead of queued behind the many quick rejections. The same
   // functions as the device-wide driver's contactOfPair, in the same order: the same contacts.
+  // With the vertices in shared memory the prefilter is not repeated: every pair passed it above.
   for (int k = threadIdx.x; k < pairs; k += blockDim.x) {
     const unsigned long long key = s.pairs[k];
-    s.flag[k] =
-        overlapOfPair(s.members[key >> 32], s.members[key & 0xffffffffu], p.worldVertices, p.vertexCount, p.boxes, p.invMass, p.world) ? 1
-                                                                                                                                       : 0;
+    const int ia = static_cast<int>(key >> 32), ib = static_cast<int>(key & 0xffffffffu);
+    const bool overlap = vertices
+                             ? convexOverlap(vertices + vertexAt[ia], vertexAt[ia + 1] - vertexAt[ia], vertices + vertexAt[ib],
+                                             vertexAt[ib + 1] - vertexAt[ib])
+                             : overlapOfPair(s.members[ia], s.members[ib], p.worldVertices, p.vertexCount, p.boxes, p.invMass, p.world);
+    s.flag[k] = overlap ? 1 : 0;
   }
   if (threadIdx.x == 0) s.flag[pairs] = 0;
   __syncthreads();
@@ -340,20 +421,41 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
   for (int k = threadIdx.x; k < pairs; k += blockDim.x)
     if (s.flag[k + 1] != s.flag[k]) s.survivors[s.flag[k]] = k;
   __syncthreads();
-  mark(sh, 4);
-  // clipLanes lanes of each warp clip, the others wait: the lanes of a warp that clip different
-  // pairs diverge through the whole clipping, so fewer of them can finish sooner.
-  const int clipLane = threadIdx.x & 31, clipWarp = threadIdx.x >> 5, clipStride = (blockDim.x >> 5) * a.clipLanes;
-  for (int j = clipWarp * a.clipLanes + clipLane; clipLane < a.clipLanes && j < overlapping; j += clipStride) {
-    const unsigned long long key = s.pairs[s.survivors[j]];
-    Contact c{};
-    const bool touching = contactOfPair(s.members[key >> 32], s.members[key & 0xffffffffu], p.worldVertices, p.vertexCount, p.x, p.y,
-                                        p.boxes, p.invMass, p.world, c);
-    s.touching[j] = touching ? 1 : 0;
-    if (touching) s.candidates[j] = c;
+  mark(sh, 5);
+  if (a.clipByThread) {
+    for (int j = threadIdx.x; j < overlapping; j += blockDim.x) {
+      const unsigned long long key = s.pairs[s.survivors[j]];
+      Contact c{};
+      const bool touching = contactOfPair(s.members[key >> 32], s.members[key & 0xffffffffu], p.worldVertices, p.vertexCount, p.x, p.y,
+                                          p.boxes, p.invMass, p.world, c);
+      s.touching[j] = touching ? 1 : 0;
+      if (touching) s.candidates[j] = c;
+    }
+  } else {
+    // Two pairs a warp, a half warp each (warp_contact.cuh): the lanes of one warp clipping
+    // different pairs would diverge through every clipping, and one thread's chain of a pair's
+    // clipping is the longest latency of the step. The separating-axis test above already passed.
+    const int warp = threadIdx.x >> 5;
+    auto fetch = [&](int j) {
+      const unsigned long long key = s.pairs[s.survivors[j]];
+      const int ia = static_cast<int>(key >> 32), ib = static_cast<int>(key & 0xffffffffu);
+      const int sa = s.members[ia], sb = s.members[ib];
+      return PairPolygons{vertices ? vertices + vertexAt[ia] : p.worldVertices + static_cast<size_t>(sa) * kMaxVertices,
+                          p.vertexCount[sa],
+                          Vec2{p.x[sa], p.y[sa]},
+                          vertices ? vertices + vertexAt[ib] : p.worldVertices + static_cast<size_t>(sb) * kMaxVertices,
+                          p.vertexCount[sb],
+                          Vec2{p.x[sb], p.y[sb]}};
+    };
+    auto store = [&](int j, const Contact& c) {
+      s.touching[j] = c.touching ? 1 : 0;
+      if (c.touching) s.candidates[j] = c;
+    };
+    for (int j0 = 2 * warp; j0 < overlapping; j0 += 2 * (blockDim.x >> 5)) warpContactsOfTwo(j0, overlapping, fetch, store, sh.clip[warp]);
   }
   if (threadIdx.x == 0) s.touching[overlapping] = 0;
   __syncthreads();
+  mark(sh, 6);
   const int contacts = blockExclusiveScan(s.touching, overlapping + 1, sh);
   const int previous = a.previousCount[w];
   for (int j = threadIdx.x; j < overlapping; j += blockDim.x) {
@@ -374,8 +476,10 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
     s.bs[c] = ((key & 0xffffffffu) << 32) | static_cast<unsigned>(c);  // b's place in the world, then the contact
   }
   if (threadIdx.x == 0) atomicAdd(&a.control->contacts[parity], contacts);
+  if (blockIdx.x == 0 && threadIdx.x == 0 && w == 0)
+    sh.pairCounts[0] += pairs, sh.pairCounts[1] += overlapping, sh.pairCounts[2] += contacts;
   __syncthreads();
-  mark(sh, 5);
+  mark(sh, 7);
 
   // 4. The pair events, a contact at a time, each contact's events in order; then the solo events.
   const unsigned char* row = a.params + static_cast<size_t>(w) * static_cast<size_t>(a.paramsStride);
@@ -397,11 +501,11 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
     p.changes[slot] = change;
   }
   __syncthreads();
-  mark(sh, 6);
+  mark(sh, 8);
   // Phase 5 reads the b side in contact order, and the next step's onset the pairs by id.
   blockSort(s.bs, contacts, sh);
   blockSort(s.ids, contacts, sh);
-  mark(sh, 7);
+  mark(sh, 9);
   return contacts;
 }
 
@@ -453,6 +557,7 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a,
   ResidentControl& control = *a.control;
   if (threadIdx.x == 0) {
     for (long long& c : sh.cycles) c = 0;
+    for (long long& c : sh.pairCounts) c = 0;
     sh.stamp = clock64();
   }
   __syncthreads();
@@ -474,7 +579,7 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a,
       if (threadIdx.x == 0) a.worldRing[static_cast<size_t>(s) * a.worlds + w].contacts = contacts;
     }
     gridBarrier();
-    mark(sh, 8);
+    mark(sh, 10);
     // Nothing is pushed between the two barriers: every block reads the same counters.
     const bool overflow = readShared(&control.overflow[parity]) != 0 || recordsOverflowed(a.sink);
     if (leader && !overflow) {
@@ -503,13 +608,13 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a,
         secondHalf<Events>(a, w, contacts, ctx, record);
       }
     }
-    mark(sh, 9);
+    mark(sh, 11);
     if (leader) {
       // The next step's counters start at zero (this step's parity is read until the barrier).
       control.candidates[parity ^ 1] = control.contacts[parity ^ 1] = control.overflow[parity ^ 1] = control.halt[parity ^ 1] = 0;
     }
     gridBarrier();
-    mark(sh, 10);
+    mark(sh, 12);
     if (overflow) {
       if (leader) {
         // The overflowed step's rows are dropped: the counters go back to its start.
@@ -520,10 +625,12 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a,
       break;
     }
     if (readShared(&control.halt[parity])) break;
-    mark(sh, 11);
+    mark(sh, 13);
   }
   if (blockIdx.x == 0 && threadIdx.x == 0)
     for (int k = 0; k < kResidentPhases; ++k) control.phaseCycles[k] += sh.cycles[k];
+  if (blockIdx.x == 0 && threadIdx.x == 0)
+    for (int k = 0; k < 3; ++k) control.pairCounts[k] = sh.pairCounts[k];
 }
 
 }  // namespace gem::cuda::resident
