@@ -104,13 +104,14 @@ enum ResidentPhase : int { kResidentPair = 0, kResidentSolo = 1, kResidentMotion
 // of its Params, or -1 when the kernel does not hold an event of that name and phase.
 int residentEventKind(const std::string& name, ResidentPhase phase, std::size_t* paramsSize);
 // A launch's dynamic shared memory holds, for the world a block steps: the sweep's keys, the boxes
-// and inverse masses (bodySort of each), the offsets of each body's vertices (bodySort + 1), then
-// as many of the world's vertices as fit in the rest (the narrowphase reads them there).
+// and inverse masses (bodySort of each), the offsets of each body's vertices and of each body's
+// candidate pairs (bodySort + 1 of each), then as many of the world's vertices as fit in the rest
+// (the narrowphase reads them there).
 constexpr std::size_t kResidentSharedBytes = 160 * 1024;
 // The bytes before the vertices, 16-aligned.
 __host__ __device__ constexpr std::size_t residentBodyBytes(int bodySort) {
   return (static_cast<std::size_t>(bodySort) * (sizeof(unsigned long long) + sizeof(Box) + sizeof(Real)) +
-          (static_cast<std::size_t>(bodySort) + 1) * sizeof(int) + 15) /
+          2 * (static_cast<std::size_t>(bodySort) + 1) * sizeof(int) + 15) /
          16 * 16;
 }
 // The dynamic shared memory of a launch whose largest world has `bodies` bodies and room for

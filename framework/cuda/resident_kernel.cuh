@@ -222,6 +222,29 @@ __device__ inline void blockSort(unsigned long long* keys, int n, BlockShared& s
   __syncthreads();
 }
 
+// pairs[0..count) (keys a << 32 | b, each pair once) sorted ascending, where pairsAt[a] has counted
+// the pairs of each place a: a counting sort by a through shared memory, then each pair's rank by b
+// among its own place's few. A few barriers where the bitonic network has dozens.
+__device__ inline void sortPairsByPlace(unsigned long long* pairs, int count, int* pairsAt, int n, BlockShared& sh) {
+  blockExclusiveScan(pairsAt, n + 1, sh);
+  unsigned long long* placed = sh.sort;
+  for (int k = threadIdx.x; k < count; k += blockDim.x) {
+    const unsigned long long key = pairs[k];
+    placed[atomicAdd(&pairsAt[key >> 32], 1)] = key;
+  }
+  __syncthreads();
+  // pairsAt[a] is now where place a's pairs end (and a + 1's begin).
+  for (int k = threadIdx.x; k < count; k += blockDim.x) {
+    const unsigned long long key = placed[k];
+    const int a = static_cast<int>(key >> 32);
+    const int begin = a > 0 ? pairsAt[a - 1] : 0, end = pairsAt[a];
+    int rank = 0;
+    for (int j = begin; j < end; ++j) rank += placed[j] < key ? 1 : 0;
+    pairs[begin + rank] = key;
+  }
+  __syncthreads();
+}
+
 template <class T>
 __device__ inline int lowerBoundOf(const T* v, int n, T x) {
   int lo = 0, hi = n;
@@ -292,13 +315,14 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
   // are those of the body at place i.
   Box* boxes = nullptr;
   Real* invMass = nullptr;
-  int* vertexAt = nullptr;
+  int *vertexAt = nullptr, *pairsAt = nullptr;
   Vec2* vertices = nullptr;
   if (dynamic) {
     s.sweep = reinterpret_cast<unsigned long long*>(dynamic);
     boxes = reinterpret_cast<Box*>(s.sweep + a.bodySort);
     invMass = reinterpret_cast<Real*>(boxes + a.bodySort);
     vertexAt = reinterpret_cast<int*>(invMass + a.bodySort);
+    pairsAt = vertexAt + a.bodySort + 1;
     vertices = reinterpret_cast<Vec2*>(dynamic + residentBodyBytes(a.bodySort));
   }
   // 1. Prepare (body_phases.cuh), and the sweep's keys: the box's left edge rounded down (a float
@@ -352,7 +376,9 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
       boxes[i] = box;
       invMass[i] = p.invMass[slot];
       s.sweep[i] = sweepKey(box, i);
+      pairsAt[i] = 0;
     }
+    if (threadIdx.x == 0) pairsAt[n] = 0;
     __syncthreads();
   }
   mark(sh, 1);
@@ -382,7 +408,10 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
           if (touch) {
             const int at = atomicAdd(&sh.count, 1);
             const unsigned lo = ia < ib ? ia : ib, hi = ia < ib ? ib : ia;
-            if (at < a.capacity) s.pairs[at] = (static_cast<unsigned long long>(lo) << 32) | hi;
+            if (at < a.capacity) {
+              s.pairs[at] = (static_cast<unsigned long long>(lo) << 32) | hi;
+              if (pairsAt) atomicAdd(&pairsAt[lo], 1);
+            }
           }
         }
       }
@@ -398,7 +427,10 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
     if (pairs > a.capacity) atomicOr(&a.control->overflow[parity], 1);
   }
   if (pairs > a.capacity) return -1;
-  blockSort(s.pairs, pairs, sh);
+  if (pairsAt && pairs <= kSharedSort)
+    sortPairsByPlace(s.pairs, pairs, pairsAt, n, sh);
+  else
+    blockSort(s.pairs, pairs, sh);
   mark(sh, 4);
 
   // 3. Narrowphase in two passes: the separating-axis test over every pair, then the contact

@@ -33,15 +33,13 @@ struct ClipGroup {
   __device__ bool any(bool p) const { return __any_sync(mask, p); }
   __device__ void sync() const { __syncwarp(mask); }
   __device__ int fromFirst(int value) const { return __shfl_sync(mask, value, 0, Lanes); }
-  // Exclusive prefix sum of value over the group's lanes; total: the sum over all of them.
-  __device__ int exclusiveSum(int value, int& total) const {
-    int inclusive = value;
-    for (int o = 1; o < Lanes; o <<= 1) {
-      const int t = __shfl_up_sync(mask, inclusive, o, Lanes);
-      if (lane >= o) inclusive += t;
-    }
-    total = __shfl_sync(mask, inclusive, Lanes - 1, Lanes);
-    return inclusive - value;
+  // Exclusive prefix sum over the group's lanes of value, which is 0, 1 or 2 (a vertex emits that
+  // many): two ballots instead of a shuffle per step of a scan. total: the sum over all lanes.
+  __device__ int exclusiveSumOfSmall(int value, int& total) const {
+    const unsigned ones = __ballot_sync(mask, (value & 1) != 0) & mask, twos = __ballot_sync(mask, (value & 2) != 0) & mask;
+    const unsigned below = (1u << (threadIdx.x & 31)) - 1u;
+    total = __popc(ones) + 2 * __popc(twos);
+    return __popc(ones & below) + 2 * __popc(twos & below);
   }
 };
 
@@ -133,8 +131,8 @@ __device__ inline int groupClipConvex(const ClipGroup<Lanes>& g, const Vec2* p, 
     if (!anyOut) continue;  // this edge does not cut the polygon
     if (!anyIn) return 0;   // wholly outside this edge: no overlap
     int total0 = 0, total1 = 0;
-    const int at0 = g.exclusiveSum(count[0], total0);
-    const int at1 = total0 + g.exclusiveSum(count[1], total1);
+    const int at0 = g.exclusiveSumOfSmall(count[0], total0);
+    const int at1 = total0 + g.exclusiveSumOfSmall(count[1], total1);
     if (total0 + total1 > room) return -1;
     g.sync();  // every lane has read the polygon before any overwrites it
     if (count[0]) detail::emitted(cur[0], sCur[0], prev[0], sPrev[0], buf + at0);
@@ -203,6 +201,7 @@ __device__ inline void warpContactsOfTwo(int j0, int count, const Fetch& fetch, 
     const unsigned failed = __ballot_sync(~0u, !clipped);
     redoFirst = (failed & 1u) != 0;
     redoOther = ((failed >> 16) & 1u) != 0;
+    __syncwarp();  // both halves are done with buf before the whole warp writes it (racecheck)
   }
   const int lane = static_cast<int>(threadIdx.x & 31);
   if (redoFirst) {
