@@ -160,6 +160,17 @@ void CpuStepper::setUp() {
   if (m_scenario.mortonSort) reorderAlongCurve();
 }
 
+const std::vector<std::pair<std::int64_t, Real>>* CpuStepper::contactForces() const {
+  if (!m_contactForcesBuilt) {
+    m_contactForces.clear();
+    for (size_t i = 0; i < m_contactForceOfSlot.size(); ++i)
+      if (m_contactForceOfSlot[i] > 0) m_contactForces.emplace_back(m_contactForceId[i], m_contactForceOfSlot[i]);
+    std::sort(m_contactForces.begin(), m_contactForces.end());
+    m_contactForcesBuilt = true;
+  }
+  return &m_contactForces;
+}
+
 StepperState CpuStepper::saveState() { return StepperState{m_world, m_step, m_time, m_previousContacts, m_rubbleMass, m_floesBroken}; }
 
 void CpuStepper::restoreState(const StepperState& state) {
@@ -508,6 +519,7 @@ void CpuStepper::gatherAndMove() {
   Vec2 vesselImpulse{0, 0};
   m_motionBodies.resize(n);
   m_contactForceOfSlot.resize(n);
+  m_contactForceId.resize(n);
   forEachBody(n, [&](int i) {
     Vec2 onBody{0, 0};
     for (int q = m_bodyContactStart[i]; q < m_bodyContactStart[i + 1]; ++q) {
@@ -520,15 +532,12 @@ void CpuStepper::gatherAndMove() {
     }
     if (i == vessel) vesselImpulse = onBody;
     m_contactForceOfSlot[i] = norm(onBody) / m_scenario.dt;
+    m_contactForceId[i] = m_world.id[i];
     const PairBody& p = m_pairBodies[i];
     m_motionBodies[i] = MotionBody{p.kind, p.dof, p.position, p.angle, p.velocity + total[i].dv, p.omega + total[i].domega};
   });
   m_vesselIceForce = forceOfImpulse(vesselImpulse, m_scenario.dt);
-  // By id: the breaks and re-sorts after this phase move bodies between slots.
-  m_contactForces.clear();
-  for (int i = 0; i < n; ++i)
-    if (m_contactForceOfSlot[i] > 0) m_contactForces.emplace_back(m_world.id[i], m_contactForceOfSlot[i]);
-  std::sort(m_contactForces.begin(), m_contactForces.end());
+  m_contactForcesBuilt = false;
 
   const StepContext ctx{m_scenario.dt, m_time, m_step};
   forEachRange(n, [&](int begin, int end) {

@@ -65,7 +65,7 @@ class CpuStepper final : public Stepper {
   // of them for the 456-hexagon field made its step 1.3x slower than one thread's).
   static constexpr int kGrain = 512;
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
-  const std::vector<std::pair<std::int64_t, Real>>* contactForces() const override { return &m_contactForces; }
+  const std::vector<std::pair<std::int64_t, Real>>* contactForces() const override;
   int vesselSlot() const;  // -1 without a vessel
   StepperState saveState() override;
   void restoreState(const StepperState& state) override;
@@ -152,8 +152,13 @@ class CpuStepper final : public Stepper {
   std::vector<std::vector<unsigned char>> m_pairRecordRows;
   std::vector<int> m_pairRecordRoom;
   Vec2 m_vesselIceForce{0, 0};
-  std::vector<Real> m_contactForceOfSlot;                      // |sum of a body's contact impulses| / dt, N
-  std::vector<std::pair<std::int64_t, Real>> m_contactForces;  // the non-zero ones by id (contactForces())
+  // |sum of a body's contact impulses| / dt (N) and the body's id, by the slots of the gather (the
+  // breaks and re-sorts after it move bodies between slots).
+  std::vector<Real> m_contactForceOfSlot;
+  std::vector<std::int64_t> m_contactForceId;
+  // The non-zero ones by id, built when contactForces() is asked (a frame is written), not every step.
+  mutable std::vector<std::pair<std::int64_t, Real>> m_contactForces;
+  mutable bool m_contactForcesBuilt = false;
   double m_rubbleMass = 0;
   long m_floesBroken = 0;
 };
