@@ -374,6 +374,82 @@ TEST(Broadphase, MovingBodiesNeverMissed) {
     }
 }
 
+// Relisting (NeighbourList::relistDirect) under the motion it is for and the motion that tests its
+// 1.5-skin reach: each step a few floes jump 1.2 m (past half the skin: direct, then relisted once
+// more than kMaxDirect are), while every floe swings about its own base by up to 0.49 skin, each in
+// its own phase and direction, so that a floe listed at a relist can close in on a relisted one from
+// the far end of its swing. Every step, every kept-list strategy gives all_pairs' candidates.
+TEST(Broadphase, RelistedFloesNeverMissAPair) {
+  World w = randomWorld(17, 400, 130);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  std::uniform_int_distribution<int> pick(0, w.size() - 1);
+  std::vector<Vec2> base(w.size()), swing(w.size());
+  std::vector<Real> phase(w.size());
+  for (int i = 0; i < w.size(); ++i) {
+    base[i] = {w.x[i], w.y[i]};
+    swing[i] = rotate(Vec2{Real(0.49), 0}, kPi * u(rng));  // peak to peak just under half the 2 m skin
+    phase[i] = kPi * u(rng);
+  }
+  BroadphaseSettings s;
+  s.skin = 2;
+  auto all = makeAll(s);
+  for (int step = 0; step < 200; ++step) {
+    for (int jumps = 0; jumps < 4; ++jumps) {
+      const int i = pick(rng);
+      if (w.kind[i] == BodyKind::Floe) base[i] = base[i] + rotate(Vec2{Real(1.2), 0}, kPi * u(rng));
+    }
+    for (int i = 0; i < w.size(); ++i) {
+      if (w.kind[i] != BodyKind::Floe) continue;
+      const Real t = std::sin(phase[i] + Real(0.7) * static_cast<Real>(step));
+      w.x[i] = base[i].x + t * swing[i].x, w.y[i] = base[i].y + t * swing[i].y;
+    }
+    checkAll(w, all, "step " + std::to_string(step));
+    if (HasFatalFailure()) return;
+  }
+  for (auto& b : all) {
+    const auto* kept = dynamic_cast<const KeptListBroadphase*>(b.get());
+    if (!kept) continue;
+    EXPECT_GE(kept->list().relists(), 40) << b->name() << ": relisting went untested";
+    EXPECT_LT(b->rebuilds(), 20) << b->name() << ": relisting should spare most rebuilds";
+  }
+}
+
+// The worst case of the relist reach, by hand (skin 2 m; squares of side sqrt 2, so R = 1 m and the
+// circles touch at 2 m): floe B, 0.9 m beyond touching A at the build, swings 0.99 m away; A and
+// 8 far floes jump 1.01 m, so 9 are direct and their rows are relisted, with A and B 2.9 m beyond
+// touching: past one skin, within 1.5. Then B swings 1.98 m back and A 0.99 m towards it: their
+// circles overlap, and neither has passed half the skin since its reference, so only A's relisted
+// row can hold the pair. A reach of one skin would miss it.
+TEST(Broadphase, ARelistedRowCoversWhatItsNeighboursCanStillTravel) {
+  World w;
+  const Real side = std::sqrt(Real(2)), touch = 2;                                    // R_a + R_b
+  w.addBody(spec(BodyKind::Floe, rectangle({0, 0}, side, side, 0)));                  // A
+  w.addBody(spec(BodyKind::Floe, rectangle({touch + Real(0.9), 0}, side, side, 0)));  // B
+  for (int k = 0; k < 80; ++k)
+    w.addBody(spec(BodyKind::Floe, rectangle({Real(100 + 10 * (k % 10)), Real(100 + 10 * (k / 10))}, side, side, 0)));
+  BroadphaseSettings s;
+  s.skin = 2;
+  auto all = makeAll(s);
+  checkAll(w, all, "build");
+  w.x[1] += Real(0.99);
+  w.x[0] -= Real(1.01);
+  for (int k = 2; k < 10; ++k) w.y[k] += Real(1.01);
+  checkAll(w, all, "relist");
+  w.x[1] -= Real(1.98);
+  w.x[0] += Real(0.99);
+  const Real gap = w.x[1] - w.x[0];
+  ASSERT_LT(gap, touch) << "the bounding circles must overlap for the case to mean anything";
+  checkAll(w, all, "closed in");
+  for (auto& b : all) {
+    const auto* kept = dynamic_cast<const KeptListBroadphase*>(b.get());
+    if (!kept) continue;
+    EXPECT_EQ(kept->list().relists(), 1) << b->name();
+    EXPECT_EQ(b->rebuilds(), 1) << b->name();
+    EXPECT_EQ(kept->list().directCount(), 0) << b->name();
+  }
+}
+
 TEST(Broadphase, RebuildOnlyWhenNeeded) {
   BroadphaseSettings s;
   s.skin = 2;

@@ -91,8 +91,9 @@ TEST(Threads, ALargeFieldStepsBitForBitOnOneTwoAndFourThreads) {
 // The kept lists' build (the sweep, the counting sort, the clean-up) and their per-step filter (the
 // listed pairs, the direct pass) run over ranges of bodies and pairs on the stepper's pool
 // (framework/api/parallel.hpp). On a field past every range's threshold, with floes moved so that
-// the lists are rebuilt at some calls and only direct at others, every strategy gives the same list
-// and the same candidates, bit for bit, on one thread and on two, three and four.
+// the lists are rebuilt at some calls, relisted at others (NeighbourList::relistDirect) and only
+// direct at the rest, every strategy gives the same list and the same candidates, bit for bit, on
+// one thread and on two, three and four.
 TEST(Threads, KeptListsBuildAndFilterTheSameOnAnyThreadCount) {
   test::TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, test::kBusyScene, {"domain.x=[0.0, 700.0]", "domain.y=[-200.0, 200.0]"});
@@ -111,9 +112,11 @@ TEST(Threads, KeptListsBuildAndFilterTheSameOnAnyThreadCount) {
     std::mt19937 random(7);
     bool sawDirect = false;
     for (int call = 0; call < 12; ++call) {
-      // Odd calls move 3 floes past half the skin (direct, no rebuild), even ones 40 (a rebuild).
+      // Odd calls move 3 floes past half the skin (direct, no rebuild), calls 2 and 6 40 (relisted:
+      // within an eighth of the bodies), the other even ones a third of the bodies (a rebuild).
       std::uniform_int_distribution<int> body(0, world.size() - 1);
-      for (int moved = 0; moved < (call % 2 ? 3 : 40); ++moved) {
+      const int moves = call % 2 ? 3 : call % 4 == 2 ? 40 : world.size() / 3;
+      for (int moved = 0; moved < moves; ++moved) {
         const int i = body(random);
         if (world.kind[i] != BodyKind::Floe) continue;
         world.x[i] += Real(1.5);
@@ -136,10 +139,16 @@ TEST(Threads, KeptListsBuildAndFilterTheSameOnAnyThreadCount) {
         const auto& listed = dynamic_cast<const KeptListBroadphase&>(*many[k]).list().pairs();
         ASSERT_EQ(listed.size(), list.pairs().size());
         EXPECT_EQ(0, std::memcmp(listed.data(), list.pairs().data(), listed.size() * sizeof(ListedPair)));
+        const auto& side = dynamic_cast<const KeptListBroadphase&>(*many[k]).list().sidePairs();
+        ASSERT_EQ(side.size(), list.sidePairs().size());
+        EXPECT_EQ(0, std::memcmp(side.data(), list.sidePairs().data(), side.size() * sizeof(ListedPair)));
         EXPECT_EQ(many[k]->rebuilds(), one->rebuilds());
+        EXPECT_EQ(dynamic_cast<const KeptListBroadphase&>(*many[k]).list().relists(), list.relists());
       }
     }
-    EXPECT_GE(one->rebuilds(), 6) << "the lists were not rebuilt: the build's parallel parts went untested";
+    const NeighbourList& list = dynamic_cast<const KeptListBroadphase&>(*one).list();
+    EXPECT_GE(one->rebuilds(), 3) << "the lists were not rebuilt: the build's parallel parts went untested";
+    EXPECT_GE(list.relists(), 2) << "no list was relisted: relistDirect's parallel parts went untested";
     EXPECT_TRUE(sawDirect) << "no floe was direct: the direct pass went untested";
   }
 }

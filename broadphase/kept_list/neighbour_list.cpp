@@ -10,34 +10,115 @@
 
 namespace gem {
 
-bool NeighbourList::update(const World& world) {
-  if (!m_valid) return true;
+NeighbourList::Need NeighbourList::update(const World& world) {
+  if (!m_valid) return Need::Rebuild;
   const int n = world.size();
-  if (n != static_cast<int>(m_x0.size())) return true;
+  if (n != static_cast<int>(m_x0.size())) return Need::Rebuild;
   const Real* x = world.x.data();
   const Real* y = world.y.data();
   const Real* angle = world.angle.data();
   const Real* radius = world.radius.data();
   const std::int64_t* id = world.id.data();
   const Real limit = kRebuildTrigger * m_skin / 2;
-  for (int i = 0; i < n; ++i) {
-    // A reorder or an in-place replacement without invalidate() would make the list point at the
-    // wrong bodies: the ids guard against it for the price of one load per body.
-    if (id[i] != m_id0[i]) return true;
-    if (m_direct[i]) continue;  // its pairs are found afresh every step
-    const Real dx = x[i] - m_x0[i], dy = y[i] - m_y0[i];
-    // The farthest a point at distance R from the centroid moves under a turn of da is the chord
-    // 2 R |sin(da / 2)| <= R |da wrapped to [-pi, pi]|: an angle that was wrapped by the motion code
-    // (a jump of 2 pi) then counts as no turn, as it should. The wrap is rare, so it is branched.
-    Real da = std::fabs(angle[i] - m_angle0[i]);
-    if (da > kPi) da = std::fabs(std::remainder(da, Real(2) * kPi));
-    if (std::sqrt(dx * dx + dy * dy) + radius[i] * da > limit) {
-      m_direct[i] = 1;
-      m_directList.push_back(i);
-      if (static_cast<int>(m_directList.size()) > kMaxDirect) return true;
+  // Over ranges of bodies, each range's newly direct bodies into a part of its own, appended in
+  // range order: the same list as one pass.
+  const int tasks = parallelTasks(n, kBodyGrain);
+  m_newlyDirect.resize(static_cast<size_t>(tasks));
+  std::vector<char> renamed(static_cast<size_t>(tasks), 0);
+  parallelRanges(n, kBodyGrain, [&](int t, long begin, long end) {
+    std::vector<int>& part = m_newlyDirect[static_cast<size_t>(t)];
+    part.clear();
+    for (long i = begin; i < end; ++i) {
+      // A reorder or an in-place replacement without invalidate() would make the list point at the
+      // wrong bodies: the ids guard against it for the price of one load per body.
+      if (id[i] != m_id0[static_cast<size_t>(i)]) {
+        renamed[static_cast<size_t>(t)] = 1;
+        return;
+      }
+      if (m_direct[static_cast<size_t>(i)]) continue;  // its pairs are found afresh every step
+      const Real dx = x[i] - m_x0[static_cast<size_t>(i)], dy = y[i] - m_y0[static_cast<size_t>(i)];
+      // The farthest a point at distance R from the centroid moves under a turn of da is the chord
+      // 2 R |sin(da / 2)| <= R |da wrapped to [-pi, pi]|: an angle that was wrapped by the motion
+      // code (a jump of 2 pi) then counts as no turn, as it should. The wrap is rare, so branched.
+      Real da = std::fabs(angle[i] - m_angle0[static_cast<size_t>(i)]);
+      if (da > kPi) da = std::fabs(std::remainder(da, Real(2) * kPi));
+      if (std::sqrt(dx * dx + dy * dy) + radius[i] * da > limit) {
+        m_direct[static_cast<size_t>(i)] = 1, m_masked[static_cast<size_t>(i)] = 1;
+        part.push_back(static_cast<int>(i));
+      }
     }
+  });
+  for (char r : renamed)
+    if (r) return Need::Rebuild;
+  for (const std::vector<int>& part : m_newlyDirect) m_directList.insert(m_directList.end(), part.begin(), part.end());
+  const int direct = static_cast<int>(m_directList.size());
+  if (direct <= kMaxDirect) return Need::Nothing;
+  return m_relistedSinceBuild + direct > n / 8 ? Need::Rebuild : Need::Relist;
+}
+
+// The relisted floes' new pairs (each floe against every body, like the direct pass, over ranges of
+// bodies and joined in range order, then sorted: the same on any number of threads) replace their
+// pairs in the side list. The main list is left as it is: its pairs of a relisted floe are masked
+// from then on (m_masked), so a pair is in one list only, and relisting costs a pass over the
+// bodies per floe plus one over the side list, never one over the whole list.
+void NeighbourList::relistDirect(const World& world) {
+  const int n = world.size();
+  const Real* x = world.x.data();
+  const Real* y = world.y.data();
+  const Real* radius = world.radius.data();
+  std::vector<int> relisted, vessels;
+  for (int v : m_directList) (world.kind[v] == BodyKind::Vessel ? vessels : relisted).push_back(v);
+  std::sort(relisted.begin(), relisted.end());
+  m_relisting.assign(static_cast<size_t>(n), 0);
+  for (int v : relisted) m_relisting[static_cast<size_t>(v)] = 1;
+
+  const Real margin = kRelistReach * m_skin;
+  // The box of every relisted floe's reach but the other body's radius: a body whose circle misses
+  // it is beyond every relisted floe's reach, so one test of the box spares the |relisted| tests
+  // of most bodies (the relisted floes are usually the vessel's wake, close together).
+  Real bx0 = 0, bx1 = 0, by0 = 0, by1 = 0;
+  for (size_t k = 0; k < relisted.size(); ++k) {
+    const int v = relisted[k];
+    const Real e = radius[v] + margin;
+    bx0 = k ? std::min(bx0, x[v] - e) : x[v] - e, bx1 = k ? std::max(bx1, x[v] + e) : x[v] + e;
+    by0 = k ? std::min(by0, y[v] - e) : y[v] - e, by1 = k ? std::max(by1, y[v] + e) : y[v] + e;
   }
-  return false;
+  const int bodyTasks = parallelTasks(n, kBodyGrain);
+  m_relistParts.resize(static_cast<size_t>(bodyTasks));
+  parallelRanges(n, kBodyGrain, [&](int t, long begin, long end) {
+    std::vector<ListedPair>& part = m_relistParts[static_cast<size_t>(t)];
+    part.clear();
+    for (int j = static_cast<int>(begin); j < end; ++j) {
+      // Not negated comparisons: a body at no finite place is tested the plain way.
+      if (x[j] + radius[j] < bx0 || x[j] - radius[j] > bx1 || y[j] + radius[j] < by0 || y[j] - radius[j] > by1) continue;
+      for (int v : relisted) {
+        if (j == v || (m_relisting[static_cast<size_t>(j)] && j < v)) continue;  // a pair of two relisted floes once
+        // As finish(): wall-wall pairs never interact, vessel pairs are found by the direct pass.
+        if (world.kind[j] == BodyKind::Vessel || (world.kind[v] == BodyKind::Wall && world.kind[j] == BodyKind::Wall)) continue;
+        const Real dx = x[v] - x[j], dy = y[v] - y[j], touch = radius[v] + radius[j], reach = touch + margin;
+        if (dx * dx + dy * dy <= reach * reach) part.push_back({j < v ? j : v, j < v ? v : j, touch * touch});
+      }
+    }
+  });
+  m_relisted.clear();
+  for (const std::vector<ListedPair>& part : m_relistParts) m_relisted.insert(m_relisted.end(), part.begin(), part.end());
+  auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
+  std::sort(m_relisted.begin(), m_relisted.end(), before);
+  // The side list without the relisted floes' old pairs, merged with their new ones.
+  auto old = [&](const ListedPair& p) { return m_relisting[static_cast<size_t>(p.a)] | m_relisting[static_cast<size_t>(p.b)]; };
+  m_sidePairs.erase(std::remove_if(m_sidePairs.begin(), m_sidePairs.end(), old), m_sidePairs.end());
+  m_merged.resize(m_sidePairs.size() + m_relisted.size());
+  std::merge(m_sidePairs.begin(), m_sidePairs.end(), m_relisted.begin(), m_relisted.end(), m_merged.begin(), before);
+  m_sidePairs.swap(m_merged);
+
+  for (int v : relisted) {
+    m_x0[static_cast<size_t>(v)] = x[v], m_y0[static_cast<size_t>(v)] = y[v], m_angle0[static_cast<size_t>(v)] = world.angle[v];
+    m_direct[static_cast<size_t>(v)] = 0;
+    m_masked[static_cast<size_t>(v)] = 1;
+  }
+  m_directList = vessels;
+  m_relistedSinceBuild += static_cast<int>(relisted.size());
+  ++m_relists;
 }
 
 void NeighbourList::begin(int parts) {
@@ -170,20 +251,25 @@ void NeighbourList::finish(const World& world) {
   m_directList.clear();
   for (int i = 0; i < n; ++i)
     if (world.kind[i] == BodyKind::Vessel) m_direct[i] = 1, m_directList.push_back(i);
+  m_masked = m_direct;
+  m_sidePairs.clear();
   m_valid = true;
+  m_relistedSinceBuild = 0;
   ++m_rebuilds;
 }
 
 void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePair>& out) {
   // Branch-free: every listed pair is written to a scratch row and kept by advancing the count;
   // about a third pass, so a branch would mispredict often. The scratch never shrinks. Pairs of a
-  // direct body are skipped here: the direct pass below finds them. In parallel ranges, each
-  // compacting into its own stretch of the scratch; the stretches are joined in order below.
+  // direct body are skipped here: the direct pass below finds them; so are those of a relisted
+  // floe: the side list holds them. In parallel ranges, each compacting into its own stretch of
+  // the scratch; the stretches are joined in order below.
   const long listed = static_cast<long>(m_pairs.size());
   if (m_filtered.size() < m_pairs.size()) m_filtered.resize(m_pairs.size());
   const Real* x = world.x.data();
   const Real* y = world.y.data();
   const char* direct = m_direct.data();
+  const char* masked = m_masked.data();
   const int tasks = parallelTasks(listed, kPairGrain);
   m_rangeCount.assign(static_cast<size_t>(tasks), 0);
   std::vector<long> first(static_cast<size_t>(tasks));
@@ -194,7 +280,7 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
       const ListedPair& p = m_pairs[static_cast<size_t>(k)];
       const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
       dst[count] = {p.a, p.b};
-      count += (dx * dx + dy * dy <= p.reach2) & !(direct[p.a] | direct[p.b]);
+      count += (dx * dx + dy * dy <= p.reach2) & !(masked[p.a] | masked[p.b]);
     }
     m_rangeCount[static_cast<size_t>(t)] = count;
     first[static_cast<size_t>(t)] = begin;
@@ -226,9 +312,22 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   }
   auto before = [](CandidatePair p, CandidatePair q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
   std::sort(m_directPairs.begin(), m_directPairs.end(), before);
+  // The side list's pairs whose circles overlap now, but those of a direct body (the direct pass
+  // has them), merged in: a side pair has no direct body, a direct pair has one, so none is both.
+  if (!m_sidePairs.empty()) {
+    m_sideFiltered.clear();
+    for (const ListedPair& p : m_sidePairs) {
+      const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
+      if (dx * dx + dy * dy <= p.reach2 && !(direct[p.a] | direct[p.b])) m_sideFiltered.push_back({p.a, p.b});
+    }
+    const size_t directCount = m_directPairs.size();
+    m_directPairs.insert(m_directPairs.end(), m_sideFiltered.begin(), m_sideFiltered.end());
+    std::inplace_merge(m_directPairs.begin(), m_directPairs.begin() + static_cast<std::ptrdiff_t>(directCount), m_directPairs.end(),
+                       before);
+  }
 
-  // The join: range t's pairs, merged with the direct pairs that fall before the next range's first
-  // pair, go after everything of the earlier ranges. A pair is never both listed and direct.
+  // The join: range t's pairs, merged with the direct and side pairs that fall before the next
+  // range's first pair, go after everything of the earlier ranges. A pair is in one of the three only.
   std::vector<size_t> offset(static_cast<size_t>(tasks) + 1, 0), directFrom(static_cast<size_t>(tasks) + 1, m_directPairs.size());
   for (int t = 0; t < tasks; ++t)
     offset[static_cast<size_t>(t) + 1] = offset[static_cast<size_t>(t)] + m_rangeCount[static_cast<size_t>(t)];
@@ -253,10 +352,17 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
 }
 
 void KeptListBroadphase::findCandidates(const World& world, std::vector<CandidatePair>& pairs) {
-  if (m_list.update(world)) {
-    m_list.begin();
-    build(world, m_list);
-    m_list.finish(world);
+  switch (m_list.update(world)) {
+    case NeighbourList::Need::Rebuild:
+      m_list.begin();
+      build(world, m_list);
+      m_list.finish(world);
+      break;
+    case NeighbourList::Need::Relist:
+      m_list.relistDirect(world);
+      break;
+    case NeighbourList::Need::Nothing:
+      break;
   }
   filter(world, pairs);
 }

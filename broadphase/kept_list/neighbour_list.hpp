@@ -14,8 +14,22 @@
 // bounding circles, merged into the sorted candidates). For the bodies still listed every d stays
 // <= skin / 2, so the list stays complete for them, and the direct pass covers the rest: nothing
 // is missed. The vessel is always direct (it moves at several m/s through resting ice and would
-// set the rebuild rate alone), and so are the few floes it is shoving; the list is rebuilt when
-// more than kMaxDirect bodies are direct.
+// set the rebuild rate alone), and so are the few floes it is shoving.
+//
+// When more than kMaxDirect bodies are direct, the direct floes are *relisted* rather than the whole
+// list rebuilt (at 10^5 floes the vessel's wake passed kMaxDirect every 5 steps, and a rebuild cost
+// two steps): each one's pairs are listed afresh from where it is now, with the reach
+// R_a + R_b + 1.5 skin, into a side list, its pairs in the main list are masked from then on, and
+// its reference state becomes its state now. Why 1.5 skin: take a pair and the last time T it was
+// judged, by the build or by relisting either body. If neither is direct now, neither has been
+// relisted since T, and each was within half the skin of its reference at T and is now (a body
+// direct at T was relisted at T), so since T the relisted one has moved at most skin / 2 and the
+// other at most skin / 2 + skin / 2: 1.5 skin in all (a full build judges both from their
+// references, so the skin suffices there). Extra listed pairs cost only filter time: the
+// candidates (listed pairs whose circles overlap now, plus the direct pass) are the same pairs in
+// the same order, so trajectories do not change. The list is rebuilt whole when the bodies
+// change, or once the floes relisted since the build pass an eighth of the bodies (the side list
+// is filtered on one thread, and a relist costs a pass over every body per relisted floe).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -42,12 +56,19 @@ class NeighbourList {
   explicit NeighbourList(Real skin) : m_skin(skin) {}
 
   Real skin() const { return m_skin; }
-  // True when the list must be rebuilt: never built, invalidated, body count or identities changed,
-  // or more than kMaxDirect bodies have become direct. Otherwise marks every body that has moved
-  // more than half the skin since the build as direct. One pass over the bodies.
-  bool update(const World& world);
+  // What the list needs before this step's filter. Rebuild: never built, invalidated, body count or
+  // identities changed, or more than kMaxDirect bodies are direct and relisting them would pass the
+  // budget (an eighth of the bodies since the build). Relist: more than kMaxDirect are direct,
+  // within the budget (relistDirect()). Otherwise marks every body that has moved more than half
+  // the skin since its reference as direct. One pass over the bodies.
+  enum class Need { Nothing, Relist, Rebuild };
+  Need update(const World& world);
+  // The direct floes' rows listed afresh from where they are now (see above); they stop being direct.
+  void relistDirect(const World& world);
   int directCount() const { return static_cast<int>(m_directList.size()); }
   static constexpr int kMaxDirect = 8;
+  static constexpr Real kRelistReach = Real(1.5);  // skins
+  long relists() const { return m_relists; }
   // Items a parallel range takes at least (framework/api/parallel.hpp): pairs of a stream (a few
   // nanoseconds each), bodies of an O(1) pass.
   static constexpr int kPairGrain = 4096, kBodyGrain = 1024;
@@ -69,13 +90,15 @@ class NeighbourList {
   // (sorted). Clears out first.
   void filterByCircles(const World& world, std::vector<CandidatePair>& out);
   const std::vector<ListedPair>& pairs() const { return m_pairs; }
+  const std::vector<ListedPair>& sidePairs() const { return m_sidePairs; }  // those of the relisted floes
 
  private:
   void sortRaw(int bodyCount);
   static constexpr int kShortRow = 32;  // rows up to this long are insertion-sorted
   Real m_skin;
   bool m_valid = false;
-  long m_rebuilds = 0;
+  long m_rebuilds = 0, m_relists = 0;
+  int m_relistedSinceBuild = 0;
   std::vector<std::vector<ListedPair>> m_raw;  // the build's parts
   std::vector<ListedPair> m_pairs, m_kept;
   std::vector<CandidatePair> m_filtered;
@@ -92,7 +115,18 @@ class NeighbourList {
   // bodies that moved more than half the skin since the build.
   std::vector<char> m_direct;
   std::vector<int> m_directList;
+  std::vector<std::vector<int>> m_newlyDirect;  // update()'s, range by range
   std::vector<CandidatePair> m_directPairs;
+  // Relisting: the side list (every pair of a floe relisted since the build, sorted), the bodies
+  // whose pairs the main list no longer gives (direct or relisted, by slot), and scratch: the
+  // floes being relisted (by slot), their new pairs (range by range, then all), the side pairs
+  // whose circles overlap this step.
+  std::vector<ListedPair> m_sidePairs;
+  std::vector<char> m_masked;
+  std::vector<char> m_relisting;
+  std::vector<std::vector<ListedPair>> m_relistParts;
+  std::vector<ListedPair> m_relisted, m_merged;
+  std::vector<CandidatePair> m_sideFiltered;
 };
 
 // Base of the kept-list strategies: rebuild when the rule asks, then filter. A strategy says only
