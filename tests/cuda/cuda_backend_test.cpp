@@ -412,6 +412,27 @@ TEST(CudaBackend, StagedPrepareChangesNothing) {
   EXPECT_GT(results[0].broken, 0);
 }
 
+// The resident driver keeps a world's vertices in shared memory when the launch has room for them,
+// else reads them from global memory (GEM_RESIDENT_STAGE_VERTICES=0 forces that): the same
+// arithmetic on the same values, so the same run bit for bit.
+TEST(CudaBackend, ResidentVerticesInGlobalMemoryChangeNothing) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  const Scenario s = test::scenarioFromToml(dir, kBusyScene, {"simulation.cuda_driver=\"resident\""});
+  State results[2];
+  for (int staged = 0; staged < 2; ++staged) {
+    if (!staged) ::setenv("GEM_RESIDENT_STAGE_VERTICES", "0", 1);
+    CudaStepper sim(s);
+    ASSERT_EQ(sim.driver(), "resident");
+    results[staged] = run(sim, 150);
+    ::unsetenv("GEM_RESIDENT_STAGE_VERTICES");
+  }
+  ASSERT_EQ(results[0].ids, results[1].ids);
+  EXPECT_EQ(0, std::memcmp(results[0].values.data(), results[1].values.data(), results[0].values.size() * sizeof(Real)));
+  EXPECT_EQ(results[0].impacts, results[1].impacts);
+  EXPECT_GT(results[0].impacts, 0) << "the scene must touch, or it guards nothing";
+}
+
 // A candidate list past its capacity makes the step run again with more room: same result bit for bit.
 TEST(CudaBackend, CandidateOverflowIsRedoneBitIdentically) {
   GEM_SKIP_WITHOUT_CUDA();
