@@ -153,6 +153,46 @@ TEST(Threads, KeptListsBuildAndFilterTheSameOnAnyThreadCount) {
   }
 }
 
+// The relisting's passes (the relisted floes' new pairs over ranges of bodies) and the side list's
+// filter (over ranges of side pairs) on a field big enough to split both: 22,500 squares 0.2 m
+// apart, 2,250 of them moved past half the skin, so relisted (within an eighth of the bodies).
+// One thread and three give the same side list and the same candidates, bit for bit.
+TEST(Threads, RelistingAndTheSideListSplitTheSameOnAnyThreadCount) {
+  World start;
+  for (int k = 0; k < 150 * 150; ++k)
+    start.addBody(test::squareFloe({Real(1.2) * static_cast<Real>(k % 150), Real(1.2) * static_cast<Real>(k / 150)}, 1, 1));
+  BroadphaseSettings settings;
+  settings.skin = 2;
+  auto one = Registry::global().broadphase("variable_radius").make(settings);
+  auto three = Registry::global().broadphase("variable_radius").make(settings);
+  ThreadPool pool(3);
+  std::vector<CandidatePair> expected, pairs;
+  World world = start;
+  for (int call = 0; call < 3; ++call) {
+    if (call == 1)
+      for (int i = 0; i < world.size(); i += 10) world.x[i] += Real(1.01);
+    if (call == 2)
+      for (int i = 5; i < world.size(); i += 10) world.y[i] -= Real(0.3);  // a step of ordinary motion after the relist
+    one->findCandidates(world, expected);
+    {
+      const ParallelScope lend(&pool);
+      three->findCandidates(world, pairs);
+    }
+    SCOPED_TRACE(::testing::Message() << "call " << call);
+    ASSERT_EQ(pairs.size(), expected.size());
+    EXPECT_EQ(0, std::memcmp(pairs.data(), expected.data(), pairs.size() * sizeof(CandidatePair)));
+  }
+  const NeighbourList& a = dynamic_cast<const KeptListBroadphase&>(*one).list();
+  const NeighbourList& b = dynamic_cast<const KeptListBroadphase&>(*three).list();
+  EXPECT_EQ(a.relists(), 1);
+  EXPECT_EQ(b.relists(), 1);
+  EXPECT_EQ(one->rebuilds(), 1);
+  ASSERT_GE(static_cast<int>(a.sidePairs().size()), 4 * NeighbourList::kPairGrain) << "too few side pairs for the filter to be split";
+  ASSERT_EQ(a.sidePairs().size(), b.sidePairs().size());
+  EXPECT_EQ(0, std::memcmp(a.sidePairs().data(), b.sidePairs().data(), a.sidePairs().size() * sizeof(ListedPair)));
+  EXPECT_GT(expected.size(), 10000u) << "the squares 0.2 m apart with moved ones among them must give candidates";
+}
+
 // A pack driven against a wall by a strong current: thousands of contacts a step, so the pair
 // events run over ranges of contacts on the pool, their records joined in order
 // (CpuStepper::kParallelContacts).

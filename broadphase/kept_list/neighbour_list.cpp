@@ -314,14 +314,21 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   std::sort(m_directPairs.begin(), m_directPairs.end(), before);
   // The side list's pairs whose circles overlap now, but those of a direct body (the direct pass
   // has them), merged in: a side pair has no direct body, a direct pair has one, so none is both.
+  // Over ranges of the side list, each range's survivors into a part of its own, appended in order.
   if (!m_sidePairs.empty()) {
-    m_sideFiltered.clear();
-    for (const ListedPair& p : m_sidePairs) {
-      const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
-      if (dx * dx + dy * dy <= p.reach2 && !(direct[p.a] | direct[p.b])) m_sideFiltered.push_back({p.a, p.b});
-    }
+    const long side = static_cast<long>(m_sidePairs.size());
+    m_sideParts.resize(static_cast<size_t>(parallelTasks(side, kPairGrain)));
+    parallelRanges(side, kPairGrain, [&](int t, long begin, long end) {
+      std::vector<CandidatePair>& part = m_sideParts[static_cast<size_t>(t)];
+      part.clear();
+      for (long k = begin; k < end; ++k) {
+        const ListedPair& p = m_sidePairs[static_cast<size_t>(k)];
+        const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
+        if (dx * dx + dy * dy <= p.reach2 && !(direct[p.a] | direct[p.b])) part.push_back({p.a, p.b});
+      }
+    });
     const size_t directCount = m_directPairs.size();
-    m_directPairs.insert(m_directPairs.end(), m_sideFiltered.begin(), m_sideFiltered.end());
+    for (const std::vector<CandidatePair>& part : m_sideParts) m_directPairs.insert(m_directPairs.end(), part.begin(), part.end());
     std::inplace_merge(m_directPairs.begin(), m_directPairs.begin() + static_cast<std::ptrdiff_t>(directCount), m_directPairs.end(),
                        before);
   }

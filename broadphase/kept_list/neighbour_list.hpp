@@ -29,7 +29,7 @@
 // candidates (listed pairs whose circles overlap now, plus the direct pass) are the same pairs in
 // the same order, so trajectories do not change. The list is rebuilt whole when the bodies
 // change, or once the floes relisted since the build pass an eighth of the bodies (the side list
-// is filtered on one thread, and a relist costs a pass over every body per relisted floe).
+// grows with every relist, and a relist costs a pass over every body per relisted floe).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -120,13 +120,13 @@ class NeighbourList {
   // Relisting: the side list (every pair of a floe relisted since the build, sorted), the bodies
   // whose pairs the main list no longer gives (direct or relisted, by slot), and scratch: the
   // floes being relisted (by slot), their new pairs (range by range, then all), the side pairs
-  // whose circles overlap this step.
+  // whose circles overlap this step (range by range).
   std::vector<ListedPair> m_sidePairs;
   std::vector<char> m_masked;
   std::vector<char> m_relisting;
   std::vector<std::vector<ListedPair>> m_relistParts;
   std::vector<ListedPair> m_relisted, m_merged;
-  std::vector<CandidatePair> m_sideFiltered;
+  std::vector<std::vector<CandidatePair>> m_sideParts;
 };
 
 // Base of the kept-list strategies: rebuild when the rule asks, then filter. A strategy says only

@@ -84,10 +84,10 @@ __global__ void endKernel(cudaGraphConditionalHandle loop, const Control* c, Sta
 int main(int argc, char** argv) {
   const int rounds = argc > 1 ? std::atoi(argv[1]) : 8;
   const bool deepStack = argc > 2 && std::string(argv[2]) == "stack";
-  const bool memsetNode = argc > 2 && std::string(argv[2]) == "memset";  // a memset node in the loop's body
-  const bool many = argc > 2 && std::string(argv[2]) == "many";          // GEM's prepare kernel's shape
-  const bool wide = argc > 2 && std::string(argv[2]) == "wide";          // 60 kernels a step, as many as GEM's step
-  const bool trig = argc > 2 && std::string(argv[2]).find("trig") != std::string::npos;      // double cos/sin: module-global table reads
+  const bool memsetNode = argc > 2 && std::string(argv[2]) == "memset";                        // a memset node in the loop's body
+  const bool many = argc > 2 && std::string(argv[2]) == "many";                                // GEM's prepare kernel's shape
+  const bool wide = argc > 2 && std::string(argv[2]) == "wide";                                // 60 kernels a step, as many as GEM's step
+  const bool trig = argc > 2 && std::string(argv[2]).find("trig") != std::string::npos;        // double cos/sin: module-global table reads
   const bool module2 = argc > 2 && std::string(argv[2]).find("module2") != std::string::npos;  // a body kernel from a second module
   cudaStream_t stream;
   CHECK(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking));
