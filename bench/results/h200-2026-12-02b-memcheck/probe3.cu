@@ -77,17 +77,20 @@ __global__ void trigKernel(float* x, double* angle, int n) {
 }
 void launchOther(float* x, int n, cudaStream_t s);
 __global__ void endKernel(cudaGraphConditionalHandle loop, const Control* c, Stats* s) {
+  __syncthreads();
+  if (threadIdx.x != 0) return;
   ++s->done;
   cudaGraphSetConditional(loop, s->done < c->steps ? 1u : 0u);
 }
 
-int main(int argc, char** argv) {
+int whileGraphProbe(int argc, char** argv) {
   const int rounds = argc > 1 ? std::atoi(argv[1]) : 8;
   const bool deepStack = argc > 2 && std::string(argv[2]) == "stack";
-  const bool memsetNode = argc > 2 && std::string(argv[2]) == "memset";                        // a memset node in the loop's body
-  const bool many = argc > 2 && std::string(argv[2]) == "many";                                // GEM's prepare kernel's shape
-  const bool wide = argc > 2 && std::string(argv[2]) == "wide";                                // 60 kernels a step, as many as GEM's step
-  const bool trig = argc > 2 && std::string(argv[2]).find("trig") != std::string::npos;        // double cos/sin: module-global table reads
+  const bool memsetNode = argc > 2 && std::string(argv[2]) == "memset";                  // a memset node in the loop's body
+  const bool many = argc > 2 && std::string(argv[2]) == "many";                          // GEM's prepare kernel's shape
+  const bool wide = argc > 2 && std::string(argv[2]) == "wide";                          // 60 kernels a step, as many as GEM's step
+  const bool trig = argc > 2 && std::string(argv[2]).find("trig") != std::string::npos;  // double cos/sin: module-global table reads
+  const bool edge32 = argc > 2 && std::string(argv[2]).find("edge32") != std::string::npos;
   const bool module2 = argc > 2 && std::string(argv[2]).find("module2") != std::string::npos;  // a body kernel from a second module
   cudaStream_t stream;
   CHECK(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking));
@@ -158,7 +161,7 @@ int main(int argc, char** argv) {
     if (trig) trigKernel<<<blocks, 128, 0, stream>>>(x, angle, n);
     if (module2) launchOther(x, n, stream);
     for (int k = 0; wide && k < 60; ++k) stackKernel<<<blocks, 128, 0, stream>>>(x, n, round + k);
-    endKernel<<<1, 1, 0, stream>>>(handle, control, stats);
+    endKernel<<<1, edge32 ? 32 : 1, 0, stream>>>(handle, control, stats);
     CHECK(cudaStreamEndCapture(stream, &body));
     CHECK(cudaGraphAddMemcpyNode1D(&out, graph, &loop, 1, hStats, stats, sizeof(Stats), cudaMemcpyDeviceToHost));
     cudaGraphExec_t exec;
@@ -183,3 +186,7 @@ int main(int argc, char** argv) {
   std::printf("while_graph_probe: %d rounds, every batch ran its steps\n", rounds);
   return 0;
 }
+
+#ifndef PROBE_NO_MAIN
+int main(int argc, char** argv) { return whileGraphProbe(argc, argv); }
+#endif

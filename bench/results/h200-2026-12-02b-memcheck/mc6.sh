@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+cd "$(dirname "$0")"
+export LD_LIBRARY_PATH=$PWD/lib GEM_BINARY_DIR=$PWD GEM_SOURCE_DIR=$PWD GEM_TEST_CUDA_PLUGIN_DIR=$PWD/cuda_plugins
+san=$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)
+T=CudaBroadphase.EveryStrategyGivesTheGridsTrajectoriesBitForBit
+export GEM_CUDA_DRIVER=device
+rm -f /tmp/stop-bg
+( while [ ! -f /tmp/stop-bg ]; do ./gem_cuda_tests --gtest_filter=$T > /dev/null 2>&1; done ) &
+sleep 4
+one() { name=$1; shift; for k in $(seq $RUNS); do w=$(mktemp -d); (cd $w && timeout 150 "$@" > $OUT/mc-$name-$k.txt 2>&1; echo "$name $k rc=$? $(grep -h 'ERROR SUMMARY' $OUT/mc-$name-$k.txt | head -1)"); done; }
+RUNS=4 one probe-shared-cudart $san --tool memcheck --error-exitcode 9 $PWD/probe/probe3-shared 8 plain
+RUNS=3 one probe-static-cudart $san --tool memcheck --error-exitcode 9 $PWD/probe/probe3 8 plain
+touch /tmp/stop-bg; wait
