@@ -1,6 +1,8 @@
 // EXPERIMENT (issue 15), not for main: GEM's batch graph with the loop's body cut to the step's
 // first and last kernels, rebuilt here from GEM's own types without the rest of DeviceStep.
 #include <gtest/gtest.h>
+#include <cub/device/device_radix_sort.cuh>
+#include <vector>
 
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +15,10 @@ namespace {
 using namespace gem;
 using namespace gem::cuda;
 #define PCHECK(call) ASSERT_EQ((call), cudaSuccess) << #call
+__global__ void touchKernel(float* a, int n) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) a[i] = a[i] * 0.5f + 1.0f;
+}
 __global__ void pBeginBatch(StepStats* s) {
   for (int q = 0; q < kMaxRecordStreams; ++q) s->recordCount[q] = 0;
   s->stepsDone = 0;
@@ -69,6 +75,45 @@ TEST(MemcheckProbe, GemShapedGraph) {
   PCHECK(cudaMalloc(&worldStats, sizeof(WorldStepRecord) * worlds));
   PCHECK(cudaMemset(stats, 0, sizeof(StepStats)));
   PCHECK(cudaStreamSynchronize(cudaStreamLegacy));
+  // DeviceStep's work before its first launch, by the mode's words.
+  const int arrays = 40, n = 1 << 18;
+  std::vector<float*> a(arrays, nullptr);
+  for (auto& p : a) PCHECK(cudaMalloc(&p, n * sizeof(float)));
+  if (m.find("upload") != std::string::npos) {
+    std::vector<float> host(n, 0.25f);
+    for (auto* p : a) PCHECK(cudaMemcpy(p, host.data(), n * sizeof(float), cudaMemcpyHostToDevice));
+  }
+  if (m.find("memset") != std::string::npos)
+    for (auto* p : a) PCHECK(cudaMemset(p, 0, n * sizeof(float)));
+  if (m.find("realloc") != std::string::npos)
+    for (int k = 0; k < arrays; k += 2) {
+      PCHECK(cudaFree(a[k]));
+      PCHECK(cudaMalloc(&a[k], 2 * n * sizeof(float)));
+    }
+  if (m.find("big") != std::string::npos) {
+    void* big;
+    PCHECK(cudaMalloc(&big, size_t(2) << 30));
+  }
+  PCHECK(cudaStreamSynchronize(cudaStreamLegacy));
+  if (m.find("kernels") != std::string::npos)
+    for (auto* p : a) touchKernel<<<(n + 127) / 128, 128, 0, stream>>>(p, n);
+  if (m.find("cub") != std::string::npos) {
+    unsigned *key, *keyOut;
+    int *val, *valOut;
+    PCHECK(cudaMalloc(&key, n * 4));
+    PCHECK(cudaMalloc(&keyOut, n * 4));
+    PCHECK(cudaMalloc(&val, n * 4));
+    PCHECK(cudaMalloc(&valOut, n * 4));
+    PCHECK(cudaMemset(key, 0, n * 4));
+    PCHECK(cudaMemset(val, 0, n * 4));
+    size_t bytes = 0;
+    PCHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, key, keyOut, val, valOut, n, 0, 32, stream));
+    void* temp;
+    PCHECK(cudaMalloc(&temp, bytes));
+    PCHECK(cudaStreamSynchronize(cudaStreamLegacy));
+    PCHECK(cub::DeviceRadixSort::SortPairs(temp, bytes, key, keyOut, val, valOut, n, 0, 32, stream));
+  }
+  PCHECK(cudaStreamSynchronize(stream));
 
   cudaGraph_t graph;
   PCHECK(cudaGraphCreate(&graph, 0));
