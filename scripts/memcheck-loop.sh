@@ -7,7 +7,7 @@
 # 1 otherwise. AT_ONCE 1 gives each run the GPU to itself; more at once share it, which is when the
 # graph path's unexplained report appears (docs/performance.md 6).
 # scripts/memcheck/while_graph_probe.cu is a GEM-free control to run the same way (built with
-# `nvcc -O2 -arch=sm_90 -o while_graph_probe scripts/memcheck/while_graph_probe.cu`).
+# `nvcc -O2 -arch=sm_90 -o while_graph_probe scripts/memcheck/while_graph_probe.cu scripts/memcheck/second_module.cu`).
 set -uo pipefail
 if [ $# -lt 5 ] || [ "$4" != "--" ]; then
   echo "usage: $0 RUNS AT_ONCE OUTDIR -- COMMAND [ARGS...]" >&2

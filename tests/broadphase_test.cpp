@@ -376,7 +376,7 @@ TEST(Broadphase, MovingBodiesNeverMissed) {
 
 // Relisting (NeighbourList::relistDirect) under the motion it is for and the motion that tests its
 // 1.5-skin reach: each step a few floes jump 1.2 m (past half the skin: direct, then relisted once
-// more than kMaxDirect are), while every floe swings about its own base by up to 0.49 skin, each in
+// more than kMaxDirect are), while every floe swings about its own base by up to 0.49 m, each in
 // its own phase and direction, so that a floe listed at a relist can close in on a relisted one from
 // the far end of its swing. Every step, every kept-list strategy gives all_pairs' candidates.
 TEST(Broadphase, RelistedFloesNeverMissAPair) {

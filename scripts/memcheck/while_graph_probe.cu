@@ -4,8 +4,12 @@
 // buffers cudaMalloc'd just before the capture, a CUB radix sort, a last kernel that sets the
 // condition), and copies out to pinned memory. Each round allocates fresh buffers, captures,
 // launches a few batches and frees, like the CUDA tests' simulations do. A second argument adds to
-// the loop's body a kernel with a deep stack ("stack"), a memset node ("memset"), or 60 kernels a
-// step ("wide").
+// the loop's body a kernel with a deep stack ("stack"), a memset node ("memset"), 60 kernels a
+// step ("wide"), GEM's prepare kernel's parameter shape ("many"); or, as words anywhere in it, a
+// kernel with double cos/sin ("trig"), a kernel of a second module ("module2", second_module.cu),
+// and the condition set as GEM's last step kernel sets it, thread 0 of 32 after a barrier ("edge32").
+// Build: nvcc -O2 -arch=sm_90 -o while_graph_probe while_graph_probe.cu second_module.cu
+// (-DPROBE_NO_MAIN leaves out main, to call whileGraphProbe from a test of another program).
 //
 // Used by scripts/memcheck-loop.sh: if this probe, which shares no code with GEM, reports an
 // error under several sanitized processes at once, the report is the tool's, not GEM's.
@@ -67,17 +71,31 @@ __global__ void manyArraysKernel(ManyArrays m, int n) {
   for (int k = 0; k < kManyArrays; ++k) sum += m.a[k][i];
   for (int k = 0; k < kManyArrays; ++k) m.a[k][i] = sum * 1e-3f;
 }
+// GEM's prepare reads its module's libdevice table (__cudart_sin_cos_coeffs) through double cos/sin.
+__global__ void trigKernel(float* x, double* angle, int n) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const double c = cos(angle[i]), s = sin(angle[i]);
+  angle[i] += 1e-3;
+  x[i] = static_cast<float>(x[i] * c + 1e-3 * s);
+}
+void launchOther(float* x, int n, cudaStream_t s);
 __global__ void endKernel(cudaGraphConditionalHandle loop, const Control* c, Stats* s) {
+  __syncthreads();
+  if (threadIdx.x != 0) return;
   ++s->done;
   cudaGraphSetConditional(loop, s->done < c->steps ? 1u : 0u);
 }
 
-int main(int argc, char** argv) {
+int whileGraphProbe(int argc, char** argv) {
   const int rounds = argc > 1 ? std::atoi(argv[1]) : 8;
   const bool deepStack = argc > 2 && std::string(argv[2]) == "stack";
-  const bool memsetNode = argc > 2 && std::string(argv[2]) == "memset";  // a memset node in the loop's body
-  const bool many = argc > 2 && std::string(argv[2]) == "many";          // GEM's prepare kernel's shape
-  const bool wide = argc > 2 && std::string(argv[2]) == "wide";          // 60 kernels a step, as many as GEM's step
+  const bool memsetNode = argc > 2 && std::string(argv[2]) == "memset";                  // a memset node in the loop's body
+  const bool many = argc > 2 && std::string(argv[2]) == "many";                          // GEM's prepare kernel's shape
+  const bool wide = argc > 2 && std::string(argv[2]) == "wide";                          // 60 kernels a step, as many as GEM's step
+  const bool trig = argc > 2 && std::string(argv[2]).find("trig") != std::string::npos;  // double cos/sin: module-global table reads
+  const bool edge32 = argc > 2 && std::string(argv[2]).find("edge32") != std::string::npos;
+  const bool module2 = argc > 2 && std::string(argv[2]).find("module2") != std::string::npos;  // a body kernel from a second module
   cudaStream_t stream;
   CHECK(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking));
   Control* hControl;
@@ -98,6 +116,9 @@ int main(int argc, char** argv) {
     CHECK(cudaMalloc(&valueSorted, n * sizeof(int)));
     CHECK(cudaMalloc(&control, sizeof(Control)));
     CHECK(cudaMalloc(&stats, sizeof(Stats)));
+    double* angle;
+    CHECK(cudaMalloc(&angle, n * sizeof(double)));
+    CHECK(cudaMemset(angle, 0, n * sizeof(double)));
     std::vector<float> hx(n, 0.5f);
     CHECK(cudaMemcpy(x, hx.data(), n * sizeof(float), cudaMemcpyHostToDevice));  // legacy stream, as GEM's uploads
     size_t tempBytes = 0;
@@ -141,8 +162,10 @@ int main(int argc, char** argv) {
     moveKernel<<<blocks, 128, 0, stream>>>(x, valueSorted, keySorted, n, stats);
     if (deepStack) stackKernel<<<blocks, 128, 0, stream>>>(x, n, round);
     if (many) manyArraysKernel<<<blocks, 128, 0, stream>>>(arrays, n);
+    if (trig) trigKernel<<<blocks, 128, 0, stream>>>(x, angle, n);
+    if (module2) launchOther(x, n, stream);
     for (int k = 0; wide && k < 60; ++k) stackKernel<<<blocks, 128, 0, stream>>>(x, n, round + k);
-    endKernel<<<1, 1, 0, stream>>>(handle, control, stats);
+    endKernel<<<1, edge32 ? 32 : 1, 0, stream>>>(handle, control, stats);
     CHECK(cudaStreamEndCapture(stream, &body));
     CHECK(cudaGraphAddMemcpyNode1D(&out, graph, &loop, 1, hStats, stats, sizeof(Stats), cudaMemcpyDeviceToHost));
     cudaGraphExec_t exec;
@@ -162,7 +185,12 @@ int main(int argc, char** argv) {
                     static_cast<void*>(valueSorted), static_cast<void*>(control), static_cast<void*>(stats), temp})
       CHECK(cudaFree(p));
     for (int k = 0; many && k < kManyArrays; ++k) CHECK(cudaFree(arrays.a[k]));
+    CHECK(cudaFree(angle));
   }
   std::printf("while_graph_probe: %d rounds, every batch ran its steps\n", rounds);
   return 0;
 }
+
+#ifndef PROBE_NO_MAIN
+int main(int argc, char** argv) { return whileGraphProbe(argc, argv); }
+#endif

@@ -1,4 +1,5 @@
-// A body kernel in a second module (its own translation unit, no -rdc), as prepare.cu is to step_graph.cu.
+// while_graph_probe.cu's "module2": a body kernel in a second module (its own translation unit, no
+// -rdc), as prepare.cu is to step_graph.cu.
 #include <cuda_runtime.h>
 __global__ void otherKernel(float* x, int n) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
