@@ -204,7 +204,7 @@ void DeviceStep::setTouchingPairs(const std::vector<std::pair<std::int64_t, std:
   std::sort(keys.begin(), keys.end());
   if (d.resident) return setResidentPreviousKeys(d, std::move(keys));
   const int count = static_cast<int>(keys.size());
-  d.previousKeys.ensure(std::max<size_t>(keys.size(), 1));
+  if (d.previousKeys.ensure(std::max<size_t>(keys.size(), 1))) d.dropGraph();  // the graph reads and writes them
   d.previousKeys.uploadAt(0, keys.data(), keys.size());
   d.h_stats->previousContacts = count;
   GEM_CUDA_CHECK(cudaMemcpy(&d.stats.get()->previousContacts, &count, sizeof count, cudaMemcpyHostToDevice));

@@ -164,6 +164,7 @@ struct DeviceState {
     if (stream) cudaStreamDestroy(stream);
   }
   void setRing(int size, int worldCount) {
+    dropGraph();  // first: the graph's last nodes copy into the pinned rings freed here
     if (h_ring) GEM_CUDA_CHECK(cudaFreeHost(h_ring));
     if (h_worldRing) GEM_CUDA_CHECK(cudaFreeHost(h_worldRing));
     h_ring = nullptr, h_worldRing = nullptr;
@@ -174,7 +175,6 @@ struct DeviceState {
     ring.ensure(static_cast<size_t>(size));
     worldRing.ensure(worldRecords);
     worldStats.ensure(static_cast<size_t>(worldCount));
-    dropGraph();
   }
   // The step graph no longer matches the state (n, a buffer, the ring changed): the next batch
   // captures it anew. (Updating the executable graph in place, cudaGraphExecUpdate, was tried:
