@@ -49,6 +49,37 @@ GEM_HD inline void emitVertex(ClipVertex* dst, int* k, Vec2 p, signed char in, s
   }
 }
 
+// emitVertex with the last vertex held in registers until the next one is known: the same
+// vertices and tags, stored once, field by field. (Updating a stored vertex's one-byte tag and
+// reading the vertex back whole soon after stalls the CPU's store forwarding; so does building
+// the whole struct from its bytes.)
+struct ClipWriter {
+  ClipVertex* dst;
+  Real tol;
+  int k = 0;
+  Vec2 lastP{};  // dst[k - 1], not yet stored
+  signed char lastIn = 0, lastOut = 0;
+  GEM_HD void emit(Vec2 p, signed char in, signed char out) {
+    if (k > 0 && nearPoint(lastP, p, tol)) {
+      lastOut = out;
+    } else if (k < kMaxClipVertices) {
+      store();
+      lastP = p, lastIn = in, lastOut = out;
+      ++k;
+    }
+  }
+  GEM_HD void store() {
+    if (k == 0) return;
+    dst[k - 1].p = lastP;
+    dst[k - 1].inEdge = lastIn;
+    dst[k - 1].outEdge = lastOut;
+  }
+  GEM_HD int finish() {
+    store();
+    return k;
+  }
+};
+
 // The merge tolerance of clipConvex for polygons p (n vertices) and q (m): vertices closer than
 // this are one vertex. Relative to the smaller body (the overlap's scale) and to the coordinate
 // magnitude (the rounding of world coordinates).
@@ -90,42 +121,41 @@ GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVer
   ClipVertex tmp[kMaxClipVertices];
   ClipVertex* src = out;
   ClipVertex* dst = tmp;
-  int k = 0;
-  for (int i = 0; i < n; ++i) detail::emitVertex(src, &k, p[i], 0, 0, tol);
-  k = detail::closeRing(src, k, tol);
+  detail::ClipWriter first{src, tol};
+  for (int i = 0; i < n; ++i) first.emit(p[i], 0, 0);
+  int k = detail::closeRing(src, first.finish(), tol);
 
+  Real side[kMaxClipVertices];
   for (int j = 0; j < m && k >= 3; ++j) {
     Vec2 a = q[j], e = q[j + 1 == m ? 0 : j + 1] - a;
-    // Signed test: cross(e, x - a) >= 0 is inside (left of a counter-clockwise edge).
-    bool anyOut = false, anyIn = false;
-    for (int i = 0; i < k && !(anyOut && anyIn); ++i) {
-      if (detail::clipSide(a, e, src[i].p) < Real(0)) {
-        anyOut = true;
-      } else {
-        anyIn = true;
-      }
-    }
-    if (!anyOut) continue;  // this edge does not cut the polygon: nothing to copy
-    if (!anyIn) return 0;   // wholly outside this edge: no overlap
-
-    int kk = 0;
-    Vec2 prev = src[k - 1].p;
-    Real sPrev = detail::clipSide(a, e, prev);
+    // Signed test: cross(e, x - a) >= 0 is inside (left of a counter-clockwise edge). Each
+    // vertex's side is computed once and kept for the clipping below; counting instead of
+    // branching, as most edges leave the polygon untouched.
+    int outside = 0;
     for (int i = 0; i < k; ++i) {
-      ClipVertex cur = src[i];
-      Real sCur = detail::clipSide(a, e, cur.p);
+      side[i] = detail::clipSide(a, e, src[i].p);
+      outside += side[i] < Real(0);
+    }
+    if (outside == 0) continue;  // this edge does not cut the polygon: nothing to copy
+    if (outside == k) return 0;  // wholly outside this edge: no overlap
+
+    detail::ClipWriter w{dst, tol};
+    Vec2 prev = src[k - 1].p;
+    Real sPrev = side[k - 1];
+    for (int i = 0; i < k; ++i) {
+      const Vec2 cur = src[i].p;
+      const signed char in = src[i].inEdge;
+      const Real sCur = side[i];
       if (sCur >= Real(0)) {
-        if (sPrev < Real(0)) {  // entering Q's half-plane: arrive along Q, leave along the edge
-          detail::emitVertex(dst, &kk, detail::clipCrossing(prev, sPrev, cur.p, sCur), 1, cur.inEdge, tol);
-        }
-        detail::emitVertex(dst, &kk, cur.p, cur.inEdge, cur.outEdge, tol);
+        if (sPrev < Real(0)) w.emit(detail::clipCrossing(prev, sPrev, cur, sCur), 1, in);  // entering Q's half-plane
+        w.emit(cur, in, src[i].outEdge);
       } else if (sPrev >= Real(0)) {  // leaving: arrive along the edge, continue along Q
-        detail::emitVertex(dst, &kk, detail::clipCrossing(prev, sPrev, cur.p, sCur), cur.inEdge, 1, tol);
+        w.emit(detail::clipCrossing(prev, sPrev, cur, sCur), in, 1);
       }
-      prev = cur.p;
+      prev = cur;
       sPrev = sCur;
     }
-    k = detail::closeRing(dst, kk, tol);
+    k = detail::closeRing(dst, w.finish(), tol);
     ClipVertex* t = src;
     src = dst;
     dst = t;

@@ -171,13 +171,19 @@ const std::vector<std::pair<std::int64_t, Real>>* CpuStepper::contactForces() co
   return &m_contactForces;
 }
 
-StepperState CpuStepper::saveState() { return StepperState{m_world, m_step, m_time, m_previousContacts, m_rubbleMass, m_floesBroken}; }
+StepperState CpuStepper::saveState() {
+  std::vector<std::pair<std::int64_t, std::int64_t>> touching = m_previousContacts;
+  if (!m_previousSorted) std::sort(touching.begin(), touching.end());
+  return StepperState{m_world, m_step, m_time, std::move(touching), m_rubbleMass, m_floesBroken};
+}
 
 void CpuStepper::restoreState(const StepperState& state) {
   m_world = state.world;
   m_step = state.step;
   m_time = state.time;
   m_previousContacts = state.touching;
+  std::sort(m_previousContacts.begin(), m_previousContacts.end());
+  m_previousSorted = true;
   m_rubbleMass = state.rubbleMass;
   m_floesBroken = state.floesBroken;
   // What was derived from the old world goes: every body's vertices are computed afresh (the same
@@ -242,6 +248,14 @@ void CpuStepper::narrowphase() {
     m_boxes[i] = boundingBox(v, m_world.worldVertices(i, v));
   });
 
+  // touchedAtLastStep searches the last step's contacts only for a pair whose two slots have both
+  // changed hands since (a re-sort, a break, a restored state): only then are they sorted.
+  if (!m_previousSorted &&
+      !(m_lastSlotId.size() >= static_cast<size_t>(n) && std::equal(m_world.id.begin(), m_world.id.end(), m_lastSlotId.begin()))) {
+    std::sort(m_previousContacts.begin(), m_previousContacts.end());
+    m_previousSorted = true;
+  }
+
   // The candidates in contiguous parts, a task each; the parts' contacts joined in order are the
   // contacts of one pass over all the pairs.
   const int pairs = static_cast<int>(m_pairs.size());
@@ -276,8 +290,7 @@ void CpuStepper::narrowphase() {
       const int p = survivor[s];
       const int a = m_pairs[static_cast<size_t>(p)].a, b = m_pairs[static_cast<size_t>(p)].b;
       if (!mayTouch(m_world.invMass[a], m_world.invMass[b], m_boxes[a], m_boxes[b])) continue;
-      const std::pair<std::int64_t, std::int64_t> key = std::minmax(m_world.id[a], m_world.id[b]);
-      const bool touchedBefore = touchedAtLastStep(a, b, key);
+      const bool touchedBefore = touchedAtLastStep(a, b);
       // Two bodies that have not moved since the last step, and did not touch then, do not touch
       // now: the same polygons give the same answer. Most of a pack rests ahead of the vessel.
       // (A touching pair is always a candidate, whatever the broadphase, so "did not touch then"
@@ -299,12 +312,14 @@ void CpuStepper::narrowphase() {
           continue;
         }
       }
-      const Contact c = computeContact(pa, na, m_world.position(a), pb, nb, m_world.position(b));
+      // A pair apart last step that no edge separates now overlaps: only the clipping is left.
+      const Contact c = touchedBefore ? computeContact(pa, na, m_world.position(a), pb, nb, m_world.position(b))
+                                      : contactOfOverlapping(pa, na, m_world.position(a), pb, nb, m_world.position(b));
       if (!c.touching) continue;
       part.a.push_back(a);
       part.b.push_back(b);
       part.contacts.push_back(PairContact{c, !touchedBefore});
-      part.keys.push_back(key);
+      part.keys.emplace_back(std::minmax(m_world.id[a], m_world.id[b]));
     }
   };
   if (tasks == 1)
@@ -324,8 +339,8 @@ void CpuStepper::narrowphase() {
     m_currentContacts.insert(m_currentContacts.end(), part.keys.begin(), part.keys.end());
     m_separated.insert(m_separated.end(), part.separated.begin(), part.separated.end());
   }
-  std::sort(m_currentContacts.begin(), m_currentContacts.end());
-  m_previousContacts.swap(m_currentContacts);
+  m_previousContacts.swap(m_currentContacts);  // in contact order, sorted only when searched (above)
+  m_previousSorted = false;
   m_lastSeparated.swap(m_separated);
   // Each slot's partners, for touchedAtLastStep: a counting sort of the contacts by slot.
   m_lastSlotId.assign(m_world.id.begin(), m_world.id.end());
@@ -341,17 +356,22 @@ void CpuStepper::narrowphase() {
   }
 }
 
-bool CpuStepper::touchedAtLastStep(int a, int b, std::pair<std::int64_t, std::int64_t> key) const {
+bool CpuStepper::touchedAtLastStep(int a, int b) const {
   // A slot that still holds the body it held then lists that body's partners, most often none or
-  // one or two. A slot whose body changed (a re-sort, a break) is not asked.
+  // one or two: a's if it can, else b's. Only when both slots changed hands (a re-sort, a break)
+  // is the last step's contact list searched.
   const int slots = static_cast<int>(m_lastSlotId.size());
-  for (const auto& [self, other] : {std::pair{a, b}, std::pair{b, a}}) {
-    if (self >= slots || m_lastSlotId[self] != m_world.id[self]) continue;
-    for (int k = m_lastPartnerStart[self]; k < m_lastPartnerStart[self + 1]; ++k)
-      if (m_lastPartnerId[static_cast<size_t>(k)] == m_world.id[other]) return true;
-    return false;
+  int self = a, other = b;
+  if (a >= slots || m_lastSlotId[a] != m_world.id[a]) {
+    if (b >= slots || m_lastSlotId[b] != m_world.id[b])
+      return std::binary_search(m_previousContacts.begin(), m_previousContacts.end(),
+                                std::pair<std::int64_t, std::int64_t>(std::minmax(m_world.id[a], m_world.id[b])));
+    self = b, other = a;
   }
-  return std::binary_search(m_previousContacts.begin(), m_previousContacts.end(), key);
+  const std::int64_t otherId = m_world.id[other];
+  for (int k = m_lastPartnerStart[self]; k < m_lastPartnerStart[self + 1]; ++k)
+    if (m_lastPartnerId[static_cast<size_t>(k)] == otherId) return true;
+  return false;
 }
 
 void CpuStepper::step() {
@@ -374,13 +394,18 @@ void CpuStepper::step() {
   }
   narrowphase();
 
-  // 3. Two-body events write into each contact's slot.
+  // 3. Two-body events write into each contact's slot. Only the bodies of a contact get a pair
+  // view (a pair event reads its two bodies, the gather those that have contacts): about one body
+  // in five in a pack.
+  const int contacts = static_cast<int>(m_contacts.size());
   m_pairBodies.resize(n);
+  m_inContact.assign(n, 0);
+  for (int k = 0; k < contacts; ++k) m_inContact[m_contactA[k]] = m_inContact[m_contactB[k]] = 1;
   forEachBody(n, [&](int i) {
+    if (!m_inContact[i]) return;
     m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof),
                                  &m_worldVertices[static_cast<size_t>(i) * kMaxVertices], m_world.vertexCount[i]);
   });
-  const int contacts = static_cast<int>(m_contacts.size());
   m_slots.assign(contacts, PairSlot{{0, 0}});
   // The pair events, event by event, each over contiguous ranges of contacts (a contact's slot is
   // its own; an event's apply is a function of its contact, as on the device). Each range pushes
@@ -468,11 +493,20 @@ void CpuStepper::step() {
   m_soloBodies.resize(n);
   m_changes.resize(n);
   // Each body's solo events, in their order, over contiguous ranges of bodies (a body's view and
-  // change are its own: the ranges never meet).
+  // change are its own: the ranges never meet). The world still holds the start of the step: the
+  // pair events wrote only their slots.
   forEachRange(n, [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
-      const PairBody& p = m_pairBodies[i];
-      m_soloBodies[i] = SoloBody{p.kind, p.dof, p.position, p.angle, p.velocity, p.omega, p.mass, p.area, p.thickness};
+      const BodyKind kind = m_world.kind[i];
+      m_soloBodies[i] = SoloBody{kind,
+                                 degreesOfFreedom(kind, vesselDof),
+                                 m_world.position(i),
+                                 m_world.angle[i],
+                                 m_world.velocity(i),
+                                 m_world.omega[i],
+                                 m_world.mass[i],
+                                 m_world.area[i],
+                                 m_world.thickness[i]};
       m_changes[i] = VelocityChange{{0, 0}, 0};
     }
     const SoloPhaseData soloData{m_soloBodies.data() + begin, m_changes.data() + begin, end - begin, ctx};
@@ -531,10 +565,15 @@ void CpuStepper::gatherAndMove() {
       addContactImpulse(m_pairBodies[i], ji, m_contacts[k].geometry.point, total[i]);
     }
     if (i == vessel) vesselImpulse = onBody;
-    m_contactForceOfSlot[i] = norm(onBody) / m_scenario.dt;
+    m_contactForceOfSlot[i] = onBody.x == 0 && onBody.y == 0 ? Real(0) : norm(onBody) / m_scenario.dt;  // most bodies: no contact
     m_contactForceId[i] = m_world.id[i];
-    const PairBody& p = m_pairBodies[i];
-    m_motionBodies[i] = MotionBody{p.kind, p.dof, p.position, p.angle, p.velocity + total[i].dv, p.omega + total[i].domega};
+    const BodyKind kind = m_world.kind[i];
+    m_motionBodies[i] = MotionBody{kind,
+                                   degreesOfFreedom(kind, m_scenario.vessel.dof),
+                                   m_world.position(i),
+                                   m_world.angle[i],
+                                   m_world.velocity(i) + total[i].dv,
+                                   m_world.omega[i] + total[i].domega};
   });
   m_vesselIceForce = forceOfImpulse(vesselImpulse, m_scenario.dt);
   m_contactForcesBuilt = false;

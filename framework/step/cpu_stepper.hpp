@@ -102,17 +102,19 @@ class CpuStepper final : public Stepper {
   std::vector<int> m_contactA, m_contactB;
   std::vector<PairContact> m_contacts;
   std::vector<PairSlot> m_slots;
-  std::vector<PairBody> m_pairBodies;
+  std::vector<PairBody> m_pairBodies;  // set for the bodies of this step's contacts only
+  std::vector<char> m_inContact;       // by slot: the body has a contact this step
   std::vector<SoloBody> m_soloBodies;
   std::vector<VelocityChange> m_changes;
   std::vector<MotionBody> m_motionBodies;
   std::vector<std::pair<std::int64_t, std::int64_t>> m_previousContacts, m_currentContacts;
+  bool m_previousSorted = true;  // m_previousContacts is sorted (it is kept in contact order until searched)
   // By slot, at the end of the last narrowphase: the id there and the ids it was in contact with
   // (m_lastPartnerId[m_lastPartnerStart[i] ...]), so that a candidate learns whether it touched
   // before from a list of one or two instead of a search of m_previousContacts.
   std::vector<std::int64_t> m_lastSlotId, m_lastPartnerId;
   std::vector<int> m_lastPartnerStart, m_partnerFill;
-  bool touchedAtLastStep(int a, int b, std::pair<std::int64_t, std::int64_t> key) const;
+  bool touchedAtLastStep(int a, int b) const;
   // The pairs whose polygons a full test found apart, in candidate order, with the edge that
   // separated them: next step that edge is tried first (only ever to reject; sat.hpp).
   struct SeparatedPair {
