@@ -25,22 +25,34 @@ namespace detail {
 GEM_HD inline Real minR(Real a, Real b) { return a < b ? a : b; }
 GEM_HD inline Real maxR(Real a, Real b) { return a > b ? a : b; }
 
-// True when some edge of p separates q: every q vertex lies on or outside the edge's line (to
-// within the tolerance), so touching along an edge or at a point is separation, not overlap.
-GEM_HD inline bool edgeSeparates(const Vec2* p, int n, const Vec2* q, int m) {
-  for (int i = 0; i < n; ++i) {
-    Vec2 a = p[i], e = p[i + 1 == n ? 0 : i + 1] - a;
-    // Outward normal of a counter-clockwise edge, unnormalised (length |e|): dot(nrm, x - a) is
-    // |e| times the signed distance of x outside the edge.
-    Vec2 nrm{e.y, -e.x};
-    // Allowed penetration: kGeomRelTol times (edge length + coordinate magnitude), so that the
-    // rounding of world coordinates far from the origin cannot fake an overlap of touching bodies.
-    Real le = l1Norm(e);
-    Real tol = kGeomRelTol * le * (le + l1Norm(a));
-    int j = 0;
-    while (j < m && dot(nrm, q[j] - a) >= -tol) ++j;
-    if (j == m) return true;
+// True when edge i of p (from p[i] to p[i + 1]) separates q: every q vertex lies on or outside the
+// edge's line (to within the tolerance), so touching along an edge or at a point is separation,
+// not overlap. An edge that does not separate needs one witness, a q vertex inside its line; the
+// search starts at `witness` and leaves there the one it found. Where it starts changes only how
+// soon it stops: each vertex's test is the same arithmetic, so the answer is the same.
+GEM_HD inline bool edgeSeparatesFrom(const Vec2* p, int n, int i, const Vec2* q, int m, int& witness) {
+  Vec2 a = p[i], e = p[i + 1 == n ? 0 : i + 1] - a;
+  // Outward normal of a counter-clockwise edge, unnormalised (length |e|): dot(nrm, x - a) is
+  // |e| times the signed distance of x outside the edge.
+  Vec2 nrm{e.y, -e.x};
+  // Allowed penetration: kGeomRelTol times (edge length + coordinate magnitude), so that the
+  // rounding of world coordinates far from the origin cannot fake an overlap of touching bodies.
+  Real le = l1Norm(e);
+  Real tol = kGeomRelTol * le * (le + l1Norm(a));
+  for (int tested = 0; tested < m; ++tested) {
+    if (dot(nrm, q[witness] - a) < -tol) return false;
+    witness = witness + 1 == m ? 0 : witness + 1;
   }
+  return true;
+}
+
+// True when some edge of p separates q. Each edge's search for a witness starts at the last
+// edge's: the q vertices inside one edge of p are most often inside the next one too, so for
+// overlapping polygons most searches stop at their first test.
+GEM_HD inline bool edgeSeparates(const Vec2* p, int n, const Vec2* q, int m) {
+  int witness = 0;
+  for (int i = 0; i < n; ++i)
+    if (edgeSeparatesFrom(p, n, i, q, m, witness)) return true;
   return false;
 }
 
@@ -54,12 +66,9 @@ GEM_HD inline bool convexOverlap(const Vec2* p, int n, const Vec2* q, int m) {
 }
 
 // The CPU narrowphase's rejection of apart pairs, one edge at a time, so that the edge that
-// separated a pair last step can be tried first (docs/performance.md 4.1). These repeat the
-// arithmetic of one round of detail::edgeSeparates operation for operation, so an edge found here
-// is an edge convexOverlap finds too: the pair does not touch, and computeContact would return
-// "not touching". edgeSeparates itself is left as it is, so that what the CUDA compiler makes of
-// computeContact (it fuses multiply-adds) cannot change; the host is built without fused
-// multiply-adds, so there both give the same verdict bit for bit.
+// separated a pair last step can be tried first (docs/performance.md 4.1). An edge found here is an
+// edge convexOverlap finds too (the same test, detail::edgeSeparatesFrom): the pair does not touch,
+// and computeContact would return "not touching".
 
 // A candidate separating axis: the outward normal of edge `edge` of p (side 0) or of q (side 1).
 struct SeparatingEdge {
@@ -67,15 +76,10 @@ struct SeparatingEdge {
   int edge;
 };
 
-// True when edge i of p (from p[i] to p[i + 1]) separates q, as one round of detail::edgeSeparates.
+// True when edge i of p (from p[i] to p[i + 1]) separates q.
 GEM_HD inline bool edgeSeparatesAt(const Vec2* p, int n, int i, const Vec2* q, int m) {
-  Vec2 a = p[i], e = p[i + 1 == n ? 0 : i + 1] - a;
-  Vec2 nrm{e.y, -e.x};
-  Real le = l1Norm(e);
-  Real tol = kGeomRelTol * le * (le + l1Norm(a));
-  int j = 0;
-  while (j < m && dot(nrm, q[j] - a) >= -tol) ++j;
-  return j == m;
+  int witness = 0;
+  return detail::edgeSeparatesFrom(p, n, i, q, m, witness);
 }
 
 // True when `axis` (any side and index; an index out of range is simply not tried) separates p and q.
@@ -88,10 +92,12 @@ GEM_HD inline bool separatesAlong(SeparatingEdge axis, const Vec2* p, int n, con
 // The first separating edge in convexOverlap's order (p's edges, then q's), or side -1 exactly
 // when convexOverlap(p, n, q, m) is true.
 GEM_HD inline SeparatingEdge findSeparatingEdge(const Vec2* p, int n, const Vec2* q, int m) {
+  int witness = 0;
   for (int i = 0; i < n; ++i)
-    if (edgeSeparatesAt(p, n, i, q, m)) return {0, i};
+    if (detail::edgeSeparatesFrom(p, n, i, q, m, witness)) return {0, i};
+  witness = 0;
   for (int i = 0; i < m; ++i)
-    if (edgeSeparatesAt(q, m, i, p, n)) return {1, i};
+    if (detail::edgeSeparatesFrom(q, m, i, p, n, witness)) return {1, i};
   return {-1, 0};
 }
 

@@ -516,3 +516,58 @@ TEST(Geometry, CachedSeparatingEdgeNeverRejectsATouchingPair) {
   EXPECT_GT(rejected, 3000);
   EXPECT_GT(sharedEdges, 3000);
 }
+
+// The separating-axis test's search for a witness vertex starts where the last edge's search
+// stopped (sat.hpp). It must give the answer of the plain search, every edge scanned from vertex
+// 0: the same separating edge first, and "no edge" exactly when the plain search finds none.
+// Written out here from docs/model.md 3, not from sat.hpp.
+namespace {
+bool plainEdgeSeparates(const Poly& p, int i, const Poly& q) {
+  const Vec2 a = p[static_cast<size_t>(i)], e = p[(static_cast<size_t>(i) + 1) % p.size()] - a;
+  const Vec2 outward{e.y, -e.x};
+  const Real le = l1Norm(e), tol = kGeomRelTol * le * (le + l1Norm(a));
+  for (const Vec2& v : q)
+    if (dot(outward, v - a) < -tol) return false;
+  return true;
+}
+SeparatingEdge plainFirstSeparatingEdge(const Poly& p, const Poly& q) {
+  for (int i = 0; i < static_cast<int>(p.size()); ++i)
+    if (plainEdgeSeparates(p, i, q)) return {0, i};
+  for (int i = 0; i < static_cast<int>(q.size()); ++i)
+    if (plainEdgeSeparates(q, i, p)) return {1, i};
+  return {-1, 0};
+}
+}  // namespace
+
+TEST(Geometry, WitnessSearchGivesThePlainSearchsAnswer) {
+  std::mt19937 rng(20261202);
+  std::uniform_real_distribution<Real> unit(0, 1);
+  int overlapping = 0, apart = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Vec2 origin = trial % 2 ? Vec2{1000 * unit(rng), -700 * unit(rng)} : Vec2{0, 0};
+    const Real r = 0.5 + 5 * unit(rng);
+    const Poly p = randomConvex(rng, origin, r);
+    // From deep overlap to well apart, and sharing an edge to within a few nanometres.
+    Poly q;
+    if (trial % 4 == 3) {
+      const int i = static_cast<int>(unit(rng) * p.size()) % static_cast<int>(p.size());
+      const Vec2 a = p[static_cast<size_t>(i)], e = p[(static_cast<size_t>(i) + 1) % p.size()] - a, t = (Real(1) / norm(e)) * e;
+      for (auto it = p.rbegin(); it != p.rend(); ++it) q.push_back(a + 2 * dot(*it - a, t) * t - (*it - a));
+      const Real nudge = (unit(rng) - 0.5) * 1e-8;
+      for (Vec2& v : q) v = v + nudge * Vec2{t.y, -t.x};
+    } else {
+      q = randomConvex(rng, origin + 3 * r * unit(rng) * Vec2{unit(rng) - 0.5, unit(rng) - 0.5}, 0.5 + 5 * unit(rng));
+    }
+    const int n = static_cast<int>(p.size()), m = static_cast<int>(q.size());
+    const SeparatingEdge plain = plainFirstSeparatingEdge(p, q);
+    const SeparatingEdge found = findSeparatingEdge(p.data(), n, q.data(), m);
+    ASSERT_EQ(found.side, plain.side) << "trial " << trial;
+    if (plain.side >= 0) ASSERT_EQ(found.edge, plain.edge) << "trial " << trial;
+    ASSERT_EQ(convexOverlap(p.data(), n, q.data(), m), plain.side < 0) << "trial " << trial;
+    ASSERT_EQ(convexOverlap(q.data(), m, p.data(), n), plain.side < 0) << "trial " << trial;
+    for (int i = 0; i < n; ++i) ASSERT_EQ(edgeSeparatesAt(p.data(), n, i, q.data(), m), plainEdgeSeparates(p, i, q)) << "trial " << trial;
+    (plain.side < 0 ? overlapping : apart) += 1;
+  }
+  EXPECT_GT(overlapping, 4000);
+  EXPECT_GT(apart, 4000);
+}
