@@ -300,11 +300,16 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
       std::vector<CandidatePair>& part = m_directParts[static_cast<size_t>(t)];
       part.clear();
       for (int v : m_directList) {
+        const Real xv = x[v], yv = y[v], rv = radius[v];
+        const bool wall = world.kind[v] == BodyKind::Wall;
         for (int j = static_cast<int>(begin); j < end; ++j) {
+          // The circles first: most bodies are far, so this branch is well predicted and the
+          // rarer conditions are looked up only for the near ones.
+          const Real dx = xv - x[j], dy = yv - y[j], reach = rv + radius[j];
+          if (!(dx * dx + dy * dy <= reach * reach)) continue;
           if (j == v || (direct[j] && j < v)) continue;  // a pair of two direct bodies is found once
-          if (world.kind[v] == BodyKind::Wall && world.kind[j] == BodyKind::Wall) continue;
-          const Real dx = x[v] - x[j], dy = y[v] - y[j], reach = radius[v] + radius[j];
-          if (dx * dx + dy * dy <= reach * reach) part.push_back(j < v ? CandidatePair{j, v} : CandidatePair{v, j});
+          if (wall && world.kind[j] == BodyKind::Wall) continue;
+          part.push_back(j < v ? CandidatePair{j, v} : CandidatePair{v, j});
         }
       }
     });
