@@ -3,6 +3,7 @@
 // parts are joined in order, so the contacts, the records and every sum are the same.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstring>
@@ -216,6 +217,38 @@ TEST(Threads, ABrokenFieldStepsBitForBitOnThreeThreads) {
   const ThreadedRun one = runWithThreads(s, 1, 420);
   EXPECT_GT(one.broken, 0) << "no floe broke: the test guards nothing of the topology phase";
   expectSame(one, runWithThreads(s, 3, 420), 3);
+}
+
+// A break removes bodies from the world: inside a threaded step (the pool lent to the topology
+// phase, flexural breaking passes parallelEach) every array is compacted by a task of its own. The
+// world left must be the one a single thread leaves, array by array.
+TEST(Threads, RemovingBodiesOnThePoolLeavesTheWorldOneThreadLeaves) {
+  World start;
+  for (int k = 0; k < 40000; ++k)
+    start.addBody(test::squareFloe({Real(1.5) * static_cast<Real>(k % 200), Real(1.5) * static_cast<Real>(k / 200)}, 1, 0.5,
+                                   {Real(0.001) * static_cast<Real>(k % 7), 0}, Real(0.01) * static_cast<Real>(k % 3)));
+  std::vector<char> remove(start.id.size(), 0);
+  for (size_t i = 3; i < remove.size(); i += 7) remove[i] = 1;
+  World alone = start, pooled = start;
+  alone.removeBodies(remove);
+  ThreadPool pool(3);
+  {
+    const ParallelScope lend(&pool);
+    ASSERT_GT(parallelTasks(static_cast<long>(remove.size()), 4096), 1) << "too few bodies for the pool to be used";
+    pooled.removeBodies(remove, parallelEach);
+  }
+  ASSERT_EQ(pooled.size(), alone.size());
+  EXPECT_EQ(alone.size(), 40000 - static_cast<int>(std::count(remove.begin(), remove.end(), 1)));
+  EXPECT_EQ(pooled.id, alone.id);
+  EXPECT_EQ(pooled.kind, alone.kind);
+  EXPECT_EQ(pooled.vertexCount, alone.vertexCount);
+  for (auto member : {&World::x, &World::y, &World::angle, &World::vx, &World::vy, &World::omega, &World::area, &World::thickness,
+                      &World::mass, &World::invMass, &World::invInertia, &World::gyration2, &World::gyrationX2, &World::gyrationY2,
+                      &World::principalAngle, &World::radius})
+    EXPECT_EQ(pooled.*member, alone.*member);
+  ASSERT_EQ(pooled.localVertices.size(), alone.localVertices.size());
+  EXPECT_EQ(0, std::memcmp(pooled.localVertices.data(), alone.localVertices.data(), alone.localVertices.size() * sizeof(Vec2)));
+  EXPECT_EQ(alone.id[3], start.id[4]) << "the bodies after a removed one move down, in order";
 }
 
 TEST(ThreadPool, RunsEveryTaskOnceAndRethrowsTheFirstError) {

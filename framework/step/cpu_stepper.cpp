@@ -1,6 +1,7 @@
 #include "framework/step/cpu_stepper.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <optional>
 #include <cmath>
@@ -237,7 +238,12 @@ void CpuStepper::narrowphase() {
   m_boxes.resize(n);
   m_vertexPose.resize(n, Pose{-1, 0, 0, 0});
   m_moved.assign(n, 0);
+  // Whether a slot changed hands since the last narrowphase (a re-sort, a break, a restored state),
+  // seen in this pass over the bodies rather than in a serial one of its own.
+  const int lastSlots = static_cast<int>(m_lastSlotId.size());
+  std::atomic<bool> slotsChanged{n > lastSlots};
   forEachBody(n, [&](int i) {
+    if (i < lastSlots && m_lastSlotId[i] != m_world.id[i]) slotsChanged.store(true, std::memory_order_relaxed);
     // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
     // vertices from an earlier step are still exact, so only bodies that moved are transformed.
     const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
@@ -250,8 +256,7 @@ void CpuStepper::narrowphase() {
 
   // touchedAtLastStep searches the last step's contacts only for a pair whose two slots have both
   // changed hands since (a re-sort, a break, a restored state): only then are they sorted.
-  if (!m_previousSorted &&
-      !(m_lastSlotId.size() >= static_cast<size_t>(n) && std::equal(m_world.id.begin(), m_world.id.end(), m_lastSlotId.begin()))) {
+  if (!m_previousSorted && slotsChanged.load(std::memory_order_relaxed)) {
     std::sort(m_previousContacts.begin(), m_previousContacts.end());
     m_previousSorted = true;
   }
@@ -519,8 +524,11 @@ void CpuStepper::step() {
 
   // 6. Topology: breaks, rubble, new floes.
   TopologyData topology{&m_world, &m_records, m_time};
-  for (auto& e : m_events)
-    if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
+  {
+    const ParallelScope lend(m_pool.get());  // World::removeBodies compacts its arrays in parallel
+    for (auto& e : m_events)
+      if (e.phase == EventPhase::Topology) e.instance->runTopology(topology);
+  }
   m_rubbleMass += topology.rubbleMass;
   m_floesBroken += topology.floesBroken;
   if (topology.changed) m_broadphase->invalidate();

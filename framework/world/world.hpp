@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <functional>
 #include <vector>
 
 #include "framework/world/body_kind.hpp"
@@ -57,7 +58,11 @@ struct World {
   // Floe mass is rho_ice * area * thickness (docs/model.md 1); walls get infinite mass.
   int addBody(const BodySpec& spec);
   // Removes the bodies whose flag is set, keeping the order of the others.
-  void removeBodies(const std::vector<char>& remove);
+  // forEachTask, when given, runs tasks 0 .. count - 1 on the caller's threads (a topology event
+  // passes framework/api/parallel.hpp's parallelEach when the CPU stepper has lent its pool): each
+  // array is then compacted by a task of its own. The result is the same either way.
+  using TaskRunner = std::function<void(int count, const std::function<void(int)>& task)>;
+  void removeBodies(const std::vector<char>& remove, const TaskRunner& forEachTask = nullptr);
   // Reorders all arrays by the permutation (new slot k holds old slot order[k]).
   void permute(const std::vector<int>& order);
   // The order of the bodies along a Morton (Z-order) curve through their centroids: neighbours in
