@@ -242,8 +242,10 @@ void CpuStepper::narrowphase() {
   // seen in this pass over the bodies rather than in a serial one of its own.
   const int lastSlots = static_cast<int>(m_lastSlotId.size());
   std::atomic<bool> slotsChanged{n > lastSlots};
+  m_slotIdNow.resize(static_cast<size_t>(n));
   forEachBody(n, [&](int i) {
     if (i < lastSlots && m_lastSlotId[i] != m_world.id[i]) slotsChanged.store(true, std::memory_order_relaxed);
+    m_slotIdNow[static_cast<size_t>(i)] = m_world.id[i];
     // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
     // vertices from an earlier step are still exact, so only bodies that moved are transformed.
     const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
@@ -347,17 +349,30 @@ void CpuStepper::narrowphase() {
   m_previousContacts.swap(m_currentContacts);  // in contact order, sorted only when searched (above)
   m_previousSorted = false;
   m_lastSeparated.swap(m_separated);
-  // Each slot's partners, for touchedAtLastStep: a counting sort of the contacts by slot.
-  m_lastSlotId.assign(m_world.id.begin(), m_world.id.end());
-  m_lastPartnerStart.assign(static_cast<size_t>(n) + 1, 0);
-  for (size_t k = 0; k < m_contactA.size(); ++k) ++m_lastPartnerStart[m_contactA[k] + 1], ++m_lastPartnerStart[m_contactB[k] + 1];
-  for (int i = 0; i < n; ++i) m_lastPartnerStart[i + 1] += m_lastPartnerStart[i];
-  m_lastPartnerId.resize(2 * m_contactA.size());
-  m_partnerFill.assign(m_lastPartnerStart.begin(), m_lastPartnerStart.end() - 1);
-  for (size_t k = 0; k < m_contactA.size(); ++k) {
-    const int a = m_contactA[k], b = m_contactB[k];
-    m_lastPartnerId[static_cast<size_t>(m_partnerFill[a]++)] = m_world.id[b];
-    m_lastPartnerId[static_cast<size_t>(m_partnerFill[b]++)] = m_world.id[a];
+  m_lastSlotId.swap(m_slotIdNow);
+  m_byBody.build(m_contactA, m_contactB, n);
+}
+
+void CpuStepper::ContactsByBody::build(const std::vector<int>& a, const std::vector<int>& b, int n) {
+  if (++current == 0) {  // the stamps wrapped: start them afresh
+    stamp.assign(stamp.size(), 0);
+    current = 1;
+  }
+  stamp.resize(static_cast<size_t>(n), 0), start.resize(static_cast<size_t>(n)), count.resize(static_cast<size_t>(n));
+  bodies.clear();
+  const size_t contacts = a.size();
+  for (size_t k = 0; k < contacts; ++k)
+    for (const int i : {a[k], b[k]}) {
+      if (stamp[static_cast<size_t>(i)] != current)
+        stamp[static_cast<size_t>(i)] = current, count[static_cast<size_t>(i)] = 0, bodies.push_back(i);
+      ++count[static_cast<size_t>(i)];
+    }
+  int next = 0;
+  for (const int i : bodies) start[static_cast<size_t>(i)] = next, next += count[static_cast<size_t>(i)], count[static_cast<size_t>(i)] = 0;
+  entries.resize(2 * contacts);
+  for (size_t k = 0; k < contacts; ++k) {
+    entries[static_cast<size_t>(start[static_cast<size_t>(a[k])] + count[static_cast<size_t>(a[k])]++)] = static_cast<int>(2 * k);
+    entries[static_cast<size_t>(start[static_cast<size_t>(b[k])] + count[static_cast<size_t>(b[k])]++)] = static_cast<int>(2 * k + 1);
   }
 }
 
@@ -373,9 +388,16 @@ void CpuStepper::narrowphase() {
                                 std::pair<std::int64_t, std::int64_t>(std::minmax(m_world.id[a], m_world.id[b])));
     self = b, other = a;
   }
+  // The last step's contacts of self's slot (m_contactA/B still hold them): the partner's slot then,
+  // and the id that slot held then.
+  if (!m_byBody.has(self)) return false;
   const std::int64_t otherId = m_world.id[other];
-  for (int k = m_lastPartnerStart[self]; k < m_lastPartnerStart[self + 1]; ++k)
-    if (m_lastPartnerId[static_cast<size_t>(k)] == otherId) return true;
+  const int* entry = &m_byBody.entries[static_cast<size_t>(m_byBody.start[static_cast<size_t>(self)])];
+  for (int q = 0; q < m_byBody.count[static_cast<size_t>(self)]; ++q) {
+    const size_t k = static_cast<size_t>(entry[q] / 2);
+    const int partner = entry[q] % 2 ? m_contactA[k] : m_contactB[k];
+    if (m_lastSlotId[static_cast<size_t>(partner)] == otherId) return true;
+  }
   return false;
 }
 
@@ -404,12 +426,12 @@ void CpuStepper::step() {
   // in five in a pack.
   const int contacts = static_cast<int>(m_contacts.size());
   m_pairBodies.resize(n);
-  m_inContact.assign(n, 0);
-  for (int k = 0; k < contacts; ++k) m_inContact[m_contactA[k]] = m_inContact[m_contactB[k]] = 1;
-  forEachBody(n, [&](int i) {
-    if (!m_inContact[i]) return;
-    m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof),
-                                 &m_worldVertices[static_cast<size_t>(i) * kMaxVertices], m_world.vertexCount[i]);
+  forEachRange(static_cast<int>(m_byBody.bodies.size()), [&](int begin, int end) {
+    for (int q = begin; q < end; ++q) {
+      const int i = m_byBody.bodies[static_cast<size_t>(q)];
+      m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof),
+                                   &m_worldVertices[static_cast<size_t>(i) * kMaxVertices], m_world.vertexCount[i]);
+    }
   });
   m_slots.assign(contacts, PairSlot{{0, 0}});
   // The pair events, event by event, each over contiguous ranges of contacts (a contact's slot is
@@ -542,21 +564,8 @@ void CpuStepper::gatherAndMove() {
   const int n = m_world.size();
   // Impulses: every body sums its contacts in contact order (sorted by slot pair), so the sum
   // is the same whatever broadphase found the pairs, and no atomics are needed. Each body's
-  // contacts, in contact order, as a = -impulse and b = +impulse (m_bodyContacts: k x 2 + side).
+  // contacts, in contact order, as a = -impulse and b = +impulse (m_byBody: k x 2 + side).
   std::vector<VelocityChange>& total = m_changes;  // already holds the solo events' part
-  const int contacts = static_cast<int>(m_contacts.size());
-  m_bodyContactStart.assign(static_cast<size_t>(n) + 1, 0);
-  for (int k = 0; k < contacts; ++k) ++m_bodyContactStart[m_contactA[k] + 1], ++m_bodyContactStart[m_contactB[k] + 1];
-  for (int i = 0; i < n; ++i) m_bodyContactStart[i + 1] += m_bodyContactStart[i];
-  m_bodyContacts.resize(static_cast<size_t>(2 * contacts));
-  {
-    std::vector<int>& at = m_bodyContactFill;
-    at.assign(m_bodyContactStart.begin(), m_bodyContactStart.end() - 1);
-    for (int k = 0; k < contacts; ++k) {
-      m_bodyContacts[static_cast<size_t>(at[m_contactA[k]]++)] = 2 * k;
-      m_bodyContacts[static_cast<size_t>(at[m_contactB[k]]++)] = 2 * k + 1;
-    }
-  }
   const int vessel = m_vesselId >= 0 ? vesselSlot() : -1;
   Vec2 vesselImpulse{0, 0};
   m_motionBodies.resize(n);
@@ -564,8 +573,10 @@ void CpuStepper::gatherAndMove() {
   m_contactForceId.resize(n);
   forEachBody(n, [&](int i) {
     Vec2 onBody{0, 0};
-    for (int q = m_bodyContactStart[i]; q < m_bodyContactStart[i + 1]; ++q) {
-      const int k = m_bodyContacts[static_cast<size_t>(q)] / 2, side = m_bodyContacts[static_cast<size_t>(q)] % 2;
+    const int own = m_byBody.has(i) ? m_byBody.count[static_cast<size_t>(i)] : 0;
+    const int* entry = own ? &m_byBody.entries[static_cast<size_t>(m_byBody.start[static_cast<size_t>(i)])] : nullptr;
+    for (int q = 0; q < own; ++q) {
+      const int k = entry[q] / 2, side = entry[q] % 2;
       const Vec2 j = m_slots[k].impulse;
       if (j.x == 0 && j.y == 0) continue;
       const Vec2 ji = side == 0 ? -j : j;
