@@ -149,6 +149,15 @@ class CpuStepper final : public Stepper {
   // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads; body(i) for
   // every i likewise.
   void forEachRange(int n, const std::function<void(int, int)>& range);
+  // block(begin, end) over every slot: forEachRange's ranges cut into blocks of at most kBlock
+  // bodies, in order (a phase that makes several passes over its views makes them block by block).
+  static constexpr int kBlock = 256;
+  template <class Block>
+  void forEachBlock(int n, Block&& block) {
+    forEachRange(n, [&](int begin, int end) {
+      for (int b = begin; b < end; b += kBlock) block(b, std::min(end, b + kBlock));
+    });
+  }
   // body(i) for every slot, in ranges as forEachRange: a template, so that the per-body call is
   // inlined (a std::function per body cost an indirect call each).
   template <class Body>
