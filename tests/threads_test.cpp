@@ -142,8 +142,9 @@ TEST(Threads, KeptListsBuildAndFilterTheSameOnAnyThreadCount) {
         EXPECT_EQ(0, std::memcmp(listed.data(), list.pairs().data(), listed.size() * sizeof(ListedPair)));
         const auto& side = dynamic_cast<const KeptListBroadphase&>(*many[k]).list().sidePairs();
         ASSERT_EQ(side.size(), list.sidePairs().size());
-        if (!side.empty())  // memcmp of an empty vector's null data() is undefined behaviour
+        if (!side.empty()) {  // memcmp of an empty vector's null data() is undefined behaviour
           EXPECT_EQ(0, std::memcmp(side.data(), list.sidePairs().data(), side.size() * sizeof(ListedPair)));
+        }
         EXPECT_EQ(many[k]->rebuilds(), one->rebuilds());
         EXPECT_EQ(dynamic_cast<const KeptListBroadphase&>(*many[k]).list().relists(), list.relists());
       }
