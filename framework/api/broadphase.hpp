@@ -4,6 +4,7 @@
 // Pairs come out as (a, b) slot indices with a < b, sorted by (a, b): so the contact set and the
 // order in which each body sums its contacts do not depend on the strategy (bit-identical runs).
 #pragma once
+#include <algorithm>
 #include <iterator>
 #include <memory>
 #include <string>
@@ -43,6 +44,29 @@ std::vector<std::string> declaredBroadphaseSettings() {
     return {std::begin(Strategy::kSettings), std::end(Strategy::kSettings)};
   else
     return {};
+}
+
+// A plugin strategy's pairs made what the contract above asks: each pair a < b (a pair of one slot
+// dropped), sorted by (a, b), each once. The CPU stepper applies it to strategies from plugins, so a
+// strategy that proposes its pairs in any order, or twice, still gives the built-ins' trajectories;
+// the built-ins already keep the contract (checked in their tests) and skip it.
+inline void normalizeCandidatePairs(std::vector<CandidatePair>& pairs) {
+  auto before = [](const CandidatePair& x, const CandidatePair& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); };
+  bool ordered = true;
+  size_t kept = 0;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    CandidatePair p = pairs[k];
+    if (p.a > p.b) std::swap(p.a, p.b);
+    if (p.a == p.b) continue;
+    if (kept > 0 && !before(pairs[kept - 1], p)) ordered = false;
+    pairs[kept++] = p;
+  }
+  pairs.resize(kept);
+  if (ordered) return;
+  std::sort(pairs.begin(), pairs.end(), before);
+  pairs.erase(
+      std::unique(pairs.begin(), pairs.end(), [](const CandidatePair& x, const CandidatePair& y) { return x.a == y.a && x.b == y.b; }),
+      pairs.end());
 }
 
 class Broadphase {

@@ -87,6 +87,10 @@ struct EventConfig {
   TableReader& params;
   const Scenario& scenario;
   RecordStreams& records;  // the run's record streams: open the ones the event writes or reads
+  // Whether the run uses the event. Every registered event is parsed, off or on, so that a table
+  // given for it is checked either way; an event with a parameter that has no default should
+  // require it only when enabled (a disabled event's instance is dropped).
+  bool enabled = true;
 };
 
 struct EventEntry {

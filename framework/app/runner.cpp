@@ -240,6 +240,7 @@ class ScenarioRun {
       const StepRecords& records = sim.records();
       for (int r = 0; r < records.rowCount(f.stream); ++r) {
         const void* record = records.record(f.stream, r);
+        row.clear();  // a writeRow that appends still writes its own row only
         f.output->writeRow(record, row);
         f.file->stream() << row;
         const double value = f.output->statisticValue ? f.output->statisticValue(record) : 0;

@@ -133,7 +133,9 @@ CpuStepper::CpuStepper(const Scenario& scenario, World world) : m_scenario(scena
 
 void CpuStepper::setUp() {
   const OverrideScope blameSet(m_scenario.overrides);  // an error in a --set value names the --set
-  m_broadphase = Registry::global().broadphase(m_scenario.broadphase).make(m_scenario.broadphaseSettings);
+  const BroadphaseEntry& strategy = Registry::global().broadphase(m_scenario.broadphase);
+  m_broadphase = strategy.make(m_scenario.broadphaseSettings);
+  m_broadphaseFromPlugin = strategy.origin != "built-in";
   // Every event's table is checked, and all their errors reported together (docs/scenario.md 2).
   ErrorCollector errors;
   std::optional<DefaultsRecorder> defaults;
@@ -146,7 +148,7 @@ void CpuStepper::setUp() {
       if (defaults) defaults->record("events." + entry->name + ".enabled", enabled);
       TableReader reader(table, "events." + entry->name, m_scenario.fileName);
       reader.accept("enabled");
-      EventConfig config{reader, m_scenario, m_streams};
+      EventConfig config{reader, m_scenario, m_streams, enabled};
       auto instance = entry->makeCpu(config);  // parsed even when off, so its table is still checked
       reader.finish();
       if (enabled) m_events.push_back({entry->name, entry->phase, std::move(instance)});
@@ -419,6 +421,7 @@ void CpuStepper::step() {
     const ParallelScope lend(m_pool.get());
     m_broadphase->findCandidates(m_world, m_pairs);
   }
+  if (m_broadphaseFromPlugin) normalizeCandidatePairs(m_pairs);
   narrowphase();
 
   // 3. Two-body events write into each contact's slot. Only the bodies of a contact get a pair

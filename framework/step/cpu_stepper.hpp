@@ -83,6 +83,7 @@ class CpuStepper final : public Stepper {
   Scenario m_scenario;
   World m_world;
   std::unique_ptr<Broadphase> m_broadphase;
+  bool m_broadphaseFromPlugin = false;  // its pairs are normalised (normalizeCandidatePairs)
   std::vector<EnabledEvent> m_events;
   long m_step = 0;
   Real m_time = 0;

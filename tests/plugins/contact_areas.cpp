@@ -23,19 +23,30 @@ struct ContactArea {
 struct ContactAreaLog {
   static constexpr int kOrder = event_order::kObservers;
   struct Params {
+    Real minArea;  // m^2: smaller overlaps are not logged; required (no default) when the event is on
     RecordStream<ContactArea> rows;
   };
   GEM_HD static void apply(const Params& p, const PairBody& a, const PairBody& b, const PairContact& contact, PairSlot&,
                            const StepContext& ctx, const RecordSink& sink) {
-    if (a.kind == BodyKind::Floe && b.kind == BodyKind::Floe) sink.push(p.rows, ContactArea{ctx.time, a.id, b.id, contact.geometry.area});
+    if (a.kind == BodyKind::Floe && b.kind == BodyKind::Floe && contact.geometry.area >= p.minArea)
+      sink.push(p.rows, ContactArea{ctx.time, a.id, b.id, contact.geometry.area});
   }
 };
 
-static ContactAreaLog::Params parseContactAreaLog(EventConfig& config) { return {config.records.open<ContactArea>("contact_areas")}; }
+// A parameter without a default is asked for only when the event is on (config.enabled): every
+// loaded event is parsed, and a scenario that leaves this one off must not need it.
+static ContactAreaLog::Params parseContactAreaLog(EventConfig& config) {
+  ContactAreaLog::Params p{};
+  p.minArea = config.params.findReal("min_area").value_or(0);
+  if (config.enabled && !config.params.has("min_area")) config.params.report("min_area", "is required (no default)");
+  p.rows = config.records.open<ContactArea>("contact_areas");
+  return p;
+}
 
+// Appends to `row`, which GEM hands over empty for every record.
 static void writeContactArea(const void* record, std::string& row) {
   const ContactArea& r = *static_cast<const ContactArea*>(record);
-  row = fmt::format("{:.6g},{},{},{:.9g}\n", r.time, r.idA, r.idB, r.area);
+  row += fmt::format("{:.6g},{},{},{:.9g}\n", r.time, r.idA, r.idB, r.area);
 }
 
 GEM_REGISTER_RECORD_OUTPUT("contact_areas", "contact_areas.csv", "t,id_a,id_b,area_m2", writeContactArea, "contact_rows", "contact_area_m2",
