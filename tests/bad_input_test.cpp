@@ -87,6 +87,14 @@ std::vector<BadCase> badCases() {
        kSim + "[domain]\nx = [0.0, 1e7]\ny = [0.0, 1e7]\n[field]\nkind = \"hexagons\"\n",
        {"field: about", "floes", "GB"}},
       {"duration_below_one_step", "[simulation]\ndt = 0.1\nduration = 0.01\n", {"simulation.duration", "shorter than one step"}},
+      // Values whose derived quantities overflow (the second hostile audit): refused, naming the key.
+      {"huge_dt_makes_the_time_infinite", "[simulation]\ndt = 1e308\nsteps = 5\n", {"simulation.dt", "not a finite time", ":2:"}},
+      {"huge_thickness_makes_the_mass_infinite",
+       kSim + floe(kSquare).replace(floe(kSquare).find("1.0"), 3, "1e308"),
+       {"floes[0]", "mass", "not a finite number"}},
+      {"domain_beyond_any_field", kSim + "[domain]\nx = [-1e308, 1e308]\ny = [-50.0, 50.0]\nwalls = true\n", {"domain.x", "within"}},
+      {"walls_too_thick", kSim + kDomain + "walls = true\nwall_thickness = 1e308\n", {"domain.wall_thickness", "at most"}},
+      {"empty_hull", kSim + "[vessel]\nvertices = []\nframe_angle_deg = []\n", {"vessel.vertices", "at least 3 vertices, got 0"}},
   };
 }
 
@@ -203,6 +211,24 @@ TEST(BadInputCli, ANumericOptionOutOfRangeNamesItsRange) {
     EXPECT_LT(text.size(), 200u) << arguments << ": " << text;
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "summary.csv")) << arguments;
   }
+}
+
+// A default worked out from other values that overflows (the autopilot's gains from a vessel of
+// 1e308 kg) is refused naming each key, instead of running as inf into a scenario.toml that does
+// not load; and a --set whose value holds a newline cannot slip a second key in unseen.
+TEST(BadInputCli, DerivedDefaultsThatOverflowAndSetValuesOfTwoLinesAreRefused) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  const auto heavy = dir.write("heavy.toml", kSim + "[vessel]\nmass = 1e308\n");
+  EXPECT_EQ(gem::test::runGem("run " + heavy.string() + " --quiet --out " + (dir.path() / "out").string(), log), 2);
+  std::string text = gem::test::readFile(log);
+  EXPECT_NE(text.find("heavy.toml: events.autopilot.g1: its default"), std::string::npos) << text;
+  EXPECT_NE(text.find("not a finite number"), std::string::npos) << text;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "summary.json"));
+  const auto good = dir.write("good.toml", kSim);
+  EXPECT_EQ(gem::test::runGem("check " + good.string() + " --set \"$(printf 'simulation.dt=0.5\\nbogus_key=3')\"", log), 2);
+  text = gem::test::readFile(log);
+  EXPECT_NE(text.find("--set simulation.dt: the value must be one TOML value, with no other key after it"), std::string::npos) << text;
 }
 
 // A bad value given by --set is blamed on the --set, not on the scenario file that never held it:

@@ -93,8 +93,8 @@ ErrorCollector* ErrorCollector::active() { return t_collector; }
 
 void ErrorCollector::add(const std::string& message, const std::string& key) {
   // The same error twice (a value read by two readers) is one error.
-  if (std::find(m_messages.begin(), m_messages.end(), message) == m_messages.end()) m_messages.push_back(message);
-  if (!key.empty() && key.find(' ') == std::string::npos) m_keys.insert(key);
+  if (m_seen.insert(message).second) m_messages.push_back(message);
+  if (!key.empty() && key.find(' ') == std::string::npos && m_keys.size() < kMostKeys) m_keys.insert(key);
 }
 
 bool ErrorCollector::followsFrom(const std::string& message) const {

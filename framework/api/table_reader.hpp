@@ -2,10 +2,13 @@
 // is checked for type and range, and finish() rejects any key nobody asked for, listing the valid
 // ones, so a typo can never be silently ignored (docs/scenario.md). Errors name file:line:column.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <set>
 #include <string>
+#include <type_traits>
+#include <unordered_set>
 #include <vector>
 
 #include <toml++/toml.h>
@@ -50,9 +53,13 @@ class ErrorCollector {
   static ErrorCollector* active();
 
   static constexpr size_t kMostShown = 20;
+  // Keys kept for followsFrom: enough for any real scenario, and a file of 10^5 bad keys does not
+  // make each later check walk them all.
+  static constexpr size_t kMostKeys = 1000;
 
  private:
   std::vector<std::string> m_messages;
+  std::unordered_set<std::string> m_seen;  // m_messages as a set: a file of 10^5 bad keys stays linear
   std::set<std::string> m_keys;
   ErrorCollector* m_previous;
 };
@@ -126,8 +133,16 @@ class TableReader {
   std::string keyPath(const std::string& key) const { return m_path.empty() ? key : m_path + "." + key; }
   // The default a key took when the table does not give it, for the active DefaultsRecorder: the
   // get* methods call it; a caller reading a key through find* (an array, say) calls it itself.
+  // A default worked out from other values (an autopilot gain from the vessel's mass) that is not
+  // a finite number is refused here, naming the key: it would run as inf and make the run's
+  // scenario.toml one that does not load.
   template <class T>
   void recordDefault(const std::string& key, T value) const {
+    if constexpr (std::is_floating_point_v<T>)
+      if (!std::isfinite(value))
+        return report(key,
+                      "its default, worked out from other values of the scenario, is not a finite number: give it, or smaller "
+                      "values for what it follows from");
     if (DefaultsRecorder* r = DefaultsRecorder::active()) r->record(keyPath(key), std::move(value));
   }
 

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <csignal>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <functional>
 #include <memory>
@@ -48,7 +49,8 @@ struct Accumulator {
 // without a fraction: "100", not "100.0"); NaN and infinities, which JSON lacks, as null.
 nlohmann::ordered_json jsonNumber(double v) {
   if (!std::isfinite(v)) return nullptr;
-  const double rounded = std::stod(fmt::format("{:.9g}", v));
+  // strtod, not stod: a subnormal value (below 2.2e-308) is read back as it is, where stod throws.
+  const double rounded = std::strtod(fmt::format("{:.9g}", v).c_str(), nullptr);
   if (rounded == std::trunc(rounded) && std::fabs(rounded) < 1e15) return static_cast<std::int64_t>(rounded);
   return rounded;
 }

@@ -34,6 +34,8 @@ void applyOverride(toml::table& root, const std::string& assignment) {
   } catch (const toml::parse_error&) {
     parsed = toml::table{{"value", text}};
   }
+  // One value (an array may span lines): a newline must not slip a second key in unseen.
+  if (parsed.size() != 1) throw InputError(fmt::format("--set {}: the value must be one TOML value, with no other key after it", key));
   toml::table* table = &root;
   std::stringstream path(key);
   std::string part;
@@ -48,16 +50,23 @@ void applyOverride(toml::table& root, const std::string& assignment) {
   table->insert_or_assign(parts.back(), *parsed.get("value"));
 }
 
+// The largest |coordinate| of a domain's edge, m: far past any ice field (10,000 km), and small enough
+// that the walls' and the field's arithmetic (spans, areas, cell counts) stays finite.
+constexpr Real kMostDomainCoordinate = 1e7;
+
 Domain readDomain(TableReader& t, const Scenario& s) {
   Domain d = s.domain;
+  auto within = [](Real v) { return std::fabs(v) <= kMostDomainCoordinate; };
   if (auto x = t.findReals("x")) {
     if (x->size() != 2 || !((*x)[0] < (*x)[1])) t.fail("x", "expected [x0, x1] with x0 < x1");
+    if (!within((*x)[0]) || !within((*x)[1])) t.fail("x", fmt::format("each edge must be within +-{:g} m", kMostDomainCoordinate));
     d.x0 = (*x)[0], d.x1 = (*x)[1];
   } else {
     t.recordDefault("x", toml::array{static_cast<double>(d.x0), static_cast<double>(d.x1)});
   }
   if (auto y = t.findReals("y")) {
     if (y->size() != 2 || !((*y)[0] < (*y)[1])) t.fail("y", "expected [y0, y1] with y0 < y1");
+    if (!within((*y)[0]) || !within((*y)[1])) t.fail("y", fmt::format("each edge must be within +-{:g} m", kMostDomainCoordinate));
     d.y0 = (*y)[0], d.y1 = (*y)[1];
   } else {
     t.recordDefault("y", toml::array{static_cast<double>(d.y0), static_cast<double>(d.y1)});
@@ -205,6 +214,8 @@ void readVessel(TableReader& t, Scenario& s) {
   auto hull = t.findPoints("vertices");
   auto frames = t.findReals("frame_angle_deg");
   if (hull) {
+    if (hull->size() < 3)
+      t.fail("vertices", fmt::format("a hull needs at least 3 vertices, got {} (leave the key out for the default hull)", hull->size()));
     if (!frames) t.fail("vertices", "a hull given by vertices also needs frame_angle_deg (one per edge)");
     if (frames->size() != hull->size())
       t.fail("frame_angle_deg", fmt::format("needs one angle per hull edge: {} vertices, {} angles", hull->size(), frames->size()));
@@ -380,6 +391,8 @@ void readScenarioTables(Scenario& s) {
     }
     s.steps = hasSteps ? static_cast<long>(steps) : static_cast<long>(std::llround(s.duration / s.dt));
     if (hasSteps) s.duration = static_cast<Real>(s.steps) * s.dt;
+    // The step's time, k x dt, stays finite to the end (dt = 1e308 s would make it inf by step 2).
+    if (!std::isfinite(s.duration)) t.fail("dt", fmt::format("steps x dt = {} x {:g} s is not a finite time", s.steps, s.dt));
     s.backend = t.getChoice("backend", "auto", {"auto", "cpu", "cuda"});
     const std::string defaultBroadphase = s.broadphase;
     s.broadphase = t.getString("broadphase", s.broadphase);
@@ -421,6 +434,8 @@ void readScenarioTables(Scenario& s) {
       s.wallThickness = t.getPositive("wall_thickness", s.wallThickness);
     else
       t.accept("wall_thickness");
+    if (s.wallThickness > kMostDomainCoordinate)
+      t.fail("wall_thickness", fmt::format("must be at most {:g} m, got {:g}", kMostDomainCoordinate, s.wallThickness));
     t.finish();
   }
   if (const toml::table* v = top.findTable("vessel")) {

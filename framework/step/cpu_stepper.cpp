@@ -36,6 +36,16 @@ void validateBodySpec(BodySpec& spec, int maxVertices) {
         fmt::format("{}: the polygon is not convex (or is self-intersecting or has repeated or collinear vertices)", spec.origin));
 }
 
+// A body's mass properties, worked out from its polygon, thickness (or the vessel's mass), must be
+// finite numbers: a floe 1e308 m thick has an infinite mass that would reach every output.
+static void requireFiniteMass(const World& world, int i, const std::string& origin) {
+  for (Real v : {world.area[i], world.mass[i], world.invMass[i], world.invInertia[i], world.gyration2[i]})
+    if (!std::isfinite(v))
+      throw InputError(
+          fmt::format("{}: its mass or moment of inertia is not a finite number (area {:g} m^2, thickness {:g} m, mass {:g} kg)", origin,
+                      world.area[i], world.thickness[i], world.mass[i]));
+}
+
 // Static walls along the long sides of the domain (docs/scenario.md [domain] walls): the channel. They
 // reach past both ends so that a vessel starting before the field is already between them.
 static void addWalls(const Scenario& s, std::vector<BodySpec>& bodies) {
@@ -48,7 +58,7 @@ static void addWalls(const Scenario& s, std::vector<BodySpec>& bodies) {
     BodySpec wall;
     wall.kind = BodyKind::Wall;
     wall.thickness = 10;
-    wall.origin = side == 0 ? "domain wall (y0)" : "domain wall (y1)";
+    wall.origin = s.fileName + (side == 0 ? ": [domain] wall along y0" : ": [domain] wall along y1");
     wall.vertices = {
         {x0, std::min(inner, outer)}, {x1, std::min(inner, outer)}, {x1, std::max(inner, outer)}, {x0, std::max(inner, outer)}};
     bodies.push_back(wall);
@@ -94,7 +104,7 @@ World buildWorld(const Scenario& s) {
   for (BodySpec& spec : bodies) {
     if (spec.kind == BodyKind::Vessel) continue;  // a vessel comes from [vessel]
     validateBodySpec(spec, spec.kind == BodyKind::Floe ? kMaxFloeVertices : kMaxVertices);
-    world.addBody(spec);
+    requireFiniteMass(world, world.addBody(spec), spec.origin);
     origins.push_back(spec.origin);
   }
   if (s.vessel.present) {
@@ -105,7 +115,7 @@ World buildWorld(const Scenario& s) {
     check.vertices = hull.vertices;
     check.thickness = s.vessel.draft;
     validateBodySpec(check, kMaxVertices);
-    addVessel(world, s.vessel);
+    requireFiniteMass(world, addVessel(world, s.vessel), s.fileName + ": [vessel]");
     origins.push_back("vessel");
   }
 
