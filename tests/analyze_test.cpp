@@ -295,7 +295,11 @@ TEST(Analyze, ValuesOutsideTheirColumnsRangeNameFileAndLine) {
   for (const auto& [row, column] :
        std::vector<std::pair<std::string, std::string>>{{"1,2,3,4,1780,6,7,8,9,10,11,12,13,14,15,0", "apex_deg"},
                                                         {"1,2,3,4,5,6,7,8,9,10,11,1e300,13,14,15,0", "y_from_centerline"},
-                                                        {"1,2,3,4,5,6,7,8,9,10,-1e9,12,13,14,15,0", "x_from_stem"}}) {
+                                                        {"1,2,3,4,5,6,7,8,9,10,-1e9,12,13,14,15,0", "x_from_stem"},
+                                                        {"1,2,3,4,5,6,7,8,9,10,11,12,13,-1e308,15,0", "fn"},
+                                                        {"1,2,3,4,5,6,7,8,9,10,11,12,13,nan,15,0", "fn"},
+                                                        {"1,2,3,4,5,6,7,8,9,10,11,12,inf,14,15,0", "vn"},
+                                                        {"1e308,2,3,4,5,6,7,8,9,10,11,12,13,14,15,0", "t"}}) {
     SCOPED_TRACE(column);
     TempDir tmp;
     writeImpacts(tmp.path(), 3, 1);

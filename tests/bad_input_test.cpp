@@ -94,6 +94,7 @@ std::vector<BadCase> badCases() {
        {"floes[0]", "mass", "not a finite number"}},
       {"domain_beyond_any_field", kSim + "[domain]\nx = [-1e308, 1e308]\ny = [-50.0, 50.0]\nwalls = true\n", {"domain.x", "within"}},
       {"walls_too_thick", kSim + kDomain + "walls = true\nwall_thickness = 1e308\n", {"domain.wall_thickness", "at most"}},
+      {"nul_in_output_dir", kSim + "[output]\ndir = \"a\\u0000b\"\n", {"output.dir", "NUL"}},
       {"empty_hull", kSim + "[vessel]\nvertices = []\nframe_angle_deg = []\n", {"vessel.vertices", "at least 3 vertices, got 0"}},
   };
 }

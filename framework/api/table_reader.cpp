@@ -223,6 +223,9 @@ std::string TableReader::getString(const std::string& key, const std::string& fa
   if (!n) return recordDefault(key, fallback), fallback;
   auto s = n->value_exact<std::string>();
   if (!s) return reportAt(*n, fmt::format("{}: expected a string", keyPath(key))), fallback;
+  // A NUL ("\u0000") ends a path or a name early in every system call: "a\u0000b" would write to "a".
+  if (s->find('\0') != std::string::npos)
+    return reportAt(*n, fmt::format("{}: a string may not hold a NUL character", keyPath(key))), fallback;
   return *s;
 }
 

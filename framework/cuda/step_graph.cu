@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdlib>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "framework/api/cuda_check.hpp"
@@ -127,6 +128,12 @@ __global__ void endStepKernel(cudaGraphConditionalHandle loop, bool inGraph, con
   if (inGraph) cudaGraphSetConditional(loop, s->halt == kRunning ? 1u : 0u);
 }
 
+// Between two steps of the chained batch graph (captureStep): the next step runs only if the batch
+// is still running. A kernel of the parent graph upstream of the conditional node it sets.
+__global__ void gateStepKernel(cudaGraphConditionalHandle next, const StepStats* s) {
+  cudaGraphSetConditional(next, s->halt == kRunning ? 1u : 0u);
+}
+
 // ---- a step, a batch -----------------------------------------------------------------------------
 
 // Enqueues one whole step on d.stream: captured as the body of the batch graph's loop (inGraph),
@@ -218,9 +225,29 @@ void prepareBuffers(DeviceState& d) {
   d.tempBytes = bytes;
 }
 
+// How the batch graph repeats its step (GEM_CUDA_GRAPH_LOOP): "while" (the default), one copy of
+// the step inside a WHILE node whose last kernel decides whether it goes round again; or "chain",
+// copy_back_every copies of the step one after the other, each inside an IF node that a small gate
+// kernel between two steps opens while the batch runs. Both run the same kernels in the same order:
+// the same results. The chain is a diagnostic of the memcheck report on a shared GPU
+// (docs/reliability.md): on an H200 it made the report rare (2 runs in 51, against 3 in 3 with the
+// WHILE node in the same session) but not absent, at 2 to 9 % more time a step.
+bool graphLoopIsChain() {
+  static const bool chain = [] {
+    const char* v = std::getenv("GEM_CUDA_GRAPH_LOOP");
+    return v && std::string(v) == "chain";
+  }();
+  return chain;
+}
+// The chain's length: its copies of the step make the graph's size (about 40 nodes a step), so a
+// long copy_back_every runs as several launches of at most this many steps (same results).
+constexpr int kChainedSteps = 32;
+int stepsPerGraphLaunch(const DeviceState& d) { return graphLoopIsChain() ? std::min(d.ringSize, kChainedSteps) : d.ringSize; }
+
 // Captures a batch as one graph, replayed every batch until n, a capacity or the ring changes:
-//   copy the control in -> reset the batch's counters -> WHILE (a step; its last kernel sets the
-//   condition) -> copy the ring and the counters out to pinned memory.
+//   copy the control in -> reset the batch's counters -> the steps (graphLoopIsChain's form; the
+//   last kernel of a step decides whether the batch goes on) -> copy the ring and the counters out
+//   to pinned memory.
 // So a batch of up to copy_back_every steps is one launch and one host sync (thesis 5.7).
 void captureStep(DeviceState& d) {
   prepareBuffers(d);
@@ -248,23 +275,52 @@ void captureStep(DeviceState& d) {
   beginParams.kernelParams = beginArgs;
   GEM_CUDA_CHECK(cudaGraphAddKernelNode(&begin, graph, &controlIn, 1, &beginParams));
 
-  cudaGraphConditionalHandle handle;
-  GEM_CUDA_CHECK(cudaGraphConditionalHandleCreate(&handle, graph, 1, cudaGraphCondAssignDefault));
-  cudaGraphNodeParams loopParams{};
-  loopParams.type = cudaGraphNodeTypeConditional;
-  loopParams.conditional.handle = handle;
-  loopParams.conditional.type = cudaGraphCondTypeWhile;
-  loopParams.conditional.size = 1;
-  GEM_CUDA_CHECK(cudaGraphAddNode(&loop, graph, &begin, nullptr, 1, &loopParams));
-  cudaGraph_t body = loopParams.conditional.phGraph_out[0];
-  GEM_CUDA_CHECK(cudaStreamBeginCaptureToGraph(d.stream, body, nullptr, nullptr, 0, cudaStreamCaptureModeThreadLocal));
-  try {
-    enqueueStep(d, handle, true);
-  } catch (...) {
-    cudaStreamEndCapture(d.stream, &body);
-    throw;
+  // A conditional node after `after` whose body is one step captured from the stream; `decides`:
+  // the handle the step's last kernel sets (WHILE: its own), none in the chain (inGraph false).
+  auto addStepNode = [&](cudaGraphNode_t after, cudaGraphConditionalNodeType type, cudaGraphConditionalHandle handle, bool decides) {
+    cudaGraphNodeParams params{};
+    params.type = cudaGraphNodeTypeConditional;
+    params.conditional.handle = handle;
+    params.conditional.type = type;
+    params.conditional.size = 1;
+    cudaGraphNode_t node;
+    GEM_CUDA_CHECK(cudaGraphAddNode(&node, graph, &after, nullptr, 1, &params));
+    cudaGraph_t body = params.conditional.phGraph_out[0];
+    GEM_CUDA_CHECK(cudaStreamBeginCaptureToGraph(d.stream, body, nullptr, nullptr, 0, cudaStreamCaptureModeThreadLocal));
+    try {
+      enqueueStep(d, handle, decides);
+    } catch (...) {
+      cudaStreamEndCapture(d.stream, &body);
+      throw;
+    }
+    GEM_CUDA_CHECK(cudaStreamEndCapture(d.stream, &body));
+    return node;
+  };
+  if (!graphLoopIsChain()) {
+    cudaGraphConditionalHandle handle;
+    GEM_CUDA_CHECK(cudaGraphConditionalHandleCreate(&handle, graph, 1, cudaGraphCondAssignDefault));
+    loop = addStepNode(begin, cudaGraphCondTypeWhile, handle, true);
+  } else {
+    // Step k's IF node opens when the gate before it saw the batch running (the first always: a
+    // batch has at least one step). A step past the batch's end leaves every later one closed.
+    loop = begin;
+    for (int k = 0; k < stepsPerGraphLaunch(d); ++k) {
+      cudaGraphConditionalHandle handle;
+      GEM_CUDA_CHECK(cudaGraphConditionalHandleCreate(&handle, graph, k == 0 ? 1u : 0u, cudaGraphCondAssignDefault));
+      if (k > 0) {
+        void* gateArgs[] = {&handle, &stats};
+        cudaKernelNodeParams gateParams{};
+        gateParams.func = reinterpret_cast<void*>(gateStepKernel);
+        gateParams.gridDim = dim3(1);
+        gateParams.blockDim = dim3(1);
+        gateParams.kernelParams = gateArgs;
+        cudaGraphNode_t gate;
+        GEM_CUDA_CHECK(cudaGraphAddKernelNode(&gate, graph, &loop, 1, &gateParams));
+        loop = gate;
+      }
+      loop = addStepNode(loop, cudaGraphCondTypeIf, handle, false);
+    }
   }
-  GEM_CUDA_CHECK(cudaStreamEndCapture(d.stream, &body));
 
   GEM_CUDA_CHECK(cudaGraphAddMemcpyNode1D(&ringOut, graph, &loop, 1, d.h_ring, d.ring.get(),
                                           sizeof(StepRecord) * static_cast<size_t>(d.ringSize), cudaMemcpyDeviceToHost));
@@ -327,7 +383,7 @@ void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& resu
   long next = firstStep;
   int remaining = steps;
   while (remaining > 0) {
-    *d.h_control = BatchControl{next, dt, std::min(remaining, d.ringSize)};
+    *d.h_control = BatchControl{next, dt, std::min(remaining, useGraph ? stepsPerGraphLaunch(d) : d.ringSize)};
     if (!useGraph) {
       awaitHostCopies();
       runBatchUncaptured(d);

@@ -29,6 +29,11 @@ constexpr ColumnRange kColumnRanges[] = {
     {"apex_deg", 0, 180, "an apex angle is 0 to 180 degrees"},
     {"y_from_centerline", -1e4, 1e4, "no hull is 20 km wide"},
     {"x_from_stem", -1e5, 1e5, "no hull is 100 km long"},
+    // Far past any load GEM computes (MN at most), and small enough that sums of 10^7 rows stay finite.
+    {"fn", -1e15, 1e15, "no impact force reaches 1e15 N"},
+    {"vn", -1e6, 1e6, "no impact speed reaches 1000 km/s"},
+    {"floe_mass", 0, 1e15, "no floe weighs 1e15 kg"},
+    {"t", 0, 1e15, "a run's time is 0 to 1e15 s"},
 };
 
 }  // namespace
@@ -166,9 +171,12 @@ std::vector<std::vector<double>> readColumns(const fs::path& file, const std::ve
     columns.push_back(table.numbers(w, emptyIsNaN));
     for (const ColumnRange& r : kColumnRanges) {
       if (w != r.column) continue;
+      const int c = table.column(w);
       for (size_t k = 0; k < columns.back().size(); ++k) {
         const double v = columns.back()[k];
-        if (std::isfinite(v) && !(v >= r.lo && v <= r.hi))
+        // NaN stands for an empty cell only: "nan" or "inf" written in one is refused too.
+        const bool empty = std::isnan(v) && table.rows[k][static_cast<size_t>(c)].find_first_not_of(' ') == std::string::npos;
+        if (!empty && !(v >= r.lo && v <= r.hi))
           throw InputError(file.string(), table.lines[k], 0,
                            fmt::format("column {}: {} is outside {} to {} ({})", r.column, v, r.lo, r.hi, r.why));
       }
