@@ -622,7 +622,7 @@ int runBench(const BenchOptions& o) {
   const auto& tables = benchTables();
   if (std::find(tables.begin(), tables.end(), o.table) == tables.end())
     throw InputError(fmt::format("gem bench --table {}: valid tables are {}", o.table, fmt::join(tables, ", ")));
-  if (o.steps < 1) throw InputError("gem bench --steps: must be at least 1");
+  if (o.steps < 1 || o.steps > 10000000) throw InputError(fmt::format("gem bench --steps {}: from 1 to 10^7", o.steps));
   for (int b : o.blockSizes)
     if (b < 32 || b > 1024 || b % 32) throw InputError(fmt::format("gem bench --blocks {}: a multiple of 32 from 32 to 1024", b));
   for (int k : o.copyBackEvery)

@@ -153,6 +153,9 @@ TEST(BadInputCli, NotAScenarioFileAndBadNumbersOnTheCommandLine) {
     EXPECT_LE(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "summary.json")) << c.arguments;
   }
+  // gem bench's step count is bounded too (10^13 steps ran for ever).
+  EXPECT_EQ(gem::test::runGem("bench --cases 824 --steps 9999999999999", log), 2);
+  EXPECT_NE(gem::test::readFile(log).find("--steps 9999999999999: from 1 to 10^7"), std::string::npos) << gem::test::readFile(log);
   // A file where the run folder (or a folder above it) should be: exit 2 naming it.
   const auto file = dir.write("a_file", "x");
   EXPECT_EQ(gem::test::runGem("run " + good.string() + " --quiet --out " + (file / "run").string(), log), 2);
@@ -305,4 +308,19 @@ TEST(BadInput, MisspelledNamesGetASuggestion) {
   EXPECT_EQ(status, 2) << log;
   for (const char* e : {"did you mean \"uniform_grid\"", "did you mean \"cpu\"", "did you mean \"drag\"", "3 errors in all"})
     EXPECT_NE(log.find(e), std::string::npos) << "missing \"" << e << "\" in: " << log;
+}
+
+// SIGTERM stops gem bench at once: only run, sweep and calibrate catch it to stop between two
+// steps; a command that never looks at the flag keeps the signal's default (bench once ran on).
+TEST(BadInputCli, SigtermStopsABenchAtOnce) {
+  TempDir dir;
+  const char* staged = std::getenv("GEM_BINARY_DIR");
+  const std::string gem = std::string(staged ? staged : GEM_BINARY_DIR) + "/gem";
+  const auto status = dir.path() / "status.txt";
+  const std::string script = "cd " + dir.path().string() + " && GEM_SCENARIOS=" + std::string(GEM_SOURCE_DIR) + "/scenarios " + gem +
+                             " bench --cases 824 --steps 10000000 > bench.log 2>&1 & p=$!; sleep 2; kill -TERM $p; "
+                             "(sleep 30; kill -9 $p 2>/dev/null) & g=$!; wait $p; echo $? > " +
+                             status.string() + "; kill $g 2>/dev/null";
+  std::system(("sh -c '" + script + "'").c_str());
+  EXPECT_EQ(gem::test::readFile(status), "143\n") << "128 + SIGTERM; 137 would be the guard's kill -9 after 30 s";
 }

@@ -366,7 +366,10 @@ int main(int argc, char** argv) {
     // GEM_PLUGIN_PATH's plugins, for every command: a scenario, gem bench --broadphase or gem info
     // may name what they add.
     loadEnvironmentPlugins();
-    catchInterrupts();  // Ctrl-C and SIGTERM stop a run between two steps, its files kept whole
+    // Ctrl-C and SIGTERM stop a run between two steps, its files kept whole, and a sweep or a
+    // calibration between cases; the commands that never look at the flag (check, bench, the
+    // readers) keep the signals' default and stop at once.
+    if (*run || *sweepCommand || *calibrateCommand) catchInterrupts();
     if (*run) return commandRun(args);
     if (*check) return commandCheck(args);
     // Output places named on the command line, checked before any work (framework/output/output_path.hpp).
