@@ -70,6 +70,21 @@ TEST(SweepFile, ProductExpandsFirstParameterSlowest) {
   EXPECT_EQ(def.cases[3].base, fs::absolute(dir.path() / "base.toml").lexically_normal());
 }
 
+// Parameter values of thousands of characters make names the file system cannot hold as folders:
+// each case's folder is cut short (and still unique), its name kept whole.
+TEST(SweepFile, LongParameterValuesGiveShortUniqueFolders) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const std::string a(3000, 'a'), b = std::string(2999, 'a') + "b";
+  const SweepDefinition def = readSweepFile(
+      dir.write("long.toml", "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"output.movie_title\" = [\"" + a + "\", \"" + b + "\"]\n"));
+  ASSERT_EQ(def.cases.size(), 2u);
+  EXPECT_GT(def.cases[0].name.size(), 3000u);
+  EXPECT_LE(def.cases[0].folder.size(), 125u);
+  EXPECT_LE(def.cases[1].folder.size(), 125u);
+  EXPECT_NE(def.cases[0].folder, def.cases[1].folder);
+}
+
 TEST(SweepFile, CasesTimesParametersAndNonScalarValues) {
   TempDir dir;
   dir.write("base.toml", kBase);

@@ -162,6 +162,9 @@ std::vector<Combination> expandParameters(const std::vector<Leaf>& parameters, c
 
 }  // namespace
 
+// The longest case folder name: room under the file systems' 255 for a "_2" of a clash.
+constexpr size_t kMostFolderName = 120;
+
 std::string caseFolderName(const std::string& name) {
   std::string out;
   for (char c : name) {
@@ -286,9 +289,12 @@ SweepDefinition readSweepFile(const fs::path& file) {
   }
   // Folders: unique among the sweep's cases, first come first served (the order of the cases is the
   // sweep file's, so a sweep always gives a case the same folder).
+  // A name made of long parameter values is cut to kMostFolderName characters (a file system's
+  // limit is 255); the case keeps its whole name in summary.csv.
   std::set<std::string> folders;
   for (SweepCase& c : def.cases) {
-    const std::string stem = caseFolderName(c.name);
+    std::string stem = caseFolderName(c.name);
+    if (stem.size() > kMostFolderName) stem.resize(kMostFolderName);
     c.folder = stem;
     for (int k = 2; !folders.insert(c.folder).second; ++k) c.folder = fmt::format("{}_{}", stem, k);
   }
