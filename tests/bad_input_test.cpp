@@ -324,3 +324,19 @@ TEST(BadInputCli, SigtermStopsABenchAtOnce) {
   std::system(("sh -c '" + script + "'").c_str());
   EXPECT_EQ(gem::test::readFile(status), "143\n") << "128 + SIGTERM; 137 would be the guard's kill -9 after 30 s";
 }
+
+// A folder in the place of one of the run's files (gem.log is written last of all) is refused
+// before any work: the run once wrote summary.json and state.csv and then failed on gem.log.
+TEST(BadInputCli, AFolderWhereTheRunWritesAFileIsRefusedBeforeAnyWork) {
+  TempDir dir;
+  const auto good = dir.write("good.toml", kSim);
+  for (const char* name : {"gem.log", "summary.json", "state.csv"}) {
+    const auto out = dir.path() / (std::string("run_") + name);
+    std::filesystem::create_directories(out / name / "sub");
+    EXPECT_EQ(gem::test::runGem("run " + good.string() + " --quiet --no-plots --out " + out.string(), dir.path() / "log"), 2) << name;
+    const std::string text = gem::test::readFile(dir.path() / "log");
+    EXPECT_NE(text.find((out / name).string() + ": a folder where the run writes its file"), std::string::npos) << text;
+    EXPECT_FALSE(std::filesystem::exists(out / "timeseries.csv")) << name;
+    EXPECT_FALSE(std::filesystem::is_regular_file(out / "summary.json")) << name;
+  }
+}

@@ -56,7 +56,14 @@ void RunLog::continueFrom(const std::filesystem::path& dir) {
 void RunLog::write(const std::filesystem::path& dir, int exitStatus) const {
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) return;
-  writeFileAtomically(dir / "gem.log", m_earlier + m_header + m_lines + fmt::format("\nended: {}, exit status {}\n", utcNow(), exitStatus));
+  try {
+    writeFileAtomically(dir / "gem.log",
+                        m_earlier + m_header + m_lines + fmt::format("\nended: {}, exit status {}\n", utcNow(), exitStatus));
+  } catch (const std::exception&) {
+    // A run that failed has said why on the terminal: a log that cannot be written (a folder in
+    // its place, say) must not replace that message with its own.
+    if (exitStatus == 0) throw;
+  }
 }
 
 std::string commandLineText(int argc, char** argv) {

@@ -19,7 +19,8 @@ class RunLog {
   // part's follows it.
   void continueFrom(const std::filesystem::path& dir);
   // Writes dir/gem.log (atomically) with the lines so far and how gem ends (exit status). Does
-  // nothing when dir does not exist (a run refused before it opened its folder).
+  // nothing when dir does not exist (a run refused before it opened its folder); for a run that
+  // failed (exitStatus != 0) a log that cannot be written is let go, the failure's message kept.
   void write(const std::filesystem::path& dir, int exitStatus) const;
 
  private:

@@ -29,6 +29,18 @@ RunFolderLock::RunFolderLock(const std::filesystem::path& dir) : m_file(dir / ".
     throw InputError(fmt::format("{}: another gem run is writing into this run folder{}; wait for it, or give another --out", dir.string(),
                                  n > 0 ? fmt::format(" (pid {})", std::string(holder, static_cast<size_t>(n))) : ""));
   }
+  // A folder where the run writes one of its files would fail the run at its end, after other
+  // files were written: refused now, before any work.
+  for (const char* name : {"summary.json", "state.csv", "timeseries.csv", "impacts.csv", "gem.log", "scenario.toml", "frames.pvd",
+                           "frames.ice", "checkpoint.gem"}) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(dir / name, ec)) {
+      ::close(m_fd);
+      m_fd = -1;
+      throw InputError(
+          fmt::format("{}: a folder where the run writes its file {}; remove it, or give another --out", (dir / name).string(), name));
+    }
+  }
   const std::string pid = std::to_string(::getpid());
   if (::ftruncate(m_fd, 0) == 0 && ::pwrite(m_fd, pid.data(), pid.size(), 0) < 0) {
     // the pid is only for the message of a run refused later: not writing it is no failure
