@@ -2,6 +2,7 @@
 // names the file and line (or the key), and leaves no summary.json (the list, item 7).
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 
 #include "test_support.hpp"
@@ -339,4 +340,24 @@ TEST(BadInputCli, AFolderWhereTheRunWritesAFileIsRefusedBeforeAnyWork) {
     EXPECT_FALSE(std::filesystem::exists(out / "timeseries.csv")) << name;
     EXPECT_FALSE(std::filesystem::is_regular_file(out / "summary.json")) << name;
   }
+}
+
+// A .ice field or a CSV read back whole that could not fit in memory is refused up front, naming
+// the file and its size (a sparse file of 200 GB here): it once grew until std::bad_alloc (exit 1)
+// or swapped for minutes.
+TEST(BadInputCli, AFileTooLargeToReadIsRefusedNamingItsSize) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  const auto ice = dir.path() / "huge.ice";
+  std::ofstream(ice).put('<');
+  std::filesystem::resize_file(ice, std::uintmax_t(200) << 30);
+  const auto scenario = dir.write("field.toml", kSim + "[field]\nkind = \"file\"\nfile = \"huge.ice\"\n");
+  EXPECT_EQ(gem::test::runGem("check " + scenario.string(), log), 2);
+  EXPECT_NE(gem::test::readFile(log).find("huge.ice: 215 GB, too large to read"), std::string::npos) << gem::test::readFile(log);
+  const auto run = dir.path() / "run";
+  std::filesystem::create_directories(run);
+  std::ofstream(run / "impacts.csv").put('t');
+  std::filesystem::resize_file(run / "impacts.csv", std::uintmax_t(200) << 30);
+  EXPECT_EQ(gem::test::runGem("analyze --quiet " + run.string(), log), 2);
+  EXPECT_NE(gem::test::readFile(log).find("impacts.csv: 215 GB, too large to read"), std::string::npos) << gem::test::readFile(log);
 }

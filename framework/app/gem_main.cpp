@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -398,6 +399,9 @@ int main(int argc, char** argv) {
     if (!args.quiet) std::fprintf(stderr, "\n");  // past the progress line
     std::fprintf(stderr, "gem: %s\n", e.what());
     return 128 + e.signal();
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "gem: failed: out of memory (a field, a sweep or a file larger than this machine holds)\n");
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gem: failed: %s\n", e.what());
     return 1;

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "framework/api/errors.hpp"
+#include "framework/api/input_size.hpp"
 
 namespace gem {
 
@@ -155,6 +156,7 @@ CsvTable parseCsvTable(std::string_view text, const fs::path& file) {
 CsvTable readCsvTable(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot be opened");
+  requireFitsInMemory(file, 6);  // the text, and its cells as strings
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw InputError(file.string() + ": cannot be read");
   return parseCsvTable(text, file);

@@ -1,0 +1,29 @@
+// Files a reader takes in whole (a .ice file, a CSV output read back): refused up front when they
+// could not fit in memory, naming the file and its size, instead of growing until std::bad_alloc
+// or swapping for minutes (a 100 GB impacts.csv once did both).
+#pragma once
+#include <unistd.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
+
+namespace gem {
+
+// expansion: the reader's memory per byte of the file (its text plus what it builds from it).
+inline void requireFitsInMemory(const std::filesystem::path& file, double expansion) {
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
+  if (ec) return;  // not a regular file: the reader says what it is
+  const double memory = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  const double need = static_cast<double>(bytes) * expansion;
+  if (memory > 0 && need > 0.8 * memory)
+    throw InputError(fmt::format("{}: {:.3g} GB, too large to read: it would take about {:.3g} GB of this machine's {:.3g} GB of memory",
+                                 file.string(), static_cast<double>(bytes) / 1e9, need / 1e9, memory / 1e9));
+}
+
+}  // namespace gem
