@@ -55,7 +55,8 @@ struct World {
   }
 
   // Adds a body from world-coordinate vertices (already validated: convex, CCW, finite).
-  // Floe mass is rho_ice * area * thickness (docs/model.md 1); walls get infinite mass.
+  // Mass is rho_ice * area * thickness (docs/model.md 1); a wall keeps that mass but is immovable
+  // (invMass and invInertia 0); the vessel's mass is set by its owner (addVessel).
   int addBody(const BodySpec& spec);
   // Removes the bodies whose flag is set, keeping the order of the others.
   // forEachTask, when given, runs tasks 0 .. count - 1 on the caller's threads (a topology event
