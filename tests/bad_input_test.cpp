@@ -243,7 +243,7 @@ TEST(BadInputCli, ABadSetValueNamesTheSet) {
   const auto log = dir.path() / "log.txt";
   const auto good = dir.write("good.toml", kSim);
   for (const std::string set : {"simulation.dt=-1", "vessel.dof=2", "simulation.dtt=0.1", "events.drag.cd=-5", "events.drag.cdd=1",
-                                "floes=[{vertices=[[0.0,0.0],[1.0,0.0]],thickness=1.0}]"}) {
+                                "broadphase.brute_pair.skin=1.0", "floes=[{vertices=[[0.0,0.0],[1.0,0.0]],thickness=1.0}]"}) {
     EXPECT_EQ(gem::test::runGem("check " + good.string() + " --set '" + set + "'", log), 2) << set;
     const std::string text = gem::test::readFile(log);
     EXPECT_NE(text.find("--set " + set + ": "), std::string::npos) << text;

@@ -511,3 +511,20 @@ TEST(GemRun, SubnormalValuesReachTheSummary) {
   EXPECT_GT(time, 0.0) << summary;
   EXPECT_LT(time, 1e-300) << summary;
 }
+
+// The closing report lists the files the run folder holds: no frames when the run wrote none.
+TEST(GemRun, TheClosingReportListsTheFilesWritten) {
+  test::TempDir dir;
+  const auto scenario = dir.write("plain.toml",
+                                  "[simulation]\ndt = 0.1\nsteps = 5\n[output]\nframe_every = 0\n"
+                                  "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]\n");
+  ASSERT_EQ(test::runGem("run " + scenario.string() + " --no-plots --out " + (dir.path() / "out").string(), dir.path() / "log"), 0);
+  const std::string log = test::readFile(dir.path() / "log");
+  const auto at = log.find("  outputs ");
+  ASSERT_NE(at, std::string::npos) << log;
+  const std::string line = log.substr(at, log.find('\n', at) - at);
+  EXPECT_NE(line.find("summary.json"), std::string::npos) << line;
+  EXPECT_NE(line.find("gem.log"), std::string::npos) << line;
+  EXPECT_EQ(line.find("frames.pvd"), std::string::npos) << line;
+  EXPECT_EQ(line.find("frames.ice"), std::string::npos) << line;
+}

@@ -124,10 +124,14 @@ InputError TableReader::errorAt(const toml::node& n, const std::string& message)
   // A value from --set (no source): the message starts with its key path ("a.b: ...", "a.b[0]...")
   // or quotes it ("unknown key \"a.b\""); the last assignment of that key is the one in force.
   if (!src.path && t_overrides) {
+    // The message's own key path, when it starts with one ("broadphase.x: unknown broadphase"): a
+    // --set of a key below it (broadphase.x.skin=1) made the table it is about.
+    const std::string about = message.substr(0, std::min(message.find(':'), message.find(' ')));
     for (auto a = t_overrides->rbegin(); a != t_overrides->rend(); ++a) {
       const std::string key = a->substr(0, a->find('='));
       const bool named = message.rfind(key + ":", 0) == 0 || message.rfind(key + "[", 0) == 0 || message.rfind(key + ".", 0) == 0 ||
-                         message.find("\"" + key + "\"") != std::string::npos || message.find("\"" + key + ".") != std::string::npos;
+                         message.find("\"" + key + "\"") != std::string::npos || message.find("\"" + key + ".") != std::string::npos ||
+                         (!about.empty() && key.rfind(about + ".", 0) == 0);
       if (named) return InputError(fmt::format("--set {}: {}", *a, message));
     }
   }

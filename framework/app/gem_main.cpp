@@ -3,6 +3,7 @@
 // Exit status: 0 success; 2 bad input (with file, line and column or key); 1 any other failure.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -108,10 +109,17 @@ void reportRun(RunLog& log, const RunSummary& r) {
   if (r.stopReason != "duration") log.say(fmt::format("  stopped        after {} steps: {}", r.steps, r.stopReason));
   log.say(fmt::format("  wall time      {:.3f} s for {:.1f} s simulated: {:.0f}x real time ({:.0f} steps/s)", r.wallTime, r.simTime,
                       r.simTime / std::max(r.wallTime, 1e-9), r.steps / std::max(r.wallTime, 1e-9)));
-  log.say(
-      fmt::format("  outputs        {}/ (summary.json, timeseries.csv, impacts.csv, state.csv, frames.pvd, frames.ice, "
-                  "scenario.toml, gem.log)",
-                  r.outputDir));
+  // The files the run folder holds now (the frames only when the run wrote them, a plugin's own
+  // files too), and gem.log, written just after this report.
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(r.outputDir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (e.is_regular_file(ec) && name[0] != '.' && name.find(".tmp-") == std::string::npos && name != "gem.log") files.push_back(name);
+  }
+  std::sort(files.begin(), files.end());
+  files.push_back("gem.log");
+  log.say(fmt::format("  outputs        {}/ ({})", r.outputDir, fmt::join(files, ", ")));
 }
 
 // gem plot, and the end of gem run: the run folder's plots, each file named as written.
