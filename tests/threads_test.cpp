@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <random>
@@ -208,6 +209,60 @@ TEST(Threads, APackPressedAgainstAWallStepsBitForBitOnOneAndThreeThreads) {
   ASSERT_GE(one.mostContacts, CpuStepper::kParallelContacts) << "too few contacts for the pair events to run on the pool";
   EXPECT_GT(one.impactRows, 0);
   expectSame(one, runWithThreads(s, 3, 150), 3);
+}
+
+// A field that a current moves whole: every pair whose boxes overlap is tested each step, so the
+// narrowphase's parts hold tens of thousands of separated pairs and are joined on the pool
+// (CpuStepper::kParallelJoin); the next step's search for each pair's last separating edge reads
+// the joined list.
+TEST(Threads, AFieldMovedWholeByACurrentJoinsItsNarrowphaseOnThePool) {
+  test::TempDir dir;
+  const Scenario s =
+      test::scenarioFromToml(dir, std::string(test::kBusyScene) + "[events.current]\nspeed = 1.0\nspeed_direction_deg = 30.0\n",
+                             {"simulation.steps=30", "field.concentration=0.6", "domain.x=[0.0, 2000.0]", "domain.y=[-500.0, 500.0]"});
+  Scenario probe = s;
+  probe.threads = 1;
+  CpuStepper sim(probe);
+  for (int k = 0; k < 3; ++k) sim.step();
+  ASSERT_GE(static_cast<size_t>(sim.separatedCount()), CpuStepper::kParallelJoin) << "too few separated pairs to join on the pool";
+  const ThreadedRun one = runWithThreads(s, 1, 30);
+  EXPECT_GT(one.contacts, 0);
+  expectSame(one, runWithThreads(s, 3, 30), 3);
+}
+
+// GEM_CPU_TIMING=1 (docs/performance.md 1.4): one line on stderr when the stepper goes, its steps
+// and each phase's milliseconds a step, which add up to the total it states.
+TEST(CpuTiming, OneLineOfPhasesThatAddUpToTheStep) {
+  test::TempDir dir;
+  const Scenario s = test::scenarioFromToml(dir, test::kBusyScene, {"simulation.steps=12"});
+  ::setenv("GEM_CPU_TIMING", "1", 1);
+  ::testing::internal::CaptureStderr();
+  {
+    CpuStepper sim(s);
+    for (int k = 0; k < 12; ++k) sim.step();
+  }
+  const std::string line = ::testing::internal::GetCapturedStderr();
+  ::unsetenv("GEM_CPU_TIMING");
+  ASSERT_NE(line.find("gem cpu timing, 12 steps, "), std::string::npos) << line;
+  const size_t at = line.find(" ms a step; of it");
+  ASSERT_NE(at, std::string::npos) << line;
+  const double total = std::stod(line.substr(line.rfind(' ', at - 1) + 1));
+  double sum = 0;
+  for (const char* phase :
+       {"broadphase", "narrowphase tests", "narrowphase join", "pair views and events", "solo events", "gather and motion", "topology"}) {
+    const size_t p = line.find(std::string(phase) + " ", at);
+    ASSERT_NE(p, std::string::npos) << phase << " missing in: " << line;
+    sum += std::stod(line.substr(p + std::string(phase).size() + 1));
+  }
+  EXPECT_GT(total, 0);
+  EXPECT_NEAR(sum, total, 1e-3 + 1e-3 * total);  // each figure is rounded to 0.1 us
+  // Off, nothing is printed.
+  ::testing::internal::CaptureStderr();
+  {
+    CpuStepper sim(s);
+    sim.step();
+  }
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
 }
 
 TEST(Threads, ABrokenFieldStepsBitForBitOnThreeThreads) {

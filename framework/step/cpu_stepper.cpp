@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <optional>
 #include <cmath>
@@ -141,7 +143,21 @@ CpuStepper::CpuStepper(const Scenario& scenario) : CpuStepper(scenario, buildWor
 
 CpuStepper::CpuStepper(const Scenario& scenario, World world) : m_scenario(scenario), m_world(std::move(world)) { setUp(); }
 
+CpuStepper::~CpuStepper() {
+  if (!m_clock.on || m_clock.steps == 0) return;
+  double total = 0;
+  for (const double t : m_clock.seconds) total += t;
+  std::string line = fmt::format("gem cpu timing, {} steps, {} bodies, {} thread{}: {:.4f} ms a step; of it", m_clock.steps, m_world.size(),
+                                 threads(), threads() == 1 ? "" : "s", 1e3 * total / static_cast<double>(m_clock.steps));
+  for (int p = 0; p < PhaseClock::kPhases; ++p)
+    line += fmt::format("{} {} {:.4f}", p ? "," : "", PhaseClock::kNames[static_cast<size_t>(p)],
+                        1e3 * m_clock.seconds[static_cast<size_t>(p)] / static_cast<double>(m_clock.steps));
+  std::fprintf(stderr, "%s\n", line.c_str());
+}
+
 void CpuStepper::setUp() {
+  const char* timing = std::getenv("GEM_CPU_TIMING");
+  m_clock.on = timing && timing[0] == '1';
   const OverrideScope blameSet(m_scenario.overrides);  // an error in a --set value names the --set
   const BroadphaseEntry& strategy = Registry::global().broadphase(m_scenario.broadphase);
   m_broadphase = strategy.make(m_scenario.broadphaseSettings);
@@ -249,7 +265,7 @@ void CpuStepper::narrowphase() {
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
   m_boxes.resize(n);
   m_vertexPose.resize(n, Pose{-1, 0, 0, 0});
-  m_moved.assign(n, 0);
+  m_moved.resize(n);  // each body's flag is set in the pass below
   // Whether a slot changed hands since the last narrowphase (a re-sort, a break, a restored state),
   // seen in this pass over the bodies rather than in a serial one of its own.
   const int lastSlots = static_cast<int>(m_lastSlotId.size());
@@ -261,6 +277,7 @@ void CpuStepper::narrowphase() {
     // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
     // vertices from an earlier step are still exact, so only bodies that moved are transformed.
     const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
+    m_moved[i] = 0;
     if (pose == m_vertexPose[i]) return;
     m_vertexPose[i] = pose;
     m_moved[i] = 1;
@@ -345,24 +362,53 @@ void CpuStepper::narrowphase() {
     testPart(0);
   else
     m_pool->run(tasks, testPart);
+  m_clock.lap(PhaseClock::Tests);
 
-  m_contactA.clear();
-  m_contactB.clear();
-  m_contacts.clear();
-  m_currentContacts.clear();
-  m_separated.clear();
-  for (const NarrowphasePart& part : m_parts) {
-    m_contactA.insert(m_contactA.end(), part.a.begin(), part.a.end());
-    m_contactB.insert(m_contactB.end(), part.b.begin(), part.b.end());
-    m_contacts.insert(m_contacts.end(), part.contacts.begin(), part.contacts.end());
-    m_currentContacts.insert(m_currentContacts.end(), part.keys.begin(), part.keys.end());
-    m_separated.insert(m_separated.end(), part.separated.begin(), part.separated.end());
-  }
-  m_previousContacts.swap(m_currentContacts);  // in contact order, sorted only when searched (above)
-  m_previousSorted = false;
-  m_lastSeparated.swap(m_separated);
+  joinParts(tasks);
   m_lastSlotId.swap(m_slotIdNow);
   m_byBody.build(m_contactA, m_contactB, n);
+  m_clock.lap(PhaseClock::Join);
+}
+
+// The narrowphase's parts joined in task order: the contacts of one pass over all the pairs. One
+// part (one thread) is taken over whole. Several are copied to their places, on the pool when
+// they hold more than kParallelJoin pairs: in a pack at rest they are a few dozen (a resting pair
+// is not tested again), but where the whole field moves (a current, a re-sort step) the separated
+// pairs of 10^5 floes pass a megabyte, too much for one thread of sixteen.
+void CpuStepper::joinParts(int tasks) {
+  if (tasks == 1) {
+    NarrowphasePart& part = m_parts[0];
+    m_contactA.swap(part.a), m_contactB.swap(part.b), m_contacts.swap(part.contacts);
+    m_previousContacts.swap(part.keys), m_lastSeparated.swap(part.separated);
+  } else {
+    m_joinAt.resize(static_cast<size_t>(tasks));
+    size_t contacts = 0, separated = 0;
+    for (int t = 0; t < tasks; ++t) {
+      const NarrowphasePart& part = m_parts[static_cast<size_t>(t)];
+      m_joinAt[static_cast<size_t>(t)] = {contacts, separated};
+      contacts += part.a.size(), separated += part.separated.size();
+    }
+    // resize, not clear: only what grows past last step's size is filled before it is overwritten.
+    m_contactA.resize(contacts), m_contactB.resize(contacts), m_contacts.resize(contacts), m_currentContacts.resize(contacts);
+    m_separated.resize(separated);
+    auto copyPart = [&](int t) {
+      const NarrowphasePart& part = m_parts[static_cast<size_t>(t)];
+      const auto [c, s] = m_joinAt[static_cast<size_t>(t)];
+      const auto at = static_cast<std::ptrdiff_t>(c);
+      std::copy(part.a.begin(), part.a.end(), m_contactA.begin() + at);
+      std::copy(part.b.begin(), part.b.end(), m_contactB.begin() + at);
+      std::copy(part.contacts.begin(), part.contacts.end(), m_contacts.begin() + at);
+      std::copy(part.keys.begin(), part.keys.end(), m_currentContacts.begin() + at);
+      std::copy(part.separated.begin(), part.separated.end(), m_separated.begin() + static_cast<std::ptrdiff_t>(s));
+    };
+    if (contacts + separated >= kParallelJoin)
+      m_pool->run(tasks, copyPart);
+    else
+      for (int t = 0; t < tasks; ++t) copyPart(t);
+    m_previousContacts.swap(m_currentContacts);
+    m_lastSeparated.swap(m_separated);
+  }
+  m_previousSorted = false;  // in contact order, sorted only when searched (narrowphase)
 }
 
 void CpuStepper::ContactsByBody::build(const std::vector<int>& a, const std::vector<int>& b, int n) {
@@ -421,6 +467,7 @@ void CpuStepper::step() {
     const int threads = threadsFor(m_scenario.threads);
     if (threads > 1) m_pool = std::make_unique<ThreadPool>(threads);
   }
+  m_clock.start();
   const StepContext ctx{m_scenario.dt, m_time, m_step};
   const int n = m_world.size();
   const int vesselDof = m_scenario.vessel.dof;
@@ -432,6 +479,7 @@ void CpuStepper::step() {
     m_broadphase->findCandidates(m_world, m_pairs);
   }
   if (m_broadphaseFromPlugin) normalizeCandidatePairs(m_pairs);
+  m_clock.lap(PhaseClock::Broadphase);
   narrowphase();
 
   // 3. Two-body events write into each contact's slot. Only the bodies of a contact get a pair
@@ -528,6 +576,7 @@ void CpuStepper::step() {
       }
   }
   deliverLogs(m_records);
+  m_clock.lap(PhaseClock::PairEvents);
 
   // 4. Solo events, from the state at the start of the step.
   m_soloBodies.resize(n);
@@ -556,8 +605,11 @@ void CpuStepper::step() {
       if (e.phase == EventPhase::Solo) e.instance->runSolo(soloData);
   });
 
+  m_clock.lap(PhaseClock::Solo);
+
   // 5. Velocities from 3 and 4, then positions.
   gatherAndMove();
+  m_clock.lap(PhaseClock::GatherMotion);
 
   // 6. Topology: breaks, rubble, new floes.
   TopologyData topology{&m_world, &m_records, m_time};
@@ -573,6 +625,8 @@ void CpuStepper::step() {
   ++m_step;
   m_time = stepTime(m_step, m_scenario.dt);
   if (m_scenario.mortonSort && isResortStep(m_step)) reorderAlongCurve();
+  m_clock.lap(PhaseClock::Topology);
+  ++m_clock.steps;
 }
 
 void CpuStepper::gatherAndMove() {

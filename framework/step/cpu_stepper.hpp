@@ -2,6 +2,8 @@
 //   1 broadphase  2 narrowphase  3 two-body events  4 solo events  5 motion  6 topology
 // (7, the observers, live in the runner). Events come from the registry by name.
 #pragma once
+#include <array>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -36,6 +38,7 @@ class CpuStepper final : public Stepper {
   explicit CpuStepper(const Scenario& scenario);
   // For tests: a world built by hand, with the scenario's events and broadphase.
   CpuStepper(const Scenario& scenario, World world);
+  ~CpuStepper() override;  // GEM_CPU_TIMING=1 prints the phases' times here
 
   void step() override;
 
@@ -56,6 +59,8 @@ class CpuStepper final : public Stepper {
   const RecordStreams& recordStreams() const { return m_streams; }
   int contactCount() const override { return static_cast<int>(m_contacts.size()); }
   int candidateCount() const { return static_cast<int>(m_pairs.size()); }
+  // Pairs whose boxes overlap that an edge separated (those tested: a pair at rest is not).
+  int separatedCount() const { return static_cast<int>(m_lastSeparated.size()); }
   int threads() const { return m_pool ? m_pool->size() : 1; }  // after the first step
   // The sizes from which a phase runs on the pool at all (docs/performance.md 3.8).
   static constexpr int kParallelBodies = 2048, kParallelPairs = 2048;
@@ -64,6 +69,8 @@ class CpuStepper final : public Stepper {
   // Bodies or pairs a task takes at least: a small field wakes few threads (on 16 cores, waking all
   // of them for the 456-hexagon field made its step 1.3x slower than one thread's).
   static constexpr int kGrain = 512;
+  // Contacts and separated pairs from which the narrowphase's parts are joined on the pool.
+  static constexpr size_t kParallelJoin = 32768;
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
   const std::vector<std::pair<std::int64_t, Real>>* contactForces() const override;
   int vesselSlot() const;  // -1 without a vessel
@@ -75,6 +82,27 @@ class CpuStepper final : public Stepper {
   long floesBroken() const override { return m_floesBroken; }
 
  private:
+  // GEM_CPU_TIMING=1: the wall time of each phase of the steps taken, printed as one line on
+  // stderr when the stepper goes (docs/performance.md 1.4). Off, a lap is one test of a flag.
+  struct PhaseClock {
+    enum Phase { Broadphase, Tests, Join, PairEvents, Solo, GatherMotion, Topology, kPhases };
+    static constexpr std::array<const char*, kPhases> kNames{
+        "broadphase", "narrowphase tests", "narrowphase join", "pair views and events", "solo events", "gather and motion", "topology"};
+    bool on = false;
+    long steps = 0;
+    std::array<double, kPhases> seconds{};
+    std::chrono::steady_clock::time_point mark;
+    void start() {
+      if (on) mark = std::chrono::steady_clock::now();
+    }
+    void lap(Phase phase) {
+      if (!on) return;
+      const auto now = std::chrono::steady_clock::now();
+      seconds[phase] += std::chrono::duration<double>(now - mark).count();
+      mark = now;
+    }
+  } m_clock;
+
   void setUp();
   void narrowphase();
   void gatherAndMove();
@@ -147,6 +175,8 @@ class CpuStepper final : public Stepper {
     std::vector<int> boxSurvivors;  // scratch: the candidates whose boxes overlap
   };
   std::vector<NarrowphasePart> m_parts;
+  std::vector<std::pair<size_t, size_t>> m_joinAt;  // each part's first contact and separated pair in the join
+  void joinParts(int tasks);
   // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads; body(i) for
   // every i likewise.
   void forEachRange(int n, const std::function<void(int, int)>& range);
