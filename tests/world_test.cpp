@@ -1,9 +1,15 @@
 // World: removing bodies keeps the survivors' order and every array in step (a break in a world of
-// 10^5 bodies or more compacts the arrays on helper threads, which this also covers).
+// 10^5 bodies or more compacts the arrays on helper threads, which this also covers); the re-sort's
+// order and permutation.
 #include "framework/world/world.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <utility>
 #include <vector>
 
 using namespace gem;
@@ -66,4 +72,49 @@ TEST(World, RemoveBodiesFromALargeWorldUsesHelpersAndKeepsEveryArray) {
   World same = after;
   same.removeBodies(none);  // nothing flagged: nothing changes
   EXPECT_EQ(same.id, after.id);
+}
+
+// The re-sort (CpuStepper's every 200 steps): World::curveOrder is the slots sorted by their
+// Morton key, ties in slot order, and World::permute moves every array's row k to order[k]'s,
+// on one thread or as tasks on a runner (past 16,384 bodies the vertices go in ranges too).
+TEST(World, CurveOrderAndPermuteOnOneThreadOrAsTasks) {
+  World before = squares(40000);
+  // Positions scattered so that the order changes, several bodies on one spot so that keys tie.
+  for (int i = 0; i < before.size(); ++i) {
+    const unsigned h = static_cast<unsigned>(i / 3) * 2654435761u;
+    before.x[i] = static_cast<Real>(h % 4096u), before.y[i] = static_cast<Real>((h >> 12) % 4096u);
+  }
+  const std::vector<int> order = before.curveOrder();
+  Real x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  for (int i = 0; i < before.size(); ++i)
+    x0 = std::min(x0, before.x[i]), x1 = std::max(x1, before.x[i]), y0 = std::min(y0, before.y[i]), y1 = std::max(y1, before.y[i]);
+  const Real scale = curveScale(x0, y0, x1, y1);
+  std::vector<std::pair<std::uint32_t, int>> keys;
+  for (int i = 0; i < before.size(); ++i) keys.emplace_back(curveKey(before.x[i], before.y[i], x0, y0, scale), i);
+  std::sort(keys.begin(), keys.end());
+  ASSERT_EQ(order.size(), keys.size());
+  int ties = 0;
+  for (size_t k = 0; k < keys.size(); ++k) {
+    ASSERT_EQ(order[k], keys[k].second) << "position " << k;
+    ties += k > 0 && keys[k].first == keys[k - 1].first;
+  }
+  EXPECT_GT(ties, 1000) << "no tied keys: the slot order of ties went untested";
+
+  World alone = before;
+  alone.permute(order);
+  int tasks = 0;
+  World pooled = before;
+  pooled.permute(order, [&](int count, const std::function<void(int)>& task) {
+    tasks = count;
+    for (int t = count - 1; t >= 0; --t) task(t);  // any order of the tasks gives the same world
+  });
+  EXPECT_GT(tasks, 19 + 1) << "the vertices were not split into ranges";
+  const std::vector<char> keepAll(before.size(), 0);
+  for (const World* w : {&alone, &pooled})  // row k of the result is row order[k] of before
+    for (size_t k = 0; k < order.size(); ++k) ASSERT_EQ(w->id[k], before.id[static_cast<size_t>(order[k])]);
+  expectCompacted(alone, pooled, keepAll);  // nothing removed: every array equal row by row
+  std::vector<int> inverse(order.size());
+  for (size_t k = 0; k < order.size(); ++k) inverse[static_cast<size_t>(order[k])] = static_cast<int>(k);
+  alone.permute(inverse);
+  expectCompacted(before, alone, keepAll);  // and back again: every array moved with its row
 }

@@ -53,6 +53,7 @@ class CpuStepper final : public Stepper {
   std::string backend() const override { return "cpu"; }
   const std::vector<EnabledEvent>& events() const { return m_events; }
   Broadphase& broadphase() { return *m_broadphase; }
+  void restartPhaseClock() override { m_clock.steps = 0, m_clock.seconds = {}; }
 
   // What the last step produced.
   const StepRecords& records() const override { return m_records; }
@@ -116,6 +117,7 @@ class CpuStepper final : public Stepper {
   long m_step = 0;
   Real m_time = 0;
   std::int64_t m_vesselId = -1;
+  mutable int m_vesselSlotSeen = -1;  // where vesselSlot() last found it
 
   // Per-step buffers, kept to avoid allocation.
   std::vector<Vec2> m_worldVertices;  // kMaxVertices per body

@@ -62,6 +62,9 @@ class Stepper {
   // Wall seconds the backend's device has spent stepping so far, copies of results included (its
   // share when cases run together is the whole batch's); 0 for a backend without a device.
   virtual double deviceSeconds() const { return 0; }
+  // A backend's phase clocks (GEM_CPU_TIMING=1) count from here on: `gem bench` calls it after its
+  // warm-up, so that the clocks time the steps the bench times.
+  virtual void restartPhaseClock() {}
   // The magnitude of each body's contact force over the last step (the sum of its contacts'
   // impulses / dt, N), by body id, sorted by id, bodies without contact left out; null for a
   // backend that does not keep it (the ParaView frames then have no contact_force array).

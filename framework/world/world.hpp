@@ -64,8 +64,9 @@ struct World {
   // array is then compacted by a task of its own. The result is the same either way.
   using TaskRunner = std::function<void(int count, const std::function<void(int)>& task)>;
   void removeBodies(const std::vector<char>& remove, const TaskRunner& forEachTask = nullptr);
-  // Reorders all arrays by the permutation (new slot k holds old slot order[k]).
-  void permute(const std::vector<int>& order);
+  // Reorders all arrays by the permutation (new slot k holds old slot order[k]); forEachTask as for
+  // removeBodies (then the arrays, and ranges of the vertices, are tasks). The same either way.
+  void permute(const std::vector<int>& order, const TaskRunner& forEachTask = nullptr);
   // The order of the bodies along a Morton (Z-order) curve through their centroids: neighbours in
   // space become neighbours in memory (docs/architecture.md "Speed habits"). Ties keep slot order.
   std::vector<int> curveOrder() const;  // sorted by curveKey, ties by slot
