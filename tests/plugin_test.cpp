@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -256,6 +257,34 @@ TEST(PluginRecords, ADisabledEventWritesNoRecordFile) {
   EXPECT_TRUE(fs::exists(dir.path() / "on" / "contact_areas.csv"));
   EXPECT_TRUE(fs::exists(dir.path() / "on" / "impacts.csv"));
   EXPECT_TRUE(contains(readFile(dir.path() / "on" / "summary.json"), "\"contact_rows\": ")) << readFile(dir.path() / "on" / "summary.json");
+}
+
+// gem info's columns fit the longest name: a plugin's event of 25 characters
+// (tests/plugins/spin_up.cpp) once pushed its own row's columns out of line with the others.
+TEST(PluginInfo, TheColumnsFitTheLongestName) {
+  TempDir dir;
+  const fs::path log = dir.path() / "log.txt";
+  ASSERT_EQ(gem::test::runGem("info --plugin " + plugin("spin_up"), log), 0) << readFile(log);
+  std::istringstream lines(readFile(log));
+  std::string line;
+  std::map<std::string, size_t> column;  // where the phase (or origin, or version) column starts, by row
+  size_t fromColumn = 0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("  ", 0) != 0) continue;
+    const size_t nameEnd = line.find(' ', 2);
+    const std::string name = line.substr(2, nameEnd - 2);
+    if (name.empty()) {
+      fromColumn = line.find("from ");  // the plugin's origin, under the name column's end
+      continue;
+    }
+    column[name] = line.find_first_not_of(' ', nameEnd);
+  }
+  ASSERT_TRUE(column.count("spin_past_any_finite_rate")) << readFile(log);
+  for (const char* other : {"drag", "motion", "all_pairs", "triangulation_mesh", "spin_up"}) {
+    ASSERT_TRUE(column.count(other)) << other << ": " << readFile(log);
+    EXPECT_EQ(column[other], column["spin_past_any_finite_rate"]) << other << ": " << readFile(log);
+  }
+  EXPECT_EQ(fromColumn, column["drag"]) << readFile(log);
 }
 
 // A plugin event's parameter without a default: asked for when the event is on, not when a scenario

@@ -205,8 +205,8 @@ int commandCheck(const RunArguments& a) {
 
 // An entry's origin: "built-in", or for a plugin's "PATH (NAME VERSION)" on a line of its own.
 std::string originColumn(const std::string& origin) { return origin == "built-in" ? origin : "plugin"; }
-void printPluginOrigin(const std::string& origin) {
-  if (origin != "built-in") std::printf("  %-18s from %s\n", "", origin.c_str());
+void printPluginOrigin(const std::string& origin, size_t nameWidth) {
+  if (origin != "built-in") std::printf("%s\n", fmt::format("  {:<{}} from {}", "", nameWidth, origin).c_str());
 }
 
 int commandInfo(const std::vector<std::string>& plugins) {
@@ -221,21 +221,29 @@ int commandInfo(const std::vector<std::string>& plugins) {
   std::printf("sweeps across MPI ranks: %s\n", mpiBuilt() ? "yes" : "no (built without MPI)");
   std::printf("devices: cpu");
   if (cuda) std::printf(", %s", cuda->available() ? cuda->deviceName().c_str() : "no CUDA device found");
+  // The name column fits the longest name of the three lists (a plugin's may be long), 18 at least,
+  // so that every list's columns line up.
+  const std::vector<LoadedPlugin> loaded = loadedPlugins();
+  size_t width = 18;
+  for (const EventEntry* e : Registry::global().events()) width = std::max(width, e->name.size());
+  for (const BroadphaseEntry* b : Registry::global().broadphases()) width = std::max(width, b->name.size());
+  for (const LoadedPlugin& p : loaded) width = std::max(width, p.name.size());
   // In the order the drivers run them: by phase, then each event's declared order (docs/plugins.md "Order").
   std::printf("\n\nevents, in the order they run (phase, order, default, origin):\n");
   for (const EventEntry* e : Registry::global().events()) {
-    std::printf("  %-18s %-9s %-5d %-4s %-9s %s\n", e->name.c_str(), eventPhaseName(e->phase), e->order, e->enabledByDefault ? "on" : "off",
-                originColumn(e->origin).c_str(), e->description.c_str());
-    printPluginOrigin(e->origin);
+    std::printf("%s\n", fmt::format("  {:<{}} {:<9} {:<5} {:<4} {:<9} {}", e->name, width, eventPhaseName(e->phase), e->order,
+                                    e->enabledByDefault ? "on" : "off", originColumn(e->origin), e->description)
+                            .c_str());
+    printPluginOrigin(e->origin, width);
   }
   std::printf("\nbroadphases (origin):\n");
   for (const BroadphaseEntry* b : Registry::global().broadphases()) {
-    std::printf("  %-18s %-9s %s\n", b->name.c_str(), originColumn(b->origin).c_str(), b->description.c_str());
-    printPluginOrigin(b->origin);
+    std::printf("%s\n", fmt::format("  {:<{}} {:<9} {}", b->name, width, originColumn(b->origin), b->description).c_str());
+    printPluginOrigin(b->origin, width);
   }
-  const std::vector<LoadedPlugin> loaded = loadedPlugins();
   std::printf("\nplugins loaded: %s\n", loaded.empty() ? "none (GEM_PLUGIN_PATH, [[plugins]] or gem info --plugin PATH)" : "");
-  for (const LoadedPlugin& p : loaded) std::printf("  %-18s %-9s %s\n", p.name.c_str(), p.version.c_str(), p.path.c_str());
+  for (const LoadedPlugin& p : loaded)
+    std::printf("%s\n", fmt::format("  {:<{}} {:<9} {}", p.name, width, p.version, p.path.string()).c_str());
   return 0;
 }
 
