@@ -228,6 +228,36 @@ TEST(GemRun, ANonFiniteStateStopsTheRunNamingTheBodyAndStep) {
   EXPECT_EQ(series.find("inf"), std::string::npos) << series;
 }
 
+// Every input error is found before gem run announces the run: a bad event parameter (read when
+// the run builds its events) once came after the "gem run ...: N steps" line. The failed start
+// prints the error alone; a good one prints the line first.
+TEST(GemRun, AnInputErrorComesBeforeTheRunAnnouncesItself) {
+  test::TempDir dir;
+  const std::string base =
+      "[simulation]\ndt = 0.1\nsteps = 3\n[[floes]]\nvertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\n";
+  const auto bad = dir.write("bad.toml", base + "[events.drag]\ncd = -1.0\n");
+  const auto stdoutFile = dir.path() / "stdout", stderrFile = dir.path() / "stderr";
+  const std::string gem = std::string(std::getenv("GEM_BINARY_DIR") ? std::getenv("GEM_BINARY_DIR") : GEM_BINARY_DIR) + "/gem";
+  auto run = [&](const std::filesystem::path& scenario, const std::string& out) {
+    const int status = std::system((gem + " run " + scenario.string() + " --no-plots --out " + (dir.path() / out).string() + " > " +
+                                    stdoutFile.string() + " 2> " + stderrFile.string())
+                                       .c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  EXPECT_EQ(run(bad, "bad"), 2);
+  EXPECT_EQ(test::readFile(stdoutFile), "") << "printed before the error";
+  EXPECT_NE(test::readFile(stderrFile).find("events.drag.cd"), std::string::npos) << test::readFile(stderrFile);
+  // A run folder that cannot be made is input too, checked before the line.
+  const auto blocked = dir.write("a_file", "x");
+  const auto good = dir.write("good.toml", base);
+  EXPECT_EQ(run(good, "a_file/run"), 2);
+  EXPECT_EQ(test::readFile(stdoutFile), "") << "printed before the error";
+  EXPECT_EQ(run(good, "good"), 0) << test::readFile(stderrFile);
+  EXPECT_EQ(
+      test::readFile(stdoutFile).rfind("gem run " + good.string() + ": 3 steps of 0.1 s, backend cpu, broadphase variable_radius\n", 0), 0u)
+      << test::readFile(stdoutFile);
+}
+
 // One run writes into a run folder at a time: while another process holds the folder's lock, gem
 // run is refused (exit 2, naming the folder); once it is free the run goes ahead and leaves no lock.
 TEST(GemRun, ARunFolderInUseIsRefused) {

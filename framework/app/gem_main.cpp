@@ -158,13 +158,15 @@ int commandRun(const RunArguments& a) {
   options.quiet = a.quiet;
   options.progress = isatty(fileno(stderr));
   RunLog log(a.commandLine, a.quiet);
-  if (resume) {
-    log.continueFrom(s.output.dir);
-    log.say(fmt::format("gem run --resume {}: from its checkpoint to step {}", a.resume, s.steps));
-  } else {
-    log.say(fmt::format("gem run {}: {} steps of {:.3g} s, backend {}, broadphase {}", a.scenario, s.steps, static_cast<double>(s.dt),
-                        resolveBackend(s.backend), s.broadphase));
-  }
+  if (resume) log.continueFrom(s.output.dir);
+  // The run announces itself once its input is all checked (runSteps calls this before its first step).
+  options.started = [&](Stepper& sim) {
+    if (resume)
+      log.say(fmt::format("gem run --resume {}: from its checkpoint to step {}", a.resume, s.steps));
+    else
+      log.say(fmt::format("gem run {}: {} steps of {:.3g} s, backend {}, broadphase {}", a.scenario, s.steps, static_cast<double>(s.dt),
+                          sim.backend(), s.broadphase));
+  };
   try {
     const RunSummary r = resume ? resumeScenario(s, options) : runScenario(s, options);
     log.note(fmt::format("  device         {} ({} driver)", r.device, r.driver));

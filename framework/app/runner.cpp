@@ -477,6 +477,7 @@ namespace {
 RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const std::string* checkpoint) {
   const std::unique_ptr<Stepper> stepper = makeStepper(scenario);  // bad input throws here, before anything is written
   ScenarioRun run(scenario, *stepper, checkpoint);
+  if (options.started) options.started(*stepper);
   Stepper& sim = *stepper;
   const auto start = std::chrono::steady_clock::now();
   auto lastProgress = start;
