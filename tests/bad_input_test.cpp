@@ -97,6 +97,10 @@ std::vector<BadCase> badCases() {
       {"walls_too_thick", kSim + kDomain + "walls = true\nwall_thickness = 1e308\n", {"domain.wall_thickness", "at most"}},
       {"nul_in_output_dir", kSim + "[output]\ndir = \"a\\u0000b\"\n", {"output.dir", "NUL"}},
       {"empty_hull", kSim + "[vessel]\nvertices = []\nframe_angle_deg = []\n", {"vessel.vertices", "at least 3 vertices, got 0"}},
+      // Scenario keys that name a file or folder: "" once meant the default, or the scenario's folder.
+      {"empty_output_dir", kSim + "[output]\ndir = \"\"\n", {"output.dir", "an empty path", ":5:"}},
+      {"empty_field_file", kSim + "[field]\nkind = \"file\"\nfile = \"\"\n", {"field.file", "an empty path", ":6:"}},
+      {"empty_plugin_path", kSim + "[[plugins]]\npath = \"\"\n", {"plugins.path", "an empty path", ":5:"}},
   };
 }
 
@@ -360,4 +364,46 @@ TEST(BadInputCli, AFileTooLargeToReadIsRefusedNamingItsSize) {
   std::filesystem::resize_file(run / "impacts.csv", std::uintmax_t(200) << 30);
   EXPECT_EQ(gem::test::runGem("analyze --quiet " + run.string(), log), 2);
   EXPECT_NE(gem::test::readFile(log).find("impacts.csv: 215 GB, too large to read"), std::string::npos) << gem::test::readFile(log);
+}
+
+// An empty value of any option or argument that names a file or folder is refused, naming the
+// option, before any work: `gem run --out ''` once ran into the scenario's own output folder.
+TEST(BadInputCli, AnEmptyPathOptionIsRefusedNamingTheOption) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  const auto good = dir.write("good.toml", kSim + "[output]\ndir = \"default_run\"\n");
+  dir.write("base.toml", kSim);
+  const auto sweepFile = dir.write("study.toml", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n");
+  const std::string folder = dir.path().string();
+  const struct {
+    std::string arguments, option;
+  } cases[] = {
+      {"run " + good.string() + " --quiet --out ''", "--out"},
+      {"run ''", "scenario"},
+      {"run --resume ''", "--resume"},
+      {"check ''", "scenario"},
+      {"info --plugin ''", "--plugin"},
+      {"bench --cases 100 --steps 10 --csv ''", "--csv"},
+      {"calibrate ''", "scenario"},
+      {"calibrate --out ''", "--out"},
+      {"sweep ''", "sweep"},
+      {"sweep " + sweepFile.string() + " --quiet --out ''", "--out"},
+      {"analyze ''", "dir"},
+      {"plot ''", "dir"},
+      {"movie ''", "dir"},
+      {"movie " + folder + " --out ''", "--out"},
+      {"view ''", "dir"},
+      {"view " + folder + " --out ''", "--out"},
+  };
+  for (const auto& c : cases) {
+    EXPECT_EQ(gem::test::runGem(c.arguments, log), 2) << c.arguments;
+    const std::string text = gem::test::readFile(log);
+    EXPECT_EQ(text.rfind(c.option + ": an empty path", 0), 0u) << c.arguments << ": " << text;
+    EXPECT_LT(text.size(), 200u) << c.arguments << ": " << text;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "default_run")) << "gem run --out '' ran into output.dir";
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "runs")) << "gem sweep --out '' ran into runs/NAME";
+  // A name that stands for a scenario key, given empty, was ignored the same way.
+  EXPECT_EQ(gem::test::runGem("check " + good.string() + " --backend ''", log), 2);
+  EXPECT_EQ(gem::test::readFile(log).rfind("--backend: an empty value", 0), 0u) << gem::test::readFile(log);
 }

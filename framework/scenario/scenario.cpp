@@ -104,7 +104,7 @@ void checkFieldMemory(const Scenario& s) {
 void readField(TableReader& t, Scenario& s) {
   s.fieldKind = t.getChoice("kind", "random_convex", {"random_convex", "hexagons", "file"});
   if (s.fieldKind == "file") {
-    const std::string file = t.getString("file", "");
+    const std::string file = t.getPath("file", "");
     if (file.empty()) t.fail("file", "kind = \"file\" needs file = \"path/to/field.ice\"");
     s.fieldFile = fs::path(file).is_absolute() ? fs::path(file) : s.file.parent_path() / file;
     t.finish();
@@ -261,7 +261,7 @@ void readCheckpointEvery(TableReader& t, OutputSpec& o) {
 
 void readOutput(TableReader& t, Scenario& s) {
   OutputSpec& o = s.output;
-  const std::string dir = t.getString("dir", "");
+  const std::string dir = t.getPath("dir", "");
   if (!dir.empty()) o.dir = fs::path(dir).is_absolute() ? fs::path(dir) : s.file.parent_path() / dir;
   o.frameEvery = static_cast<int>(t.getInt("frame_every", o.frameEvery, 0, 1000000000));
   o.timeseriesEvery = static_cast<int>(t.getInt("timeseries_every", o.timeseriesEvery, 1, 1000000000));
@@ -295,7 +295,11 @@ void readPlugins(const toml::array& plugins, TableReader& top, Scenario& s) {
     TableReader t(pt, "plugins", s.fileName);
     PluginSpec spec;
     if (!t.has("path")) t.failAt(p, "plugins: each [[plugins]] needs a path = \"...\" (to the plugin's .so)");
-    spec.path = t.getString("path", "");
+    spec.path = t.getPath("path", "");
+    if (spec.path.empty()) {  // refused (an empty path): it would name the scenario's folder
+      t.finish();
+      continue;
+    }
     // Read as "plugins" (the messages name no index), so its default is recorded here by index.
     if (DefaultsRecorder* recorder = DefaultsRecorder::active(); recorder && !t.has("override"))
       recorder->record(fmt::format("plugins[{}].override", k), false);
