@@ -241,6 +241,18 @@ std::string TableReader::getPath(const std::string& key, const std::string& fall
   return v;
 }
 
+Real TableReader::getRealIn(const std::string& key, Real fallback, Real min, Real max) {
+  Real v = getReal(key, fallback);
+  if (!(v >= min && v <= max)) report(key, fmt::format("must be from {:g} to {:g}, got {:g}", min, max, v)), v = fallback;
+  return v;
+}
+
+Real TableReader::getPositive(const std::string& key, Real fallback, Real most) {
+  Real v = getReal(key, fallback);
+  if (!(v > 0 && v <= most)) report(key, fmt::format("must be positive and at most {:g}, got {:g}", most, v)), v = fallback;
+  return v;
+}
+
 std::string TableReader::getChoice(const std::string& key, const std::string& fallback, const std::vector<std::string>& choices) {
   std::string v = getString(key, fallback);
   for (const auto& c : choices)
