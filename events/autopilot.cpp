@@ -12,16 +12,19 @@ static Autopilot::Params parseAutopilot(EventConfig& config) {
   TableReader& t = config.params;
   const VesselSpec& v = config.scenario.vessel;
   Autopilot::Params p{};
-  p.setHeading = t.getReal("heading_deg", v.headingDeg) * kPi / 180;
+  // Ranges that keep the first step finite (docs/scenario.md 2.6); the default gains, from the
+  // vessel's ranges and these, stay well inside theirs.
+  p.setHeading = t.getRealIn("heading_deg", v.headingDeg, -360, 360) * kPi / 180;
   p.trackPoint = v.position;
   p.mass = v.mass;
   p.yawInertia = v.mass * vesselYawGyration2(v.length);
-  const Real period = t.getPositive("period", 30);
+  const Real period = t.getRealIn("period", 30, Real(0.01), 1e6);
   const Real w = 2 * kPi / period;
-  p.g1 = t.getNonNegative("g1", p.yawInertia * w * w);
-  p.g2 = t.getNonNegative("g2", 2 * p.yawInertia * w);
-  p.g3 = t.getNonNegative("g3", p.mass * w * w);
-  p.g4 = t.getNonNegative("g4", 2 * p.mass * w);
+  constexpr Real kMostGain = Real(1e30);
+  p.g1 = t.getRealIn("g1", p.yawInertia * w * w, 0, kMostGain);
+  p.g2 = t.getRealIn("g2", 2 * p.yawInertia * w, 0, kMostGain);
+  p.g3 = t.getRealIn("g3", p.mass * w * w, 0, kMostGain);
+  p.g4 = t.getRealIn("g4", 2 * p.mass * w, 0, kMostGain);
   return p;
 }
 

@@ -9,10 +9,11 @@ namespace gem {
 static Drag::Params parseDrag(EventConfig& config) {
   TableReader& t = config.params;
   Drag::Params p{};
-  p.cd = t.getNonNegative("cd", Real(0.05));
-  p.rhoWater = t.getPositive("rho_water", kRhoWater);
-  p.rotationLength = t.getNonNegative("rotation_length", 1);
-  p.linear = t.getNonNegative("linear", 0);
+  // Ranges far beyond any sea (docs/scenario.md 2.6), that keep the first step finite.
+  p.cd = t.getRealIn("cd", Real(0.05), 0, 10);
+  p.rhoWater = t.getPositive("rho_water", kRhoWater, 1e4);
+  p.rotationLength = t.getRealIn("rotation_length", 1, 0, 1e4);
+  p.linear = t.getRealIn("linear", 0, 0, 1e4);
   p.isotropic = t.getChoice("form", "component", {"component", "isotropic"}) == "isotropic";
   return p;
 }

@@ -10,14 +10,16 @@ namespace gem {
 // drag_coefficient, density.
 inline EnvironmentalForce::Params parseEnvironmentalForce(TableReader& t, Real density, Real coefficient, Real relative) {
   EnvironmentalForce::Params p{};
-  const Real force = t.getReal("force", 0);
-  const Real direction = t.getReal("direction_deg", 0) * kPi / 180;
-  const Real speed = t.getNonNegative("speed", 0);
-  const Real speedDirection = t.getReal("speed_direction_deg", direction * 180 / kPi) * kPi / 180;
+  // Ranges far beyond any sea or sky (docs/scenario.md 2.6), that keep the first step finite.
+  const Real force = t.getRealIn("force", 0, -1e4, 1e4);
+  const Real directionDeg = t.getRealIn("direction_deg", 0, -360, 360);
+  const Real direction = directionDeg * kPi / 180;
+  const Real speed = t.getRealIn("speed", 0, 0, 100);
+  const Real speedDirection = t.getRealIn("speed_direction_deg", directionDeg, -360, 360) * kPi / 180;
   p.stress = {force * std::cos(direction), force * std::sin(direction)};
   p.flowVelocity = {speed * std::cos(speedDirection), speed * std::sin(speedDirection)};
-  p.density = t.getPositive("density", density);
-  p.coefficient = t.getNonNegative("drag_coefficient", coefficient);
+  p.density = t.getPositive("density", density, 1e4);
+  p.coefficient = t.getRealIn("drag_coefficient", coefficient, 0, 10);
   p.relative = relative;
   return p;
 }

@@ -16,6 +16,7 @@ struct BadCase {
   std::string toml;
   std::vector<std::string> expected;  // substrings of the message
   std::string file = "case.toml";     // the file the message must name
+  std::vector<std::string> absent{};  // substrings it must not hold (a key it once blamed wrongly)
 };
 void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
 
@@ -46,7 +47,7 @@ std::vector<BadCase> badCases() {
       {"zero_thickness", kSim + floe(kSquare, "thickness = 0.0\n").replace(kSim.size() + floe(kSquare).size() - 16, 16, ""), {"thickness"}},
       {"negative_dt", "[simulation]\ndt = -0.1\n", {"simulation.dt", "positive"}},
       {"zero_duration", "[simulation]\nduration = 0.0\n", {"simulation.duration", "positive"}},
-      {"zero_mass", kSim + "[vessel]\nmass = 0.0\n", {"vessel.mass", "positive"}},
+      {"zero_mass", kSim + "[vessel]\nmass = 0.0\n", {"vessel.mass", "from 1 to 1e+12"}},
       {"overlap",
        kSim + floe(kSquare) + floe("[[5.0, 5.0], [15.0, 5.0], [15.0, 15.0], [5.0, 15.0]]"),
        {"overlap at the start", "floes[0]", "floes[1]"}},
@@ -89,7 +90,7 @@ std::vector<BadCase> badCases() {
        {"field: about", "floes", "GB"}},
       {"duration_below_one_step", "[simulation]\ndt = 0.1\nduration = 0.01\n", {"simulation.duration", "shorter than one step"}},
       // Values whose derived quantities overflow (the second hostile audit): refused, naming the key.
-      {"huge_dt_makes_the_time_infinite", "[simulation]\ndt = 1e308\nsteps = 5\n", {"simulation.dt", "not a finite time", ":2:"}},
+      {"huge_dt_makes_the_time_infinite", "[simulation]\ndt = 1e308\nsteps = 5\n", {"simulation.dt", "at most 3600", ":2:"}},
       {"huge_thickness_makes_the_mass_infinite",
        kSim + floe(kSquare).replace(floe(kSquare).find("1.0"), 3, "1e308"),
        {"floes[0]", "mass", "not a finite number"}},
@@ -97,6 +98,60 @@ std::vector<BadCase> badCases() {
       {"walls_too_thick", kSim + kDomain + "walls = true\nwall_thickness = 1e308\n", {"domain.wall_thickness", "at most"}},
       {"nul_in_output_dir", kSim + "[output]\ndir = \"a\\u0000b\"\n", {"output.dir", "NUL"}},
       {"empty_hull", kSim + "[vessel]\nvertices = []\nframe_angle_deg = []\n", {"vessel.vertices", "at least 3 vertices, got 0"}},
+      // Values that passed gem check and made gem run fail at step 1 with a non-finite state (the
+      // third hostile audit): each refused at load by its own key, line and range.
+      {"vessel_heading_beyond_a_turn", kSim + "[vessel]\nheading_deg = 1e308\n", {"vessel.heading_deg", "from -360 to 360", ":5:"}},
+      {"vessel_speed_beyond_any_ship", kSim + "[vessel]\nspeed = 1e308\n", {"vessel.speed", "from 0 to 100", ":5:"}},
+      {"vessel_thrust_beyond_any_ship", kSim + "[vessel]\nbollard_thrust = 1e300\n", {"vessel.bollard_thrust", "from 0 to 1e+08"}},
+      {"open_water_speed_near_zero", kSim + "[vessel]\nopen_water_speed = 1e-300\n", {"vessel.open_water_speed", "from 0.01"}},
+      {"vessel_mass_beyond_any_ship", kSim + "[vessel]\nmass = 1e-300\n", {"vessel.mass", "from 1 to 1e+12"}},
+      {"autopilot_period_near_zero",
+       kSim + "[vessel]\ndof = 3\n[events.autopilot]\nperiod = 1e-300\n",
+       {"events.autopilot.period", "from 0.01", ":7:"},
+       "case.toml",
+       {"g1"}},
+      {"autopilot_gain_beyond_any",
+       kSim + "[vessel]\ndof = 3\n[events.autopilot]\ng1 = 1e308\n",
+       {"events.autopilot.g1", "from 0 to 1e+30"}},
+      {"autopilot_heading_beyond_a_turn",
+       kSim + "[vessel]\ndof = 3\n[events.autopilot]\nheading_deg = -1e308\n",
+       {"events.autopilot.heading_deg", "from -360 to 360"}},
+      {"wind_force_beyond_any_sky", kSim + "[events.wind]\nforce = 1e308\n", {"events.wind.force", "from -10000 to 10000"}},
+      {"current_direction_beyond_a_turn", kSim + "[events.current]\ndirection_deg = 1e308\n", {"events.current.direction_deg"}},
+      {"drag_coefficient_beyond_any_sea", kSim + "[events.drag]\ncd = 1e308\n", {"events.drag.cd", "from 0 to 10"}},
+      {"floe_velocity_beyond_any_floe",
+       kSim + floe(kSquare, "velocity = [1e300, 0.0]\n"),
+       {"floes[0].velocity", "within +-100 m/s", ":7:"}},
+      {"floe_spin_beyond_any_floe", kSim + floe(kSquare, "angular_velocity = 1e300\n"), {"floes[0].angular_velocity", "from -100 to 100"}},
+      {"ice_file_spin_beyond_any_floe",
+       kSim + "[field]\nkind = \"file\"\nfile = \"spin.ice\"\n",
+       {"spin.ice object 0", "angular velocity must be within +-100 rad/s"},
+       "spin.ice"},
+      // The hull's own keys are named, not the polygon drawn from them (vessel.vertices was blamed).
+      {"vessel_length_beyond_any_ship",
+       kSim + "[vessel]\nlength = 1e308\n",
+       {"vessel.length", "from 0.1 to 10000", ":5:"},
+       "case.toml",
+       {"vertices"}},
+      {"vessel_beam_below_any_ship",
+       kSim + "[vessel]\nbeam = 1e-308\n",
+       {"vessel.beam", "from 0.1 to 10000", ":5:"},
+       "case.toml",
+       {"vertices"}},
+      {"vessel_draft_beyond_any_ship", kSim + "[vessel]\ndraft = 1e308\n", {"vessel.draft", "at most 1000"}, "case.toml", {"vertices"}},
+      {"vessel_position_beyond_any_field",
+       kSim + "[vessel]\nposition = [1e308, 0.0]\n",
+       {"vessel.position", "within +-1e+07 m"},
+       "case.toml",
+       {"vertices"}},
+      {"hull_vertex_beyond_any_ship",
+       kSim +
+           "[vessel]\nvertices = [[-1e300, -10.0], [50.0, -10.0], [50.0, 10.0], [-50.0, 10.0]]\nframe_angle_deg = [0.0, 0.0, 0.0, 0.0]\n",
+       {"vessel.vertices", "within +-10000 m"}},
+      // Scenario keys that name a file or folder: "" once meant the default, or the scenario's folder.
+      {"empty_output_dir", kSim + "[output]\ndir = \"\"\n", {"output.dir", "an empty path", ":5:"}},
+      {"empty_field_file", kSim + "[field]\nkind = \"file\"\nfile = \"\"\n", {"field.file", "an empty path", ":6:"}},
+      {"empty_plugin_path", kSim + "[[plugins]]\npath = \"\"\n", {"plugins.path", "an empty path", ":5:"}},
   };
 }
 
@@ -110,6 +165,9 @@ TEST_P(BadInput, ExitsWithStatus2AndAClearMessageAndWritesNoSummary) {
   dir.write(
       "bad.ice",
       "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 1 0</coordinates\n</frame></iceFloeSim>\n");
+  dir.write("spin.ice",
+            "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 10 0 10 10 0 10</coordinates>"
+            "<velocity x=\"0\" y=\"0\" a=\"1e300\"/><thickness>1</thickness></object>\n</frame></iceFloeSim>\n");
   const auto scenario = dir.write("case.toml", c.toml);
   const auto out = dir.path() / "run";
   for (const char* command : {"run", "check"}) {
@@ -121,6 +179,7 @@ TEST_P(BadInput, ExitsWithStatus2AndAClearMessageAndWritesNoSummary) {
     EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << "one message: " << log;
     EXPECT_NE(log.find(c.file), std::string::npos) << "names the file: " << log;
     for (const std::string& e : c.expected) EXPECT_NE(log.find(e), std::string::npos) << "missing \"" << e << "\" in: " << log;
+    for (const std::string& e : c.absent) EXPECT_EQ(log.find(e), std::string::npos) << "blames \"" << e << "\": " << log;
     EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
   }
 }
@@ -218,17 +277,17 @@ TEST(BadInputCli, ANumericOptionOutOfRangeNamesItsRange) {
   }
 }
 
-// A default worked out from other values that overflows (the autopilot's gains from a vessel of
-// 1e308 kg) is refused naming each key, instead of running as inf into a scenario.toml that does
-// not load; and a --set whose value holds a newline cannot slip a second key in unseen.
-TEST(BadInputCli, DerivedDefaultsThatOverflowAndSetValuesOfTwoLinesAreRefused) {
+// A vessel of 1e308 kg is refused by its own key and range (it once got as far as the autopilot's
+// gains worked out from it, inf, and named those); and a --set whose value holds a newline cannot
+// slip a second key in unseen.
+TEST(BadInputCli, ValuesBeyondTheirRangeAndSetValuesOfTwoLinesAreRefused) {
   TempDir dir;
   const auto log = dir.path() / "log.txt";
   const auto heavy = dir.write("heavy.toml", kSim + "[vessel]\nmass = 1e308\n");
   EXPECT_EQ(gem::test::runGem("run " + heavy.string() + " --quiet --out " + (dir.path() / "out").string(), log), 2);
   std::string text = gem::test::readFile(log);
-  EXPECT_NE(text.find("heavy.toml: events.autopilot.g1: its default"), std::string::npos) << text;
-  EXPECT_NE(text.find("not a finite number"), std::string::npos) << text;
+  EXPECT_NE(text.find("heavy.toml:5:8: vessel.mass: must be from 1 to 1e+12"), std::string::npos) << text;
+  EXPECT_EQ(text.find("autopilot"), std::string::npos) << text;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "summary.json"));
   const auto good = dir.write("good.toml", kSim);
   EXPECT_EQ(gem::test::runGem("check " + good.string() + " --set \"$(printf 'simulation.dt=0.5\\nbogus_key=3')\"", log), 2);
@@ -360,4 +419,46 @@ TEST(BadInputCli, AFileTooLargeToReadIsRefusedNamingItsSize) {
   std::filesystem::resize_file(run / "impacts.csv", std::uintmax_t(200) << 30);
   EXPECT_EQ(gem::test::runGem("analyze --quiet " + run.string(), log), 2);
   EXPECT_NE(gem::test::readFile(log).find("impacts.csv: 215 GB, too large to read"), std::string::npos) << gem::test::readFile(log);
+}
+
+// An empty value of any option or argument that names a file or folder is refused, naming the
+// option, before any work: `gem run --out ''` once ran into the scenario's own output folder.
+TEST(BadInputCli, AnEmptyPathOptionIsRefusedNamingTheOption) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  const auto good = dir.write("good.toml", kSim + "[output]\ndir = \"default_run\"\n");
+  dir.write("base.toml", kSim);
+  const auto sweepFile = dir.write("study.toml", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n");
+  const std::string folder = dir.path().string();
+  const struct {
+    std::string arguments, option;
+  } cases[] = {
+      {"run " + good.string() + " --quiet --out ''", "--out"},
+      {"run ''", "scenario"},
+      {"run --resume ''", "--resume"},
+      {"check ''", "scenario"},
+      {"info --plugin ''", "--plugin"},
+      {"bench --cases 100 --steps 10 --csv ''", "--csv"},
+      {"calibrate ''", "scenario"},
+      {"calibrate --out ''", "--out"},
+      {"sweep ''", "sweep"},
+      {"sweep " + sweepFile.string() + " --quiet --out ''", "--out"},
+      {"analyze ''", "dir"},
+      {"plot ''", "dir"},
+      {"movie ''", "dir"},
+      {"movie " + folder + " --out ''", "--out"},
+      {"view ''", "dir"},
+      {"view " + folder + " --out ''", "--out"},
+  };
+  for (const auto& c : cases) {
+    EXPECT_EQ(gem::test::runGem(c.arguments, log), 2) << c.arguments;
+    const std::string text = gem::test::readFile(log);
+    EXPECT_EQ(text.rfind(c.option + ": an empty path", 0), 0u) << c.arguments << ": " << text;
+    EXPECT_LT(text.size(), 200u) << c.arguments << ": " << text;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "default_run")) << "gem run --out '' ran into output.dir";
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "runs")) << "gem sweep --out '' ran into runs/NAME";
+  // A name that stands for a scenario key, given empty, was ignored the same way.
+  EXPECT_EQ(gem::test::runGem("check " + good.string() + " --backend ''", log), 2);
+  EXPECT_EQ(gem::test::readFile(log).rfind("--backend: an empty value", 0), 0u) << gem::test::readFile(log);
 }

@@ -208,24 +208,85 @@ TEST(GemRun, AnIceFieldWithWallsHasUniqueIds) {
   EXPECT_EQ(ids, (std::set<long>{0, 1, 2, 3}));  // the floes 0 and 1 as in the file, then the walls
 }
 
-// A state that is no longer finite stops the run: exit 1, the body and the step named, what was
-// written kept whole (no NaN in any file), and no summary.json.
+// A state that is no longer finite stops the run: exit 1, the body and the step named with its
+// whole state (an infinite angular velocity once showed only the finite x, y, vx, vy), what was
+// written kept whole (no NaN in any file), and no summary.json. The test plugin spins every floe
+// infinitely from step 4 on (tests/plugins/spin_up.cpp): no scenario value within its range does.
+// gem check takes only the first step, which is finite, and passes it.
 TEST(GemRun, ANonFiniteStateStopsTheRunNamingTheBodyAndStep) {
   test::TempDir dir;
-  const auto scenario = dir.write("fast.toml",
+  const auto scenario = dir.write("spin.toml",
                                   "[simulation]\ndt = 0.1\nsteps = 50\n[[floes]]\n"
-                                  "vertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\nvelocity = [1e300, 0.0]\n");
+                                  "vertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\nvelocity = [1.0, 0.0]\n"
+                                  "[[plugins]]\npath = \"" GEM_TEST_PLUGIN_DIR
+                                  "/libspin_up.so\"\n"
+                                  "[events.spin_past_any_finite_rate]\nat_step = 3\n");
   const auto out = dir.path() / "out";
+  EXPECT_EQ(test::runGem("check " + scenario.string() + " --quiet", dir.path() / "check.log"), 0)
+      << test::readFile(dir.path() / "check.log");
   EXPECT_EQ(test::runGem("run " + scenario.string() + " --quiet --out " + out.string(), dir.path() / "log"), 1);
   const std::string log = test::readFile(dir.path() / "log");
-  EXPECT_NE(log.find("body 0 (floe)"), std::string::npos) << log;
-  EXPECT_NE(log.find("no longer finite"), std::string::npos) << log;
-  EXPECT_NE(log.find("step "), std::string::npos) << log;
+  EXPECT_NE(log.find("step 4 (t = 0.4 s): body 0 (floe) has a state that is no longer finite (x "), std::string::npos) << log;
+  EXPECT_NE(log.find(", omega inf); the run stops here"), std::string::npos) << log;
+  EXPECT_NE(log.find("angle inf"), std::string::npos) << log;
   EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
   const std::string series = test::readFile(out / "timeseries.csv");
   EXPECT_EQ(series.rfind("t,", 0), 0u) << series;
+  EXPECT_EQ(std::count(series.begin(), series.end(), '\n'), 1 + 3) << series;  // header + steps 1..3
   EXPECT_EQ(series.find("nan"), std::string::npos) << series;
   EXPECT_EQ(series.find("inf"), std::string::npos) << series;
+}
+
+// gem check takes one CPU step of the world it built: a scenario whose first step is not finite
+// (here a plugin's event, which no range of GEM's can bound) is refused with exit 2 and the words
+// gem run stops with, where it once said "ok" and gem run failed at step 1. It writes nothing.
+TEST(GemCheck, AFirstStepThatIsNotFiniteIsRefusedWithTheWordsOfGemRun) {
+  test::TempDir dir;
+  const auto scenario = dir.write("spin.toml",
+                                  "[simulation]\ndt = 0.1\nsteps = 50\n[[floes]]\n"
+                                  "vertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\n"
+                                  "[[plugins]]\npath = \"" GEM_TEST_PLUGIN_DIR
+                                  "/libspin_up.so\"\n"
+                                  "[events.spin_past_any_finite_rate]\n[output]\ndir = \"out\"\n");
+  EXPECT_EQ(test::runGem("check " + scenario.string(), dir.path() / "check.log"), 2);
+  const std::string check = test::readFile(dir.path() / "check.log");
+  const std::string words =
+      "step 1 (t = 0.1 s): body 0 (floe) has a state that is no longer finite (x 5, y 5, angle inf, vx 0, vy 0, omega inf)";
+  EXPECT_EQ(check, "gem: error: " + scenario.string() + ": " + words + "; gem run stops there\n");
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out")) << "gem check wrote a run folder";
+  EXPECT_EQ(test::runGem("run " + scenario.string() + " --quiet", dir.path() / "run.log"), 1);
+  EXPECT_NE(test::readFile(dir.path() / "run.log").find(words + "; the run stops here"), std::string::npos)
+      << test::readFile(dir.path() / "run.log");
+}
+
+// Every input error is found before gem run announces the run: a bad event parameter (read when
+// the run builds its events) once came after the "gem run ...: N steps" line. The failed start
+// prints the error alone; a good one prints the line first.
+TEST(GemRun, AnInputErrorComesBeforeTheRunAnnouncesItself) {
+  test::TempDir dir;
+  const std::string base =
+      "[simulation]\ndt = 0.1\nsteps = 3\n[[floes]]\nvertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\n";
+  const auto bad = dir.write("bad.toml", base + "[events.drag]\ncd = -1.0\n");
+  const auto stdoutFile = dir.path() / "stdout", stderrFile = dir.path() / "stderr";
+  const std::string gem = std::string(std::getenv("GEM_BINARY_DIR") ? std::getenv("GEM_BINARY_DIR") : GEM_BINARY_DIR) + "/gem";
+  auto run = [&](const std::filesystem::path& scenario, const std::string& out) {
+    const int status = std::system((gem + " run " + scenario.string() + " --no-plots --out " + (dir.path() / out).string() + " > " +
+                                    stdoutFile.string() + " 2> " + stderrFile.string())
+                                       .c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  EXPECT_EQ(run(bad, "bad"), 2);
+  EXPECT_EQ(test::readFile(stdoutFile), "") << "printed before the error";
+  EXPECT_NE(test::readFile(stderrFile).find("events.drag.cd"), std::string::npos) << test::readFile(stderrFile);
+  // A run folder that cannot be made is input too, checked before the line.
+  const auto blocked = dir.write("a_file", "x");
+  const auto good = dir.write("good.toml", base);
+  EXPECT_EQ(run(good, "a_file/run"), 2);
+  EXPECT_EQ(test::readFile(stdoutFile), "") << "printed before the error";
+  EXPECT_EQ(run(good, "good"), 0) << test::readFile(stderrFile);
+  EXPECT_EQ(
+      test::readFile(stdoutFile).rfind("gem run " + good.string() + ": 3 steps of 0.1 s, backend cpu, broadphase variable_radius\n", 0), 0u)
+      << test::readFile(stdoutFile);
 }
 
 // One run writes into a run folder at a time: while another process holds the folder's lock, gem

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -227,6 +228,63 @@ TEST(PluginRecords, APluginsRecordStreamIsWrittenToItsOwnFile) {
   EXPECT_TRUE(contains(summary, "\"contact_rows\": " + std::to_string(rows) + ",")) << summary;
   EXPECT_TRUE(contains(summary, "\"contact_area_m2\": {\"min\"")) << summary;
   EXPECT_TRUE(contains(summary, "\"impacts\": 0,")) << summary;  // ship_impact's stream, no vessel here
+}
+
+// A record file exists only for an event that is on: a disabled event (a plugin's, off by default,
+// or ship_impact turned off) once left a file with its header alone, and its totals in summary.json.
+TEST(PluginRecords, ADisabledEventWritesNoRecordFile) {
+  TempDir dir;
+  const std::string scene =
+      "[simulation]\ndt = 0.1\nsteps = 30\nbroadphase = \"all_pairs\"\n"
+      "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]\nvelocity = [1.0, 0.0]\n"
+      "[[floes]]\nvertices = [[4.5, 0.0], [8.5, 0.0], [8.5, 4.0], [4.5, 4.0]]\n"
+      "[vessel]\nposition = [-80.0, 0.0]\n"
+      "[[plugins]]\npath = \"" +
+      plugin("contact_areas") + "\"\n";
+  const fs::path off =
+                     dir.write("off.toml", scene + "[events.ship_impact]\nenabled = false\n[events.flexural_breaking]\nenabled = false\n"),
+                 on = dir.write("on.toml", scene + "[events.contact_area_log]\nmin_area = 0.0\n");
+  ASSERT_EQ(gem::test::runGem("run " + off.string() + " --quiet --no-plots --out " + (dir.path() / "off").string(), dir.path() / "log"), 0)
+      << readFile(dir.path() / "log");
+  EXPECT_FALSE(fs::exists(dir.path() / "off" / "contact_areas.csv"));
+  EXPECT_FALSE(fs::exists(dir.path() / "off" / "impacts.csv"));
+  const std::string summary = readFile(dir.path() / "off" / "summary.json");
+  EXPECT_FALSE(contains(summary, "contact_rows")) << summary;
+  EXPECT_FALSE(contains(summary, "\"impacts\"")) << summary;
+  // On, each has its file and totals.
+  ASSERT_EQ(gem::test::runGem("run " + on.string() + " --quiet --no-plots --out " + (dir.path() / "on").string(), dir.path() / "log"), 0)
+      << readFile(dir.path() / "log");
+  EXPECT_TRUE(fs::exists(dir.path() / "on" / "contact_areas.csv"));
+  EXPECT_TRUE(fs::exists(dir.path() / "on" / "impacts.csv"));
+  EXPECT_TRUE(contains(readFile(dir.path() / "on" / "summary.json"), "\"contact_rows\": ")) << readFile(dir.path() / "on" / "summary.json");
+}
+
+// gem info's columns fit the longest name: a plugin's event of 25 characters
+// (tests/plugins/spin_up.cpp) once pushed its own row's columns out of line with the others.
+TEST(PluginInfo, TheColumnsFitTheLongestName) {
+  TempDir dir;
+  const fs::path log = dir.path() / "log.txt";
+  ASSERT_EQ(gem::test::runGem("info --plugin " + plugin("spin_up"), log), 0) << readFile(log);
+  std::istringstream lines(readFile(log));
+  std::string line;
+  std::map<std::string, size_t> column;  // where the phase (or origin, or version) column starts, by row
+  size_t fromColumn = 0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("  ", 0) != 0) continue;
+    const size_t nameEnd = line.find(' ', 2);
+    const std::string name = line.substr(2, nameEnd - 2);
+    if (name.empty()) {
+      fromColumn = line.find("from ");  // the plugin's origin, under the name column's end
+      continue;
+    }
+    column[name] = line.find_first_not_of(' ', nameEnd);
+  }
+  ASSERT_TRUE(column.count("spin_past_any_finite_rate")) << readFile(log);
+  for (const char* other : {"drag", "motion", "all_pairs", "triangulation_mesh", "spin_up"}) {
+    ASSERT_TRUE(column.count(other)) << other << ": " << readFile(log);
+    EXPECT_EQ(column[other], column["spin_past_any_finite_rate"]) << other << ": " << readFile(log);
+  }
+  EXPECT_EQ(fromColumn, column["drag"]) << readFile(log);
 }
 
 // A plugin event's parameter without a default: asked for when the event is on, not when a scenario

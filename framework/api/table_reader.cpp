@@ -233,6 +233,26 @@ std::string TableReader::getString(const std::string& key, const std::string& fa
   return *s;
 }
 
+std::string TableReader::getPath(const std::string& key, const std::string& fallback) {
+  const std::string v = getString(key, fallback);
+  const toml::node* n = m_table ? m_table->get(key) : nullptr;
+  if (n && n->value_exact<std::string>() && n->value_exact<std::string>()->empty())
+    return reportAt(*n, fmt::format("{}: an empty path: name a file or folder, or leave the key out", keyPath(key))), fallback;
+  return v;
+}
+
+Real TableReader::getRealIn(const std::string& key, Real fallback, Real min, Real max) {
+  Real v = getReal(key, fallback);
+  if (!(v >= min && v <= max)) report(key, fmt::format("must be from {:g} to {:g}, got {:g}", min, max, v)), v = fallback;
+  return v;
+}
+
+Real TableReader::getPositive(const std::string& key, Real fallback, Real most) {
+  Real v = getReal(key, fallback);
+  if (!(v > 0 && v <= most)) report(key, fmt::format("must be positive and at most {:g}, got {:g}", most, v)), v = fallback;
+  return v;
+}
+
 std::string TableReader::getChoice(const std::string& key, const std::string& fallback, const std::vector<std::string>& choices) {
   std::string v = getString(key, fallback);
   for (const auto& c : choices)

@@ -106,6 +106,13 @@ class TableReader {
   std::int64_t getInt(const std::string& key, std::int64_t fallback, std::int64_t min, std::int64_t max);
   bool getBool(const std::string& key, bool fallback);
   std::string getString(const std::string& key, const std::string& fallback);
+  // A file or folder: as getString, and a value given empty ("") is refused (it would name the
+  // scenario's folder, or silently mean the default).
+  std::string getPath(const std::string& key, const std::string& fallback);
+  // A number from min to max (both finite): "must be from MIN to MAX".
+  Real getRealIn(const std::string& key, Real fallback, Real min, Real max);
+  // > 0 and at most `most`.
+  Real getPositive(const std::string& key, Real fallback, Real most);
   // A string that must be one of `choices`.
   std::string getChoice(const std::string& key, const std::string& fallback, const std::vector<std::string>& choices);
   std::optional<Vec2> findVec2(const std::string& key);

@@ -158,13 +158,15 @@ int commandRun(const RunArguments& a) {
   options.quiet = a.quiet;
   options.progress = isatty(fileno(stderr));
   RunLog log(a.commandLine, a.quiet);
-  if (resume) {
-    log.continueFrom(s.output.dir);
-    log.say(fmt::format("gem run --resume {}: from its checkpoint to step {}", a.resume, s.steps));
-  } else {
-    log.say(fmt::format("gem run {}: {} steps of {:.3g} s, backend {}, broadphase {}", a.scenario, s.steps, static_cast<double>(s.dt),
-                        resolveBackend(s.backend), s.broadphase));
-  }
+  if (resume) log.continueFrom(s.output.dir);
+  // The run announces itself once its input is all checked (runSteps calls this before its first step).
+  options.started = [&](Stepper& sim) {
+    if (resume)
+      log.say(fmt::format("gem run --resume {}: from its checkpoint to step {}", a.resume, s.steps));
+    else
+      log.say(fmt::format("gem run {}: {} steps of {:.3g} s, backend {}, broadphase {}", a.scenario, s.steps, static_cast<double>(s.dt),
+                          sim.backend(), s.broadphase));
+  };
   try {
     const RunSummary r = resume ? resumeScenario(s, options) : runScenario(s, options);
     log.note(fmt::format("  device         {} ({} driver)", r.device, r.driver));
@@ -196,6 +198,12 @@ int commandCheck(const RunArguments& a) {
   const Scenario s = load(a);
   resolveBackend(s.backend);
   CpuStepper sim(s);  // builds the field, checks every body and overlap, parses every event
+  // One step on the CPU, written nowhere: a scenario whose values pass every range but whose first
+  // step is not finite (gem run would stop at step 1) is refused with gem run's words.
+  sim.setDeliverLogs(false);
+  sim.step();
+  const std::string notFinite = nonFiniteState(sim.world(), 1, sim.time());
+  if (!notFinite.empty()) throw InputError(fmt::format("{}: {}; gem run stops there", a.scenario, notFinite));
   if (!a.quiet)
     std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(), sim.world().size(),
                 sim.world().count(BodyKind::Floe), s.vessel.present ? ", a vessel" : "", s.steps, s.broadphase.c_str(),
@@ -205,8 +213,8 @@ int commandCheck(const RunArguments& a) {
 
 // An entry's origin: "built-in", or for a plugin's "PATH (NAME VERSION)" on a line of its own.
 std::string originColumn(const std::string& origin) { return origin == "built-in" ? origin : "plugin"; }
-void printPluginOrigin(const std::string& origin) {
-  if (origin != "built-in") std::printf("  %-18s from %s\n", "", origin.c_str());
+void printPluginOrigin(const std::string& origin, size_t nameWidth) {
+  if (origin != "built-in") std::printf("%s\n", fmt::format("  {:<{}} from {}", "", nameWidth, origin).c_str());
 }
 
 int commandInfo(const std::vector<std::string>& plugins) {
@@ -221,23 +229,42 @@ int commandInfo(const std::vector<std::string>& plugins) {
   std::printf("sweeps across MPI ranks: %s\n", mpiBuilt() ? "yes" : "no (built without MPI)");
   std::printf("devices: cpu");
   if (cuda) std::printf(", %s", cuda->available() ? cuda->deviceName().c_str() : "no CUDA device found");
+  // The name column fits the longest name of the three lists (a plugin's may be long), 18 at least,
+  // so that every list's columns line up.
+  const std::vector<LoadedPlugin> loaded = loadedPlugins();
+  size_t width = 18;
+  for (const EventEntry* e : Registry::global().events()) width = std::max(width, e->name.size());
+  for (const BroadphaseEntry* b : Registry::global().broadphases()) width = std::max(width, b->name.size());
+  for (const LoadedPlugin& p : loaded) width = std::max(width, p.name.size());
   // In the order the drivers run them: by phase, then each event's declared order (docs/plugins.md "Order").
   std::printf("\n\nevents, in the order they run (phase, order, default, origin):\n");
   for (const EventEntry* e : Registry::global().events()) {
-    std::printf("  %-18s %-9s %-5d %-4s %-9s %s\n", e->name.c_str(), eventPhaseName(e->phase), e->order, e->enabledByDefault ? "on" : "off",
-                originColumn(e->origin).c_str(), e->description.c_str());
-    printPluginOrigin(e->origin);
+    std::printf("%s\n", fmt::format("  {:<{}} {:<9} {:<5} {:<4} {:<9} {}", e->name, width, eventPhaseName(e->phase), e->order,
+                                    e->enabledByDefault ? "on" : "off", originColumn(e->origin), e->description)
+                            .c_str());
+    printPluginOrigin(e->origin, width);
   }
   std::printf("\nbroadphases (origin):\n");
   for (const BroadphaseEntry* b : Registry::global().broadphases()) {
-    std::printf("  %-18s %-9s %s\n", b->name.c_str(), originColumn(b->origin).c_str(), b->description.c_str());
-    printPluginOrigin(b->origin);
+    std::printf("%s\n", fmt::format("  {:<{}} {:<9} {}", b->name, width, originColumn(b->origin), b->description).c_str());
+    printPluginOrigin(b->origin, width);
   }
-  const std::vector<LoadedPlugin> loaded = loadedPlugins();
   std::printf("\nplugins loaded: %s\n", loaded.empty() ? "none (GEM_PLUGIN_PATH, [[plugins]] or gem info --plugin PATH)" : "");
-  for (const LoadedPlugin& p : loaded) std::printf("  %-18s %-9s %s\n", p.name.c_str(), p.version.c_str(), p.path.c_str());
+  for (const LoadedPlugin& p : loaded)
+    std::printf("%s\n", fmt::format("  {:<{}} {:<9} {}", p.name, width, p.version, p.path.string()).c_str());
   return 0;
 }
+
+// Every option and argument that names a file or folder refuses an empty value: `--out ''` once
+// meant the default run folder, silently.
+const CLI::Validator kPath(
+    [](const std::string& value) { return value.empty() ? std::string("an empty path: name a file or folder") : std::string(); }, "PATH");
+// The same for a name that stands for a scenario key (--backend ''): empty, it was ignored.
+const CLI::Validator kName(
+    [](const std::string& value) {
+      return value.empty() ? std::string("an empty value: give a name, or leave the option out") : std::string();
+    },
+    "NAME");
 
 }  // namespace
 
@@ -249,10 +276,10 @@ int main(int argc, char** argv) {
   RunArguments args;
   args.commandLine = commandLineText(argc, argv);
   auto addRunOptions = [&](CLI::App* c, bool scenarioRequired) {
-    auto* scenario = c->add_option("scenario", args.scenario, "scenario file (TOML)");
+    auto* scenario = c->add_option("scenario", args.scenario, "scenario file (TOML)")->check(kPath);
     if (scenarioRequired) scenario->required();
-    c->add_option("--backend", args.backend, "auto, cpu or cuda");
-    c->add_option("--broadphase", args.broadphase, "broadphase strategy by name (see gem info)");
+    c->add_option("--backend", args.backend, "auto, cpu or cuda")->check(kName);
+    c->add_option("--broadphase", args.broadphase, "broadphase strategy by name (see gem info)")->check(kName);
     c->add_option("--threads", args.threads, "CPU backend: threads stepping the field (simulation.threads; 0 = every core)")
         ->check(CLI::Range(0, 1024));
     auto* duration =
@@ -262,14 +289,15 @@ int main(int argc, char** argv) {
   };
   CLI::App* run = app.add_subcommand("run", "run a scenario and write its outputs");
   addRunOptions(run, false);  // gem run --resume RUN_DIR takes none
-  run->add_option("--out", args.out, "run folder (default: output.dir of the scenario, else runs/NAME)");
+  run->add_option("--out", args.out, "run folder (default: output.dir of the scenario, else runs/NAME)")->check(kPath);
   run->add_flag("--quiet", args.quiet, "no progress line and no summary");
   run->add_flag("--no-plots", args.noPlots, "do not write RUN/plots/ at the end (gem plot RUN writes them later)");
   // What a resumed run could change would make it another run: only --threads, --quiet and
   // --no-plots go with --resume.
   auto* resumeOption = run->add_option("--resume", args.resume,
                                        "go on with the stopped run in this folder from its checkpoint (output.checkpoint_every, or the one "
-                                       "Ctrl-C and SIGTERM write), to the very files the whole run writes");
+                                       "Ctrl-C and SIGTERM write), to the very files the whole run writes")
+                           ->check(kPath);
   for (const char* other : {"--backend", "--broadphase", "--duration", "--steps", "--set", "--out"})
     resumeOption->excludes(run->get_option(other));
   CLI::App* check = app.add_subcommand("check", "load and validate a scenario without running it");
@@ -277,7 +305,7 @@ int main(int argc, char** argv) {
   check->add_flag("--quiet", args.quiet, "print nothing when the scenario is valid");
   std::vector<std::string> infoPlugins;
   CLI::App* info = app.add_subcommand("info", "version, build, devices, registered events and broadphases");
-  info->add_option("--plugin", infoPlugins, "load this plugin first (repeatable); GEM_PLUGIN_PATH's are loaded too");
+  info->add_option("--plugin", infoPlugins, "load this plugin first (repeatable); GEM_PLUGIN_PATH's are loaded too")->check(kPath);
   BenchOptions bench;
   CLI::App* benchCommand =
       app.add_subcommand("bench", "the thesis's Chapter 5 timings as tables, printed and as CSV, each row with its device (--table)");
@@ -293,9 +321,11 @@ int main(int argc, char** argv) {
                            "cpu: 456, 824, 10^4, 10^5 floes on 1, 2, 4, 8 and every core's threads;\n"
                            "all: fields, blocks, copyback, scaling, intersection, triangulation (without a CUDA device "
                            "the CUDA rows are skipped, saying so; each table its own cases and broadphases)");
-  benchCommand->add_option("--csv", bench.csv,
-                           "also write CSV: a FILE for one table; for --table all (or a PATH that is a directory or ends "
-                           "in /) a directory, created, with one TABLE.csv per table (fields.csv, blocks.csv, ...)");
+  benchCommand
+      ->add_option("--csv", bench.csv,
+                   "also write CSV: a FILE for one table; for --table all (or a PATH that is a directory or ends "
+                   "in /) a directory, created, with one TABLE.csv per table (fields.csv, blocks.csv, ...)")
+      ->check(kPath);
   benchCommand->add_option("--steps", bench.steps, "steps timed per case (default 2000; fewer for large fields)");
   benchCommand->add_option("--cases", bench.cases,
                            "456, 824 (thesis fields) or floe counts N (random, 40 %); default: the table's own "
@@ -311,12 +341,12 @@ int main(int argc, char** argv) {
 
   std::string calibrationFile = std::string(GEM_SOURCE_DIR) + "/scenarios/thesis/calibration.toml", calibrationOut = "runs/calibration";
   CLI::App* calibrateCommand = app.add_subcommand("calibrate", "the 32 calibration impacts of thesis 6.2.2.1: logged vs direct force");
-  calibrateCommand->add_option("scenario", calibrationFile, "base scenario (default scenarios/thesis/calibration.toml)");
-  calibrateCommand->add_option("--out", calibrationOut, "folder for calibration.csv");
+  calibrateCommand->add_option("scenario", calibrationFile, "base scenario (default scenarios/thesis/calibration.toml)")->check(kPath);
+  calibrateCommand->add_option("--out", calibrationOut, "folder for calibration.csv")->check(kPath);
 
   AnalyzeOptions analyze;
   CLI::App* analyzeCommand = app.add_subcommand("analyze", "impact-load statistics and plots of a run or sweep folder");
-  analyzeCommand->add_option("dir", analyze.dir, "run folder or sweep folder")->required();
+  analyzeCommand->add_option("dir", analyze.dir, "run folder or sweep folder")->required()->check(kPath);
   // A label holds commas ("concentration=0.4,count=668"): groups are separated by ';' or given by
   // repeating --groups.
   analyzeCommand
@@ -329,30 +359,30 @@ int main(int argc, char** argv) {
   std::string plotDir;
   bool plotQuiet = false;
   CLI::App* plotCommand = app.add_subcommand("plot", "PNG and SVG plots of a run folder: time series and impact loads, in RUN/plots/");
-  plotCommand->add_option("dir", plotDir, "run folder")->required();
+  plotCommand->add_option("dir", plotDir, "run folder")->required()->check(kPath);
   plotCommand->add_flag("--quiet", plotQuiet, "print nothing but errors");
 
   MovieOptions movie;
   std::string movieOut;
   CLI::App* movieCommand = app.add_subcommand("movie", "an MP4 of a run's frames (frames.ice) through ffmpeg, or one frame as a PNG");
-  movieCommand->add_option("dir", movie.runDir, "run folder")->required();
-  movieCommand->add_option("--out", movieOut, "movie file (default RUN/movie.mp4); with --still, the PNG");
+  movieCommand->add_option("dir", movie.runDir, "run folder")->required()->check(kPath);
+  movieCommand->add_option("--out", movieOut, "movie file (default RUN/movie.mp4); with --still, the PNG")->check(kPath);
   movieCommand->add_option("--fps", movie.fps, "frames per second (default 10: one movie frame per saved frame)");
   movieCommand->add_option("--color", movie.color, "what colours the floes: speed (default), thickness or id");
   movieCommand->add_option("--size", movie.size, "WxH in pixels, each even (default 1280x720)");
   movieCommand->add_option("--still", movie.still, "write frame K (0-based) as a PNG to --out instead of the movie");
   ViewOptions view;
   CLI::App* viewCommand = app.add_subcommand("view", "one self-contained HTML page that plays a run's frames in a browser");
-  viewCommand->add_option("dir", view.dir, "run folder (with frames.ice)")->required();
-  viewCommand->add_option("--out", view.out, "the page (default DIR/view.html)");
+  viewCommand->add_option("dir", view.dir, "run folder (with frames.ice)")->required()->check(kPath);
+  viewCommand->add_option("--out", view.out, "the page (default DIR/view.html)")->check(kPath);
   viewCommand->add_option("--every", view.every, "keep every N-th frame and the last (default: all, thinned above 300 MB)")
       ->check(CLI::Range(1, 1000000000));
   viewCommand->add_flag("--quiet", view.quiet, "print nothing but errors");
 
   SweepOptions sweep;
   CLI::App* sweepCommand = app.add_subcommand("sweep", "run a parameter study and gather one summary.csv");
-  sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required();
-  sweepCommand->add_option("--out", sweep.outDir, "sweep folder (default runs/NAME)");
+  sweepCommand->add_option("sweep", sweep.sweepFile, "sweep file (TOML)")->required()->check(kPath);
+  sweepCommand->add_option("--out", sweep.outDir, "sweep folder (default runs/NAME)")->check(kPath);
   // Bounded ranges: CLI11's PositiveNumber and NonNegativeNumber print the largest double in their message.
   sweepCommand->add_option("--jobs", sweep.jobs, "cases run at once (default 0: all cores)")->check(CLI::Range(0, 65536));
   sweepCommand->add_option("--case-index", sweep.caseIndex, "run only case I (0-based), e.g. in a job array")
@@ -363,7 +393,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100000));
   sweepCommand->add_flag("--quiet", sweep.quiet, "no progress");
   sweepCommand->add_option("--set", sweep.set, "override a scenario key in every case: --set simulation.dt=0.05")->take_all();
-  sweepCommand->add_option("--backend", sweep.backend, "auto, cpu or cuda, for every case");
+  sweepCommand->add_option("--backend", sweep.backend, "auto, cpu or cuda, for every case")->check(kName);
 
   try {
     app.parse(argc, argv);

@@ -185,7 +185,7 @@ class ScenarioRun {
     // The record streams' files, from the events that own them (ship_impact: impacts.csv).
     for (const RecordOutputEntry* output : Registry::global().recordOutputs()) {
       const int stream = sim.records().streams().find(output->stream);
-      if (stream < 0) continue;  // no event of this run opened it
+      if (stream < 0) continue;  // no enabled event of this run opened it: no file
       m_recordFiles.push_back(RecordFile{output, stream, std::make_unique<AtomicFile>(m_dir / output->file), {}, {}});
       m_recordFiles.back().file->stream() << output->header << "\n";
     }
@@ -284,13 +284,10 @@ class ScenarioRun {
       throw std::runtime_error(
           fmt::format("step {} (t = {:.6g} s): the vessel's state is no longer finite; the run stops here", k + 1, sim.time()));
     if (!fullCheck) return;
-    const World& w = sim.hostWorld();
-    for (int i = 0; i < w.size(); ++i)
-      if (!(finite(w.x[i]) && finite(w.y[i]) && finite(w.angle[i]) && finite(w.vx[i]) && finite(w.vy[i]) && finite(w.omega[i])))
-        throw std::runtime_error(
-            fmt::format("step {} (t = {:.6g} s): body {} ({}) has a state that is no longer finite (x {}, y {}, vx {}, vy {}); "
-                        "the run stops here",
-                        k + 1, sim.time(), w.id[i], bodyKindName(w.kind[i]), w.x[i], w.y[i], w.vx[i], w.vy[i]));
+    // The body's whole state, the angle and angular velocity too (an infinite spin once showed
+    // only finite x, y, vx and vy).
+    const std::string notFinite = nonFiniteState(sim.hostWorld(), k + 1, sim.time());
+    if (!notFinite.empty()) throw std::runtime_error(notFinite + "; the run stops here");
   }
 
   // The run ends after stepsRun steps, for the reason given (the duration, a stop rule, or a
@@ -477,6 +474,7 @@ namespace {
 RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const std::string* checkpoint) {
   const std::unique_ptr<Stepper> stepper = makeStepper(scenario);  // bad input throws here, before anything is written
   ScenarioRun run(scenario, *stepper, checkpoint);
+  if (options.started) options.started(*stepper);
   Stepper& sim = *stepper;
   const auto start = std::chrono::steady_clock::now();
   auto lastProgress = start;

@@ -15,6 +15,11 @@ namespace gem {
 struct RunOptions {
   bool quiet = false;     // no progress line and no closing summary
   bool progress = false;  // show a progress line (set when stderr is a terminal)
+  // Called once, when everything is checked (the events' tables, the world, the run folder) and the
+  // run is about to take its first step: gem run announces the run here, so that bad input is
+  // refused before any line of a run that never starts. It gets the stepper, whose backend is the
+  // one that runs (auto may have fallen back to the cpu).
+  std::function<void(Stepper&)> started;
 };
 
 struct Stats {

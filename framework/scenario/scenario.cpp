@@ -13,6 +13,7 @@
 #include "framework/api/errors.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/api/table_reader.hpp"
+#include "framework/world/constants.hpp"
 #include "framework/scenario/toml_limits.hpp"
 
 namespace fs = std::filesystem;
@@ -53,6 +54,12 @@ void applyOverride(toml::table& root, const std::string& assignment) {
 // The largest |coordinate| of a domain's edge, m: far past any ice field (10,000 km), and small enough
 // that the walls' and the field's arithmetic (spans, areas, cell counts) stays finite.
 constexpr Real kMostDomainCoordinate = 1e7;
+
+// The vessel's length and beam, and its hull's coordinates (m): from a model in a tank to ten
+// kilometres; the default hull drawn from them stays a convex polygon of finite area.
+constexpr Real kLeastHullSize = Real(0.1), kMostHullSize = 1e4;
+
+constexpr Real kMostDt = 3600;  // s
 
 Domain readDomain(TableReader& t, const Scenario& s) {
   Domain d = s.domain;
@@ -104,7 +111,7 @@ void checkFieldMemory(const Scenario& s) {
 void readField(TableReader& t, Scenario& s) {
   s.fieldKind = t.getChoice("kind", "random_convex", {"random_convex", "hexagons", "file"});
   if (s.fieldKind == "file") {
-    const std::string file = t.getString("file", "");
+    const std::string file = t.getPath("file", "");
     if (file.empty()) t.fail("file", "kind = \"file\" needs file = \"path/to/field.ice\"");
     s.fieldFile = fs::path(file).is_absolute() ? fs::path(file) : s.file.parent_path() / file;
     t.finish();
@@ -169,7 +176,12 @@ void readFloes(const toml::array& floes, TableReader& parent, Scenario& s) {
     spec.vertices = *vertices;
     spec.thickness = t.getReal("thickness", Real(0.7));
     spec.velocity = t.getVec2("velocity", Vec2{0, 0});
-    spec.angularVelocity = t.getReal("angular_velocity", 0);
+    if (!(std::fabs(spec.velocity.x) <= kMostStartSpeed && std::fabs(spec.velocity.y) <= kMostStartSpeed)) {
+      t.report("velocity", fmt::format("each component must be within +-{:g} m/s, got [{:g}, {:g}]", kMostStartSpeed, spec.velocity.x,
+                                       spec.velocity.y));
+      spec.velocity = Vec2{0, 0};
+    }
+    spec.angularVelocity = t.getRealIn("angular_velocity", 0, -kMostStartAngularSpeed, kMostStartAngularSpeed);
     const auto& src = ft->source();
     // Where the floe was written: its line in the file, or the --set that gave the floes.
     std::string setBy;
@@ -198,17 +210,25 @@ Real openWaterSpeedFor(Real bollardThrust) {
 void readVessel(TableReader& t, Scenario& s) {
   VesselSpec& v = s.vessel;
   v.present = true;
-  v.length = t.getPositive("length", v.length);
-  v.beam = t.getPositive("beam", v.beam);
-  v.mass = t.getPositive("mass", v.mass);
-  v.draft = t.getPositive("draft", v.draft);
+  // Each key in a range that keeps the first step finite (docs/scenario.md 2.5): beyond it the hull,
+  // the mass properties or the first step overflowed, and the error named vessel.vertices or
+  // came from gem run at step 1.
+  v.length = t.getRealIn("length", v.length, kLeastHullSize, kMostHullSize);
+  v.beam = t.getRealIn("beam", v.beam, kLeastHullSize, kMostHullSize);
+  v.mass = t.getRealIn("mass", v.mass, 1, 1e12);
+  v.draft = t.getPositive("draft", v.draft, 1000);
   v.position = t.getVec2("position", v.position);
-  v.headingDeg = t.getReal("heading_deg", 0);
+  if (!(std::fabs(v.position.x) <= kMostDomainCoordinate && std::fabs(v.position.y) <= kMostDomainCoordinate)) {
+    t.report("position",
+             fmt::format("each coordinate must be within +-{:g} m, got [{:g}, {:g}]", kMostDomainCoordinate, v.position.x, v.position.y));
+    v.position = VesselSpec{}.position;
+  }
+  v.headingDeg = t.getRealIn("heading_deg", 0, -360, 360);
   v.dof = static_cast<int>(t.getInt("dof", 1, 1, 3));
   if (v.dof == 2) t.fail("dof", "must be 1 (surge) or 3 (surge, sway, yaw)");
-  v.bollardThrust = t.getNonNegative("bollard_thrust", v.bollardThrust);
-  v.openWaterSpeed = t.getPositive("open_water_speed", openWaterSpeedFor(v.bollardThrust));
-  v.speed = t.getNonNegative("speed", v.openWaterSpeed);  // docs/model.md 7: starts at V_ow
+  v.bollardThrust = t.getRealIn("bollard_thrust", v.bollardThrust, 0, 1e8);
+  v.openWaterSpeed = t.getRealIn("open_water_speed", openWaterSpeedFor(v.bollardThrust), Real(0.01), kMostStartSpeed);
+  v.speed = t.getRealIn("speed", v.openWaterSpeed, 0, kMostStartSpeed);  // docs/model.md 7: starts at V_ow
   // No vertices: the default hull, drawn to length and beam (defaultHull); it stays unwritten in a
   // run's scenario.toml, so that a changed length or beam still reshapes it.
   auto hull = t.findPoints("vertices");
@@ -217,6 +237,10 @@ void readVessel(TableReader& t, Scenario& s) {
     if (hull->size() < 3)
       t.fail("vertices", fmt::format("a hull needs at least 3 vertices, got {} (leave the key out for the default hull)", hull->size()));
     if (!frames) t.fail("vertices", "a hull given by vertices also needs frame_angle_deg (one per edge)");
+    for (const Vec2& p : *hull)
+      if (!(std::fabs(p.x) <= kMostHullSize && std::fabs(p.y) <= kMostHullSize))
+        t.fail("vertices",
+               fmt::format("each coordinate must be within +-{:g} m (the ship frame), got [{:g}, {:g}]", kMostHullSize, p.x, p.y));
     if (frames->size() != hull->size())
       t.fail("frame_angle_deg", fmt::format("needs one angle per hull edge: {} vertices, {} angles", hull->size(), frames->size()));
     for (Real b : *frames)
@@ -261,7 +285,7 @@ void readCheckpointEvery(TableReader& t, OutputSpec& o) {
 
 void readOutput(TableReader& t, Scenario& s) {
   OutputSpec& o = s.output;
-  const std::string dir = t.getString("dir", "");
+  const std::string dir = t.getPath("dir", "");
   if (!dir.empty()) o.dir = fs::path(dir).is_absolute() ? fs::path(dir) : s.file.parent_path() / dir;
   o.frameEvery = static_cast<int>(t.getInt("frame_every", o.frameEvery, 0, 1000000000));
   o.timeseriesEvery = static_cast<int>(t.getInt("timeseries_every", o.timeseriesEvery, 1, 1000000000));
@@ -295,7 +319,11 @@ void readPlugins(const toml::array& plugins, TableReader& top, Scenario& s) {
     TableReader t(pt, "plugins", s.fileName);
     PluginSpec spec;
     if (!t.has("path")) t.failAt(p, "plugins: each [[plugins]] needs a path = \"...\" (to the plugin's .so)");
-    spec.path = t.getString("path", "");
+    spec.path = t.getPath("path", "");
+    if (spec.path.empty()) {  // refused (an empty path): it would name the scenario's folder
+      t.finish();
+      continue;
+    }
     // Read as "plugins" (the messages name no index), so its default is recorded here by index.
     if (DefaultsRecorder* recorder = DefaultsRecorder::active(); recorder && !t.has("override"))
       recorder->record(fmt::format("plugins[{}].override", k), false);
@@ -377,7 +405,8 @@ void readScenarioTables(Scenario& s) {
   if (const toml::array* plugins = top.findArray("plugins")) readPlugins(*plugins, top, s);
   {
     TableReader t(top.findTable("simulation"), "simulation", s.fileName);
-    s.dt = t.getPositive("dt", s.dt);
+    // At most an hour: a longer step is no ship-in-ice step, and from 1e300 s the first one overflowed.
+    s.dt = t.getPositive("dt", s.dt, kMostDt);
     const bool hasSteps = t.has("steps");
     s.duration = t.getPositive("duration", s.duration);
     const std::int64_t steps = t.getInt("steps", 0, 1, 2000000000);

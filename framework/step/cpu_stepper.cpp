@@ -15,6 +15,7 @@
 #include "framework/field/ice_file.hpp"
 #include "framework/api/log_channel.hpp"
 #include "framework/api/table_reader.hpp"
+#include "framework/world/constants.hpp"
 #include "framework/world/vessel.hpp"
 #include "framework/step/phases.hpp"
 #include "geometry/contact.hpp"
@@ -30,6 +31,14 @@ void validateBodySpec(BodySpec& spec, int maxVertices) {
       throw InputError(fmt::format("{}: vertex coordinates must be finite numbers", spec.origin));
   if (!std::isfinite(spec.velocity.x) || !std::isfinite(spec.velocity.y) || !std::isfinite(spec.angularVelocity))
     throw InputError(fmt::format("{}: velocity must be finite", spec.origin));
+  // A body starts no faster than any ship or floe could (a .ice field's objects too): beyond it
+  // the first step overflowed.
+  if (!(std::fabs(spec.velocity.x) <= kMostStartSpeed && std::fabs(spec.velocity.y) <= kMostStartSpeed))
+    throw InputError(fmt::format("{}: each velocity component must be within +-{:g} m/s, got ({:g}, {:g})", spec.origin, kMostStartSpeed,
+                                 spec.velocity.x, spec.velocity.y));
+  if (!(std::fabs(spec.angularVelocity) <= kMostStartAngularSpeed))
+    throw InputError(fmt::format("{}: the angular velocity must be within +-{:g} rad/s, got {:g}", spec.origin, kMostStartAngularSpeed,
+                                 spec.angularVelocity));
   if (!(spec.thickness > 0) || !std::isfinite(spec.thickness))
     throw InputError(fmt::format("{}: thickness must be a positive number, got {}", spec.origin, spec.thickness));
   if (signedArea(spec.vertices.data(), n) < 0) reverseOrder(spec.vertices.data(), n);  // docs/model.md 1
@@ -174,7 +183,10 @@ void CpuStepper::setUp() {
       if (defaults) defaults->record("events." + entry->name + ".enabled", enabled);
       TableReader reader(table, "events." + entry->name, m_scenario.fileName);
       reader.accept("enabled");
-      EventConfig config{reader, m_scenario, m_streams, enabled};
+      // A disabled event opens its streams in a set of its own, dropped with it: the run's streams,
+      // and so its record files (impacts.csv, a plugin's), are only the enabled events'.
+      RecordStreams unused;
+      EventConfig config{reader, m_scenario, enabled ? m_streams : unused, enabled};
       auto instance = entry->makeCpu(config);  // parsed even when off, so its table is still checked
       reader.finish();
       if (enabled) m_events.push_back({entry->name, entry->phase, std::move(instance)});
@@ -580,7 +592,7 @@ void CpuStepper::step() {
         m_records.append(s, rows + static_cast<size_t>(from) * stride, to - from);
       }
   }
-  deliverLogs(m_records);
+  if (m_deliverLogs) deliverLogs(m_records);
   m_clock.lap(PhaseClock::PairEvents);
 
   // 4. Solo events, from the state at the start of the step.

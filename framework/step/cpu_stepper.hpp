@@ -82,6 +82,10 @@ class CpuStepper final : public Stepper {
   double rubbleMass() const override { return m_rubbleMass; }
   long floesBroken() const override { return m_floesBroken; }
 
+  // Whether a step hands its log records to their channels' writers (a plugin's own files, such
+  // as rafting.csv). gem check takes one step to see that it stays finite, and writes nothing.
+  void setDeliverLogs(bool deliver) { m_deliverLogs = deliver; }
+
  private:
   // GEM_CPU_TIMING=1: the wall time of each phase of the steps taken, printed as one line on
   // stderr when the stepper goes (docs/performance.md 1.4). Off, a lap is one test of a flag.
@@ -201,6 +205,7 @@ class CpuStepper final : public Stepper {
   }
   RecordStreams m_streams;  // opened by the events as their Params are parsed
   StepRecords m_records;    // the last step's rows
+  bool m_deliverLogs = true;
   // The pair phase's record buffers, per range of contacts and stream (range x streams + stream),
   // and the rows each holds.
   std::vector<std::vector<unsigned char>> m_pairRecordRows;

@@ -1,5 +1,6 @@
 #include "framework/step/stepper.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <map>
 
@@ -69,6 +70,16 @@ std::unique_ptr<Stepper> makeStepper(const Scenario& scenario) {
     std::fprintf(stderr, "gem: backend auto: %s; running on the cpu\n", e.what());
     return findBackend("cpu")->make(scenario);
   }
+}
+
+std::string nonFiniteState(const World& w, long step, double time) {
+  auto finite = [](Real a) { return std::isfinite(a); };
+  for (int i = 0; i < w.size(); ++i)
+    if (!(finite(w.x[i]) && finite(w.y[i]) && finite(w.angle[i]) && finite(w.vx[i]) && finite(w.vy[i]) && finite(w.omega[i])))
+      return fmt::format(
+          "step {} (t = {:.6g} s): body {} ({}) has a state that is no longer finite (x {}, y {}, angle {}, vx {}, vy {}, omega {})", step,
+          time, w.id[i], bodyKindName(w.kind[i]), w.x[i], w.y[i], w.angle[i], w.vx[i], w.vy[i], w.omega[i]);
+  return "";
 }
 
 }  // namespace gem

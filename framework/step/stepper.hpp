@@ -113,4 +113,10 @@ std::string resolveBackend(const std::string& requested);
 // scenario (BackendUnsupported) gives way to the CPU, with a note on stderr.
 std::unique_ptr<Stepper> makeStepper(const Scenario& scenario);
 
+// "" when every body of `world` has a finite state after step `step` (1-based, at time `time`);
+// else the first body that does not, with its whole state: "step 1 (t = 0.1 s): body 3 (floe) has a
+// state that is no longer finite (x .., y .., angle .., vx .., vy .., omega ..)". gem run stops
+// with it, and gem check refuses a first step that gives it.
+std::string nonFiniteState(const World& world, long step, double time);
+
 }  // namespace gem

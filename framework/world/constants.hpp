@@ -8,4 +8,9 @@ constexpr Real kRhoIce = 900;          // kg/m^3
 constexpr Real kRhoWater = 1025;       // kg/m^3
 constexpr Real kRhoAir = Real(1.3);    // kg/m^3
 constexpr Real kGravity = Real(9.81);  // m/s^2
+
+// The fastest a body may start (docs/scenario.md): far beyond any ship or floe, and small enough
+// that no step from it overflows. Each velocity component, m/s, and the angular velocity, rad/s.
+constexpr Real kMostStartSpeed = 100;
+constexpr Real kMostStartAngularSpeed = 100;
 }  // namespace gem

@@ -47,7 +47,7 @@ static RaftingOnset::Params parseRaftingOnset(EventConfig& config) {
   p.minClosingSpeed = t.getNonNegative("min_closing_speed", Real(0.05));
   p.maxThickness = t.getPositive("max_thickness", Real(0.5));
   // The channel's writer lives as long as the process (and the library, which is never unloaded).
-  auto log = std::make_shared<RaftingLog>(config.scenario.output.dir / t.getString("file", "rafting.csv"));
+  auto log = std::make_shared<RaftingLog>(config.scenario.output.dir / t.getPath("file", "rafting.csv"));
   p.logChannel = openLogChannel([log](const LogRecord& r) { log->write(r); });
   return p;
 }
