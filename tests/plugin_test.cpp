@@ -230,35 +230,6 @@ TEST(PluginRecords, APluginsRecordStreamIsWrittenToItsOwnFile) {
   EXPECT_TRUE(contains(summary, "\"impacts\": 0,")) << summary;  // ship_impact's stream, no vessel here
 }
 
-// A record file exists only for an event that is on: a disabled event (a plugin's, off by default,
-// or ship_impact turned off) once left a file with its header alone, and its totals in summary.json.
-TEST(PluginRecords, ADisabledEventWritesNoRecordFile) {
-  TempDir dir;
-  const std::string scene =
-      "[simulation]\ndt = 0.1\nsteps = 30\nbroadphase = \"all_pairs\"\n"
-      "[[floes]]\nvertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]\nvelocity = [1.0, 0.0]\n"
-      "[[floes]]\nvertices = [[4.5, 0.0], [8.5, 0.0], [8.5, 4.0], [4.5, 4.0]]\n"
-      "[vessel]\nposition = [-80.0, 0.0]\n"
-      "[[plugins]]\npath = \"" +
-      plugin("contact_areas") + "\"\n";
-  const fs::path off =
-                     dir.write("off.toml", scene + "[events.ship_impact]\nenabled = false\n[events.flexural_breaking]\nenabled = false\n"),
-                 on = dir.write("on.toml", scene + "[events.contact_area_log]\nmin_area = 0.0\n");
-  ASSERT_EQ(gem::test::runGem("run " + off.string() + " --quiet --no-plots --out " + (dir.path() / "off").string(), dir.path() / "log"), 0)
-      << readFile(dir.path() / "log");
-  EXPECT_FALSE(fs::exists(dir.path() / "off" / "contact_areas.csv"));
-  EXPECT_FALSE(fs::exists(dir.path() / "off" / "impacts.csv"));
-  const std::string summary = readFile(dir.path() / "off" / "summary.json");
-  EXPECT_FALSE(contains(summary, "contact_rows")) << summary;
-  EXPECT_FALSE(contains(summary, "\"impacts\"")) << summary;
-  // On, each has its file and totals.
-  ASSERT_EQ(gem::test::runGem("run " + on.string() + " --quiet --no-plots --out " + (dir.path() / "on").string(), dir.path() / "log"), 0)
-      << readFile(dir.path() / "log");
-  EXPECT_TRUE(fs::exists(dir.path() / "on" / "contact_areas.csv"));
-  EXPECT_TRUE(fs::exists(dir.path() / "on" / "impacts.csv"));
-  EXPECT_TRUE(contains(readFile(dir.path() / "on" / "summary.json"), "\"contact_rows\": ")) << readFile(dir.path() / "on" / "summary.json");
-}
-
 // gem info's columns fit the longest name: a plugin's event of 25 characters
 // (tests/plugins/spin_up.cpp) once pushed its own row's columns out of line with the others.
 TEST(PluginInfo, TheColumnsFitTheLongestName) {

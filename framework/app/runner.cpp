@@ -185,7 +185,7 @@ class ScenarioRun {
     // The record streams' files, from the events that own them (ship_impact: impacts.csv).
     for (const RecordOutputEntry* output : Registry::global().recordOutputs()) {
       const int stream = sim.records().streams().find(output->stream);
-      if (stream < 0) continue;  // no enabled event of this run opened it: no file
+      if (stream < 0) continue;  // no event of this run opened it
       m_recordFiles.push_back(RecordFile{output, stream, std::make_unique<AtomicFile>(m_dir / output->file), {}, {}});
       m_recordFiles.back().file->stream() << output->header << "\n";
     }

@@ -183,10 +183,7 @@ void CpuStepper::setUp() {
       if (defaults) defaults->record("events." + entry->name + ".enabled", enabled);
       TableReader reader(table, "events." + entry->name, m_scenario.fileName);
       reader.accept("enabled");
-      // A disabled event opens its streams in a set of its own, dropped with it: the run's streams,
-      // and so its record files (impacts.csv, a plugin's), are only the enabled events'.
-      RecordStreams unused;
-      EventConfig config{reader, m_scenario, enabled ? m_streams : unused, enabled};
+      EventConfig config{reader, m_scenario, m_streams, enabled};
       auto instance = entry->makeCpu(config);  // parsed even when off, so its table is still checked
       reader.finish();
       if (enabled) m_events.push_back({entry->name, entry->phase, std::move(instance)});
