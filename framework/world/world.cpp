@@ -120,7 +120,9 @@ void World::permute(const std::vector<int>& order, const TaskRunner& forEachTask
   std::vector<std::function<void()>> tasks;
   auto whole = [&](auto& v) {
     tasks.push_back([&v, &order, n] {
-      std::remove_reference_t<decltype(v)> out(v.size());
+      std::remove_reference_t<decltype(v)> out;
+      out.reserve(v.capacity());  // room kept: else the next break's addBody regrows every array
+      out.resize(v.size());
       gatherOrder(out, v, order, 1, 0, n);
       v.swap(out);
     });
@@ -129,7 +131,9 @@ void World::permute(const std::vector<int>& order, const TaskRunner& forEachTask
   for (std::vector<Real>* v : {&x, &y, &angle, &vx, &vy, &omega, &area, &thickness, &mass, &invMass, &invInertia, &gyration2, &gyrationX2,
                                &gyrationY2, &principalAngle, &radius})
     whole(*v);
-  std::vector<Vec2> vertices(localVertices.size());
+  std::vector<Vec2> vertices;
+  vertices.reserve(localVertices.capacity());
+  vertices.resize(localVertices.size());
   const int ranges = forEachTask && n >= 16384 ? 16 : 1;
   for (int r = 0; r < ranges; ++r)
     tasks.push_back([&, r] {
