@@ -279,7 +279,7 @@ void CpuStepper::narrowphase() {
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
   m_boxes.resize(n);
   m_vertexPose.resize(n, Pose{-1, 0, 0, 0});
-  m_moved.resize(n);  // each body's flag is set in the pass below
+  m_moved.resize(n), m_active.resize(n);  // each body's flags are set in the pass below
   // Whether a slot changed hands since the last narrowphase (a re-sort, a break, a restored state),
   // seen in this pass over the bodies rather than in a serial one of its own.
   const int lastSlots = static_cast<int>(m_lastSlotId.size());
@@ -291,10 +291,11 @@ void CpuStepper::narrowphase() {
     // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
     // vertices from an earlier step are still exact, so only bodies that moved are transformed.
     const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
-    m_moved[i] = 0;
-    if (pose == m_vertexPose[i]) return;
+    const bool moved = !(pose == m_vertexPose[i]);
+    m_moved[i] = moved;
+    m_active[i] = moved || m_byBody.has(i);  // a slot that changed hands has moved: its pose holds its id
+    if (!moved) return;
     m_vertexPose[i] = pose;
-    m_moved[i] = 1;
     Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
     m_boxes[i] = boundingBox(v, m_world.worldVertices(i, v));
   });
@@ -330,9 +331,15 @@ void CpuStepper::narrowphase() {
     int* survivor = part.boxSurvivors.data();
     int survivors = 0;
     const Box* boxes = m_boxes.data();
+    const char* active = m_active.data();
     for (int p = begin; p < end; ++p) {
-      const Box& boxA = boxes[m_pairs[static_cast<size_t>(p)].a];
-      const Box& boxB = boxes[m_pairs[static_cast<size_t>(p)].b];
+      const CandidatePair pair = m_pairs[static_cast<size_t>(p)];
+      // Two bodies that have not moved since the last step and touched nothing then do not touch
+      // now (the test after mayTouch below): skipped before their boxes are read. In a pack most
+      // pairs rest, and reading the boxes was the loop's main cost.
+      if (!(active[pair.a] | active[pair.b])) continue;
+      const Box& boxA = boxes[pair.a];
+      const Box& boxB = boxes[pair.b];
       survivor[survivors] = p;
       survivors += !(boxA.x0 > boxB.x1) & !(boxB.x0 > boxA.x1) & !(boxA.y0 > boxB.y1) & !(boxB.y0 > boxA.y1);
     }

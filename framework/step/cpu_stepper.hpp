@@ -133,6 +133,7 @@ class CpuStepper final : public Stepper {
   };
   std::vector<Pose> m_vertexPose;  // the pose m_worldVertices and m_boxes were computed for, by slot
   std::vector<char> m_moved;       // this step: the body's pose differs from the last step's
+  std::vector<char> m_active;      // this step: moved, or in a contact at the last step
   std::vector<CandidatePair> m_pairs;
   std::vector<int> m_contactA, m_contactB;
   std::vector<PairContact> m_contacts;
