@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include "framework/api/errors.hpp"
@@ -280,12 +282,14 @@ TEST(Sweep, FieldFileStaysValidInTheCaseScenario) {
   EXPECT_NO_THROW(loadScenario(scenario));
 }
 
-// Three cases; "bad" puts a floe on the vessel: valid input, refused when the run builds its world.
-const char* const kCasesOneCannotBeBuilt = R"([[cases]]
+// Three cases; "bad" loads a test plugin whose event throws at step 5: input that every check
+// passes (a sweep checks one step of each case before any runs), a case that fails while running.
+const std::string kCasesOneFailsWhileRunning = std::string(R"([[cases]]
 name = "good"
 [[cases]]
 name = "bad"
-set = { floes = [{ vertices = [[-20.0, -2.0], [-10.0, -2.0], [-10.0, 2.0], [-20.0, 2.0]] }] }
+set = { plugins = [{ path = ")") + GEM_TEST_PLUGIN_DIR +
+                                               R"(/libfail_midway.so" }], "events.fail_midway.at_step" = 5 }
 [[cases]]
 name = "also_good"
 set = { "vessel.bollard_thrust" = 46e3 }
@@ -294,8 +298,8 @@ set = { "vessel.bollard_thrust" = 46e3 }
 TEST(Sweep, FailingCaseExitsOneAndOthersAreGathered) {
   TempDir dir;
   dir.write("base.toml", kBase);
-  const fs::path file =
-      dir.write("study.toml", std::string("[sweep]\nbase = \"base.toml\"\nset = { \"simulation.steps\" = 10 }\n") + kCasesOneCannotBeBuilt);
+  const fs::path file = dir.write(
+      "study.toml", std::string("[sweep]\nbase = \"base.toml\"\nset = { \"simulation.steps\" = 10 }\n") + kCasesOneFailsWhileRunning);
   const fs::path out = dir.path() / "out", log = dir.path() / "log.txt";
   ASSERT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --jobs 2", log), 1);
   EXPECT_NE(test::readFile(log).find("case bad failed"), std::string::npos) << test::readFile(log);
@@ -343,15 +347,19 @@ void PrintTo(const BadSweep& b, std::ostream* os) { *os << b.name; }
 
 class SweepBadInput : public ::testing::TestWithParam<BadSweep> {};
 
+// gem check of the sweep file refuses each with the same words as gem sweep.
 TEST_P(SweepBadInput, ExitsTwoNamingTheLine) {
   TempDir dir;
   dir.write("base.toml", kBase);
   const fs::path file = dir.write("bad_sweep.toml", GetParam().toml), log = dir.path() / "log.txt";
-  EXPECT_EQ(test::runGem("sweep " + file.string() + " --out " + (dir.path() / "out").string(), log), 2);
-  const std::string message = test::readFile(log);
-  for (const std::string& e : GetParam().expected)
-    EXPECT_NE(message.find(e), std::string::npos) << "missing \"" << e << "\" in: " << message;
-  EXPECT_FALSE(fs::exists(dir.path() / "out" / "cases"));  // nothing ran
+  for (const std::string command : {"sweep", "check"}) {
+    SCOPED_TRACE(command);
+    EXPECT_EQ(test::runGem(command + " " + file.string() + (command == "sweep" ? " --out " + (dir.path() / "out").string() : ""), log), 2);
+    const std::string message = test::readFile(log);
+    for (const std::string& e : GetParam().expected)
+      EXPECT_NE(message.find(e), std::string::npos) << "missing \"" << e << "\" in: " << message;
+    EXPECT_FALSE(fs::exists(dir.path() / "out" / "cases"));  // nothing ran
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -384,6 +392,22 @@ INSTANTIATE_TEST_SUITE_P(
             "bad_case_set",
             "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n[[cases]]\nname = \"b\"\nset = { \"simulation.dt\" = \"fast\" }\n",
             {"bad_sweep.toml:7:", "case 1 \"b\"", "simulation.dt"}},
+        BadSweep{
+            "unknown_key_in_a_case",
+            "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n[[cases]]\nname = \"b\"\nset = { \"vessel.bolard_thrust\" = 1.0 }\n",
+            {"bad_sweep.toml:7:", "case 1 \"b\"", "vessel.bolard_thrust", "unknown key"}},
+        // An event's table is read when the case's world is built: gem sweep once ran the others
+        // and failed this case (exit 1); gem check once refused the file's [sweep] table.
+        BadSweep{"unknown_event_key_in_a_case",
+                 "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n[[cases]]\nname = \"b\"\nset = { \"events.drag.cdd\" = 0.1 }\n",
+                 {"bad_sweep.toml:7:", "case 1 \"b\"", "events.drag.cdd", "did you mean \"cd\""}},
+        // The second position puts the hull on the floe every case has: refused before any case
+        // runs, naming the parameter's line, where gem sweep once ran case 0 and failed case 1.
+        BadSweep{"parameter_puts_the_vessel_on_a_floe",
+                 "[sweep]\nbase = \"base.toml\"\nset = { floes = [{ vertices = [[-60.0, -2.0], [-50.0, -2.0], [-50.0, 2.0], [-60.0, "
+                 "2.0]] }] }\n[parameters]\n\"vessel.position\" = [[-16.0, 0.0], [-55.0, 0.0]]\n",
+                 {"bad_sweep.toml:5:", ": case 1 \"position#1\": vessel.position = [ -55.0, 0.0 ]: ", "bodies overlap at the start",
+                  "and vessel"}},
         BadSweep{"case_without_name",
                  "[sweep]\nbase = \"base.toml\"\n[[cases]]\nset = { \"simulation.dt\" = 0.05 }\n",
                  {"bad_sweep.toml:3:", "name"}},
@@ -410,6 +434,49 @@ INSTANTIATE_TEST_SUITE_P(
                  "vessel.bollard_thrust = 2.0 }\n",
                  {"bad_sweep.toml:7:", "also varied"}}),
     [](const auto& info) { return std::string(info.param.name); });
+
+// gem check takes a sweep file (one with a top-level [sweep] table; it once refused "sweep" as an
+// unknown scenario key): every case loaded as gem sweep loads it, then built and stepped once as
+// gem check does a scenario. It writes nothing and names the cases and the base.
+TEST(SweepCheck, AValidSweepPassesNamingItsCasesAndBase) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("study.toml", kProduct), log = dir.path() / "log.txt";
+  ASSERT_EQ(test::runGem("check " + file.string(), log), 0) << test::readFile(log);
+  EXPECT_EQ(test::readFile(log), file.string() + ": ok (4 cases; base base.toml)\n");
+  ASSERT_EQ(test::runGem("check --quiet " + file.string(), log), 0) << test::readFile(log);
+  EXPECT_EQ(test::readFile(log), "");
+  EXPECT_FALSE(fs::exists(dir.path() / "runs"));  // no sweep folder
+  const std::string thesis = std::string(GEM_SOURCE_DIR) + "/scenarios/thesis/";
+  ASSERT_EQ(test::runGem("check " + thesis + "load_study.toml", log), 0) << test::readFile(log);
+  EXPECT_EQ(test::readFile(log), thesis + "load_study.toml: ok (70 cases; base load_study_field.toml)\n");
+  ASSERT_EQ(test::runGem("check " + thesis + "resistance_study.toml", log), 0) << test::readFile(log);
+  EXPECT_EQ(test::readFile(log),
+            thesis + "resistance_study.toml: ok (40 cases; 8 bases: random_35.toml, random_39.toml, random_41.toml, ...)\n");
+}
+
+// gem check SWEEP takes gem sweep's options: --set and --backend reach every case (an overlap that
+// --set makes is blamed on it); --steps and the others gem sweep lacks are refused by name.
+TEST(SweepCheck, TakesTheOptionsOfGemSweep) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file = dir.write("study.toml", kProduct), log = dir.path() / "log.txt";
+  EXPECT_EQ(test::runGem("check " + file.string() + " --set simulation.dtt=0.05", log), 2);
+  EXPECT_NE(test::readFile(log).find("simulation.dtt"), std::string::npos) << test::readFile(log);
+  // The base's floes lie in x = 0 to 60: a hull at x = 30 is on one of them.
+  EXPECT_EQ(test::runGem("check " + file.string() + " --set 'vessel.position=[30.0, 0.0]'", log), 2);
+  EXPECT_NE(test::readFile(log).find("study.toml: case 0 \"bollard_thrust=46000,concentration=0.25\": vessel.position = [30.0, 0.0]: "),
+            std::string::npos)
+      << test::readFile(log);
+  EXPECT_NE(test::readFile(log).find("bodies overlap at the start"), std::string::npos) << test::readFile(log);
+  EXPECT_EQ(test::runGem("check " + file.string() + " --backend cpu", log), 0) << test::readFile(log);
+  for (const char* option : {"--steps 5", "--duration 3", "--threads 2", "--broadphase all_pairs"}) {
+    EXPECT_EQ(test::runGem("check " + file.string() + " " + option, log), 2) << option;
+    EXPECT_NE(test::readFile(log).find(std::string("not ") + std::string(option).substr(0, std::string(option).find(' '))),
+              std::string::npos)
+        << test::readFile(log);
+  }
+}
 
 namespace {
 
@@ -449,7 +516,8 @@ class LockstepStepper final : public Stepper {
 
 struct TogetherBackend {
   std::vector<std::shared_ptr<Batch>> batches;
-  bool refuse = false;  // makeTogether throws BackendUnsupported, as CUDA's does for a state too full
+  bool refuse = false;                   // makeTogether throws BackendUnsupported, as CUDA's does for a state too full
+  std::function<void()> beforeTogether;  // called as makeTogether starts
   const BackendEntry* previous;
   BackendEntry saved;
   TogetherBackend() : previous(findBackend("cuda")) {
@@ -458,6 +526,7 @@ struct TogetherBackend {
                                  [](const Scenario& s) -> std::unique_ptr<Stepper> { return std::make_unique<CpuStepper>(s); }, nullptr,
                                  [](const Scenario& s) { return "steps=" + std::to_string(s.steps); },
                                  [this](const std::vector<const Scenario*>& scenarios) {
+                                   if (beforeTogether) beforeTogether();
                                    if (refuse) throw BackendUnsupported("these cases cannot share a state");
                                    auto batch = std::make_shared<Batch>();
                                    std::vector<std::unique_ptr<Stepper>> steppers;
@@ -537,16 +606,29 @@ TEST(Sweep, CasesRunTogetherWriteTheOutputsOfSingleRuns) {
   }
 }
 
-// A case whose world cannot be built, in a unit of cases that run together, fails alone as it
-// would in a run of its own: the others still run together and are gathered (a device sweep once
-// failed the whole unit with that one case's message).
+// A case whose world cannot be built when its unit runs (its field file changed after the sweep
+// checked every case), in a unit of cases that run together, fails alone as it would in a run of
+// its own: the others still run together and are gathered (a device sweep once failed the whole
+// unit with that one case's message).
 TEST(Sweep, ACaseThatCannotBeBuiltFailsAloneAndTheOthersStillRunTogether) {
   TempDir dir;
   dir.write("base.toml", kBase);
-  const fs::path file = dir.write(
-      "study.toml", std::string("[sweep]\nbase = \"base.toml\"\nset = { \"simulation.steps\" = 10, \"simulation.backend\" = \"cuda\" }\n") +
-                        kCasesOneCannotBeBuilt);
+  auto writeField = [&](double x0, double x1) {
+    dir.write("pack.ice",
+              fmt::format("<iceFloeSim numFrames=\"1\">\n<frame index=\"0\" time=\"0\">\n<object index=\"0\"><coordinates>{0} -2 "
+                          "{1} -2 {1} 2 {0} 2</coordinates><thickness>1</thickness></object>\n</frame>\n</iceFloeSim>\n",
+                          x0, x1));
+  };
+  writeField(30, 40);  // clear of the vessel, which reaches from x = -31 to -1
+  dir.write("file_base.toml",
+            "[simulation]\ndt = 0.1\nsteps = 40\n[field]\nkind = \"file\"\nfile = \"pack.ice\"\n"
+            "[vessel]\nlength = 30.0\nbeam = 8.0\nmass = 5e5\nposition = [-16.0, 0.0]\n[output]\nframe_every = 0\n");
+  const fs::path file = dir.write("study.toml",
+                                  "[sweep]\nbase = \"base.toml\"\nset = { \"simulation.steps\" = 10, \"simulation.backend\" = \"cuda\" }\n"
+                                  "[[cases]]\nname = \"good\"\n[[cases]]\nname = \"bad\"\nbase = \"file_base.toml\"\n"
+                                  "[[cases]]\nname = \"also_good\"\nset = { \"vessel.bollard_thrust\" = 46e3 }\n");
   TogetherBackend backend;
+  backend.beforeTogether = [&] { writeField(-20, -10); };  // now on the vessel
   SweepOptions o;
   o.sweepFile = file.string();
   o.outDir = (dir.path() / "out").string();

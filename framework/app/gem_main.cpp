@@ -29,10 +29,10 @@
 #include "framework/output/checkpoint.hpp"
 #include "framework/output/output_path.hpp"
 #include "framework/scenario/scenario.hpp"
-#include "framework/step/cpu_stepper.hpp"
 #include "framework/app/mpi_work.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/app/sweep.hpp"
+#include "framework/scenario/sweep_file.hpp"
 
 namespace fs = std::filesystem;
 using namespace gem;
@@ -194,20 +194,29 @@ int commandRun(const RunArguments& a) {
   }
 }
 
+// gem check SWEEP.toml: the sweep file, then every case as gem sweep loads it and as gem check
+// checks a scenario. It takes the options gem sweep takes (--set, --backend), no others.
+int commandCheckSweep(const RunArguments& a) {
+  for (const auto& [given, option] : {std::pair{!a.broadphase.empty(), "--broadphase"}, std::pair{a.threads >= 0, "--threads"},
+                                      std::pair{a.durationGiven, "--duration"}, std::pair{a.stepsGiven, "--steps"}})
+    if (given)
+      throw InputError(
+          fmt::format("gem check {}: a sweep file takes --set and --backend, as gem sweep does, not {} (use --set)", a.scenario, option));
+  SweepOptions options;
+  options.sweepFile = a.scenario;
+  options.set = a.set;
+  options.backend = a.backend;
+  options.quiet = a.quiet;
+  return checkSweep(options);
+}
+
 int commandCheck(const RunArguments& a) {
+  if (isSweepFile(a.scenario)) return commandCheckSweep(a);
   const Scenario s = load(a);
-  resolveBackend(s.backend);
-  CpuStepper sim(s);  // builds the field, checks every body and overlap, parses every event
-  // One step on the CPU, written nowhere: a scenario whose values pass every range but whose first
-  // step is not finite (gem run would stop at step 1) is refused with gem run's words.
-  sim.setDeliverLogs(false);
-  sim.step();
-  const std::string notFinite = nonFiniteState(sim.world(), 1, sim.time());
-  if (!notFinite.empty()) throw InputError(fmt::format("{}: {}; gem run stops there", a.scenario, notFinite));
+  const ScenarioCheck c = checkScenarioFirstStep(s);
   if (!a.quiet)
-    std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(), sim.world().size(),
-                sim.world().count(BodyKind::Floe), s.vessel.present ? ", a vessel" : "", s.steps, s.broadphase.c_str(),
-                sim.events().size());
+    std::printf("%s: ok (%d bodies: %d floes%s; %ld steps; broadphase %s; %zu events on)\n", a.scenario.c_str(), c.bodies, c.floes,
+                s.vessel.present ? ", a vessel" : "", s.steps, s.broadphase.c_str(), c.events);
   return 0;
 }
 
@@ -300,9 +309,11 @@ int main(int argc, char** argv) {
                            ->check(kPath);
   for (const char* other : {"--backend", "--broadphase", "--duration", "--steps", "--set", "--out"})
     resumeOption->excludes(run->get_option(other));
-  CLI::App* check = app.add_subcommand("check", "load and validate a scenario without running it");
+  CLI::App* check =
+      app.add_subcommand("check", "load and validate a scenario, or every case of a sweep file, and its first step, without running it");
   addRunOptions(check, true);
-  check->add_flag("--quiet", args.quiet, "print nothing when the scenario is valid");
+  check->get_option("scenario")->description("scenario file, or sweep file (a [sweep] table; with --set and --backend only)");
+  check->add_flag("--quiet", args.quiet, "print nothing when the scenario or sweep is valid");
   std::vector<std::string> infoPlugins;
   CLI::App* info = app.add_subcommand("info", "version, build, devices, registered events and broadphases");
   info->add_option("--plugin", infoPlugins, "load this plugin first (repeatable); GEM_PLUGIN_PATH's are loaded too")->check(kPath);

@@ -28,6 +28,7 @@
 #include "framework/output/ice_file_writer.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/app/interrupt.hpp"
+#include "framework/step/cpu_stepper.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/output/vtk_writer.hpp"
 
@@ -535,6 +536,18 @@ RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const s
 }  // namespace
 
 RunSummary runScenario(const Scenario& scenario, const RunOptions& options) { return runSteps(scenario, options, nullptr); }
+
+ScenarioCheck checkScenarioFirstStep(const Scenario& scenario) {
+  resolveBackend(scenario.backend);
+  CpuStepper sim(scenario);  // builds the field, checks every body and overlap, parses every event
+  // One step on the CPU, written nowhere: a scenario whose values pass every range but whose first
+  // step is not finite (gem run would stop at step 1) is refused with gem run's words.
+  sim.setDeliverLogs(false);
+  sim.step();
+  const std::string notFinite = nonFiniteState(sim.world(), 1, sim.time());
+  if (!notFinite.empty()) throw InputError(fmt::format("{}: {}; gem run stops there", scenario.fileName, notFinite));
+  return ScenarioCheck{sim.world().size(), sim.world().count(BodyKind::Floe), sim.events().size()};
+}
 
 RunSummary resumeScenario(Scenario scenario, const RunOptions& options) {
   const std::filesystem::path file = scenario.output.dir / kCheckpointFile;

@@ -79,4 +79,15 @@ std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>
 
 std::string summaryJson(const RunSummary& s);
 
+// gem check's work on a loaded scenario (docs/reliability.md "What gem check promises"), for a
+// scenario file and for each case of a sweep file: its backend found, its world built (every body,
+// no overlap), every event table parsed, and one step taken on the CPU, written nowhere, that
+// leaves every body's state finite. Throws InputError where gem run would fail, a first step that
+// is not finite with gem run's words ("FILE: step 1 ...; gem run stops there").
+struct ScenarioCheck {
+  int bodies = 0, floes = 0;
+  size_t events = 0;  // enabled
+};
+ScenarioCheck checkScenarioFirstStep(const Scenario& scenario);
+
 }  // namespace gem

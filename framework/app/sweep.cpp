@@ -4,11 +4,13 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -55,10 +57,15 @@ Scenario loadCase(const SweepCase& c, const fs::path& dir) {
   return s;
 }
 
+// How messages name a case: its index in case order and its name.
+std::string caseLabel(const SweepDefinition& sweep, const SweepCase& c) {
+  return fmt::format("case {} \"{}\"", &c - sweep.cases.data(), c.name);
+}
+
 // Loads a case as loadCase does; when its scenario is rejected, blames the sweep file's line for
 // the override at fault (found by trying each alone), or the base scenario's own line.
 Scenario validateCase(const SweepDefinition& sweep, const SweepCase& c, const fs::path& dir) {
-  const std::string where = fmt::format("case {} \"{}\"", &c - sweep.cases.data(), c.name);
+  const std::string where = caseLabel(sweep, c);
   try {
     Scenario s = loadCase(c, dir);
     if (s.fieldKind == "file" && !fs::is_regular_file(s.fieldFile)) {
@@ -80,6 +87,109 @@ Scenario validateCase(const SweepDefinition& sweep, const SweepCase& c, const fs
     }
     throw InputError(sweep.fileName, c.line, c.column, fmt::format("{}: {}", where, error.what()));
   }
+}
+
+// Checks a case that validateCase loaded as gem check checks a scenario (checkScenarioFirstStep:
+// its world built, its events parsed, one CPU step). An error names the sweep file and the case,
+// at the line of an override without which the case passes (a vessel.position that puts the hull
+// on a floe), the varied ones tried first, else at the case's entry. Not validateCase's "each
+// override alone": an override that needs another (field.concentration with its field.groups)
+// fails alone for another reason.
+void checkCaseFirstStep(const SweepDefinition& sweep, const SweepCase& c, const Scenario& s) {
+  try {
+    checkScenarioFirstStep(s);
+  } catch (const InputError& error) {
+    const std::string where = caseLabel(sweep, c);
+    std::vector<size_t> order;
+    for (bool varied : {true, false})
+      for (size_t k = 0; k < c.overrides.size(); ++k)
+        if (c.overrides[k].varied == varied) order.push_back(k);
+    for (size_t k : order) {
+      std::vector<std::string> others;
+      for (size_t j = 0; j < c.overrides.size(); ++j)
+        if (j != k) others.push_back(c.overrides[j].key + "=" + c.overrides[j].toml);
+      try {
+        checkScenarioFirstStep(loadScenario(c.base, others));
+      } catch (const InputError&) {
+        continue;  // fails without it too (or does not load without it): not this one's fault alone
+      }
+      const SweepOverride& o = c.overrides[k];
+      throw InputError(sweep.fileName, o.line, o.column, fmt::format("{}: {} = {}: {}", where, o.key, o.toml, error.what()));
+    }
+    throw InputError(sweep.fileName, c.line, c.column, fmt::format("{}: {}", where, error.what()));
+  }
+}
+
+// Checks the cases `which` (indices into sweep.cases, in case order) with checkCaseFirstStep, on up
+// to `jobs` threads, each case stepping on one thread, and throws the error of the first case in
+// case order that fails. On a terminal (progress), a line on stderr once there are many cases or
+// it takes a while, cleared before anything else is printed.
+void checkCases(const SweepDefinition& sweep, const std::vector<Scenario>& scenarios, const std::vector<size_t>& which, size_t jobs,
+                bool progress) {
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::atomic<size_t> next{0};
+  size_t done = 0;
+  size_t failedAt = which.size();  // the first position in `which` that failed
+  std::exception_ptr failure;
+  auto worker = [&] {
+    for (size_t k = next++; k < which.size(); k = next++) {
+      {
+        std::lock_guard lock(mutex);
+        if (k > failedAt) return;  // a case before it failed: that one is reported
+      }
+      Scenario s = scenarios[which[k]];
+      if (jobs > 1) s.threads = 1;
+      std::exception_ptr error;
+      try {
+        checkCaseFirstStep(sweep, sweep.cases[which[k]], s);
+      } catch (...) {
+        error = std::current_exception();
+      }
+      std::lock_guard lock(mutex);
+      ++done;
+      if (error && k < failedAt) failedAt = k, failure = error;
+      changed.notify_all();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (size_t t = 1; t < std::min(jobs, which.size()); ++t) threads.emplace_back(worker);
+  if (!progress) {
+    worker();
+  } else {
+    threads.emplace_back(worker);
+    const auto start = std::chrono::steady_clock::now();
+    bool shown = false;
+    std::unique_lock lock(mutex);
+    while (done < which.size() && !failure) {
+      if (which.size() >= 10 || std::chrono::steady_clock::now() - start > std::chrono::seconds(1)) {
+        std::fprintf(stderr, "\r  checking cases %zu/%zu   ", done, which.size());
+        std::fflush(stderr);
+        shown = true;
+      }
+      changed.wait_for(lock, std::chrono::milliseconds(200));
+    }
+    if (shown) std::fprintf(stderr, "\r%*s\r", 40, "");
+  }
+  for (std::thread& t : threads) t.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+// gem sweep's --set and --backend: overrides of every case, last (so they win), as in gem run.
+void addCommandLineOverrides(SweepDefinition& sweep, const SweepOptions& options) {
+  std::vector<std::string> extra = options.set;
+  if (!options.backend.empty()) extra.push_back("simulation.backend=\"" + options.backend + "\"");
+  for (const std::string& assignment : extra) {
+    const size_t eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(fmt::format("--set {}: expected KEY=VALUE, e.g. simulation.dt=0.05", assignment));
+    for (SweepCase& c : sweep.cases)
+      c.overrides.push_back(SweepOverride{assignment.substr(0, eq), assignment.substr(eq + 1), assignment.substr(eq + 1)});
+  }
+}
+
+fs::path sweepFolder(const SweepDefinition& sweep, const SweepOptions& options) {
+  return options.outDir.empty() ? sweep.file.parent_path() / "runs" / sweep.name : fs::absolute(options.outDir).lexically_normal();
 }
 
 // The first two lines are read back by gem analyze (framework/analysis/sweep_cases.cpp): the case's
@@ -181,18 +291,8 @@ struct SweepState {
 int runSweep(const SweepOptions& options) {
   MpiWork mpi;  // under mpirun: this rank's share of the world; finalised when the sweep returns
   SweepDefinition sweep = readSweepFile(options.sweepFile);
-  // The command line's overrides go to every case, last (so they win), as in gem run.
-  std::vector<std::string> extra = options.set;
-  if (!options.backend.empty()) extra.push_back("simulation.backend=\"" + options.backend + "\"");
-  for (const std::string& assignment : extra) {
-    const size_t eq = assignment.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(fmt::format("--set {}: expected KEY=VALUE, e.g. simulation.dt=0.05", assignment));
-    for (SweepCase& c : sweep.cases)
-      c.overrides.push_back(SweepOverride{assignment.substr(0, eq), assignment.substr(eq + 1), assignment.substr(eq + 1)});
-  }
-  const fs::path outDir =
-      options.outDir.empty() ? sweep.file.parent_path() / "runs" / sweep.name : fs::absolute(options.outDir).lexically_normal();
+  addCommandLineOverrides(sweep, options);
+  const fs::path outDir = sweepFolder(sweep, options);
   const size_t count = sweep.cases.size();
   if (options.caseIndex < -1 || options.caseIndex >= static_cast<long>(count))
     throw InputError(fmt::format("--case-index {}: {} has {} cases (0 to {})", options.caseIndex, sweep.fileName, count, count - 1));
@@ -227,14 +327,19 @@ int runSweep(const SweepOptions& options) {
     }
     todo.push_back(i);
   }
+  // Under MPI a rank runs one unit at a time unless --jobs says otherwise (one rank per core).
+  const unsigned cores = mpi.active() ? 1u : std::max(1u, std::thread::hardware_concurrency());
+  // Every case to run is checked as gem check checks a scenario (its world built, its events
+  // parsed, one CPU step): a floe on the vessel or a typo in an event's key fails now, before any
+  // case runs. For the thesis's sweeps it takes a third of a second (docs/scenario.md 5).
+  checkCases(sweep, scenarios, todo, options.jobs > 0 ? static_cast<size_t>(options.jobs) : cores,
+             !options.quiet && mpi.rank() == 0 && isatty(fileno(stderr)));
   // Every rank must see the same list before any of them starts changing case folders.
   mpi.sumOverRanks(0);
   const std::vector<std::vector<size_t>> units = workUnits(scenarios, todo, options.batch, mpi.active() ? mpi.size() : 0);
   size_t together = 0;
   for (const auto& unit : units)
     if (unit.size() > 1) together += unit.size();
-  // Under MPI a rank runs one unit at a time unless --jobs says otherwise (one rank per core).
-  const unsigned cores = mpi.active() ? 1u : std::max(1u, std::thread::hardware_concurrency());
   const size_t jobs = std::min<size_t>(options.jobs > 0 ? static_cast<size_t>(options.jobs) : cores, std::max<size_t>(units.size(), 1));
   fs::create_directories(outDir / "cases");
   const bool terminal = !options.quiet && isatty(fileno(stderr));
@@ -413,6 +518,36 @@ int runSweep(const SweepOptions& options) {
     throw Interrupted(signal,
                       fmt::format("sweep interrupted; {} of {} cases complete, the others run when the sweep is run again", rows, count));
   return failures == 0 ? 0 : 1;
+}
+
+int checkSweep(const SweepOptions& options) {
+  SweepDefinition sweep = readSweepFile(options.sweepFile);
+  addCommandLineOverrides(sweep, options);
+  const fs::path outDir = sweepFolder(sweep, options);
+  // Every case as gem sweep loads it before any runs...
+  std::vector<Scenario> scenarios;
+  for (const SweepCase& c : sweep.cases) scenarios.push_back(validateCase(sweep, c, outDir / "cases" / c.folder));
+  // ... then as gem check checks a scenario.
+  std::vector<size_t> all(sweep.cases.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  checkCases(sweep, scenarios, all, std::max(1u, std::thread::hardware_concurrency()), !options.quiet && isatty(fileno(stderr)));
+  if (options.quiet) return 0;
+  // The bases, relative to the sweep file's folder, each once, in case order.
+  std::vector<std::string> bases;
+  for (const SweepCase& c : sweep.cases) {
+    const std::string base = c.base.lexically_relative(sweep.file.parent_path()).string();
+    if (std::find(bases.begin(), bases.end(), base) == bases.end()) bases.push_back(base);
+  }
+  std::string baseText = "base " + bases[0];
+  if (bases.size() > 1) {
+    const size_t shownBases = std::min<size_t>(bases.size(), 3);
+    baseText =
+        fmt::format("{} bases: {}{}", bases.size(), fmt::join(bases.begin(), bases.begin() + static_cast<std::ptrdiff_t>(shownBases), ", "),
+                    bases.size() > shownBases ? ", ..." : "");
+  }
+  std::printf("%s: ok (%zu case%s; %s)\n", options.sweepFile.c_str(), sweep.cases.size(), sweep.cases.size() == 1 ? "" : "s",
+              baseText.c_str());
+  return 0;
 }
 
 }  // namespace gem

@@ -65,7 +65,9 @@
 // wall_time_s is the batch's and cases_on_device says how many shared it.
 //
 // Every case's scenario is loaded and validated before any runs, so a typo fails fast: the error
-// names the sweep file's line and column of the offending key. A case that fails while running is
+// names the sweep file's line and column of the offending key. Then every case to run is checked
+// as gem check checks a scenario (its world built, so no overlap; its events parsed; one CPU step),
+// about 0.3 s for the 70 cases of the thesis's load study. A case that fails while running is
 // reported with its message, the others go on, and the exit status is 1.
 #pragma once
 #include <string>
@@ -87,5 +89,12 @@ struct SweepOptions {
 // Returns the exit status: 0 when every case selected is complete, 1 when one failed at run time.
 // Throws InputError for a bad sweep file, a bad base scenario or a varied key a scenario rejects.
 int runSweep(const SweepOptions& options);
+
+// gem check SWEEP.toml: the sweep file, then every case's scenario as runSweep loads it, then each
+// case as gem check checks a scenario (its world built, its events parsed, one CPU step; nothing
+// written). Uses sweepFile, set, backend and quiet; prints "FILE: ok (N cases; base BASE)" unless
+// quiet. Returns 0; throws InputError naming the sweep file, the case and, where known, the line of
+// the case's entry or of the override at fault.
+int checkSweep(const SweepOptions& options);
 
 }  // namespace gem

@@ -185,6 +185,17 @@ std::string sweepCell(const SweepCase& c, const std::string& key) {
   return "";
 }
 
+bool isSweepFile(const fs::path& file) {
+  try {
+    const toml::table root = toml::parse(readTomlFile(file.string(), "scenario"), file.string());
+    return root["sweep"].is_table();
+  } catch (const InputError&) {
+    return false;
+  } catch (const toml::parse_error&) {
+    return false;
+  }
+}
+
 SweepDefinition readSweepFile(const fs::path& file) {
   SweepDefinition def;
   def.fileName = file.string();

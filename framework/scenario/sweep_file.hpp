@@ -35,6 +35,10 @@ struct SweepDefinition {
 // the scenarios themselves are checked by the caller.
 SweepDefinition readSweepFile(const std::filesystem::path& file);
 
+// Whether file is a sweep file: TOML whose top level holds a [sweep] table (gem check takes a
+// scenario or a sweep). False for a file that cannot be read or parsed: its loader says why.
+bool isSweepFile(const std::filesystem::path& file);
+
 // A case name as a folder name of only [A-Za-z0-9._-], safe in a shell and in tools that split on
 // commas or '=': '=' and '#' become '-', ',' becomes '_', '+' is dropped ("1e+06" -> "1e06"), any
 // other character becomes '_'; a name that would start with '.' or '-' gets a leading '_'.
