@@ -23,8 +23,8 @@ void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
 const std::string kSim = "[simulation]\ndt = 0.1\nsteps = 5\n";
 const std::string kDomain = "[domain]\nx = [0.0, 100.0]\ny = [-50.0, 50.0]\n";
 
-std::string floe(const std::string& vertices, const std::string& extra = "") {
-  return "[[floes]]\nvertices = " + vertices + "\nthickness = 1.0\n" + extra;
+std::string floe(const std::string& vertices, const std::string& extra = "", const std::string& thickness = "1.0") {
+  return "[[floes]]\nvertices = " + vertices + "\nthickness = " + thickness + "\n" + extra;
 }
 
 const std::string kSquare = "[[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]";
@@ -44,7 +44,14 @@ std::vector<BadCase> badCases() {
        {"floes[0]", "3 to 19 vertices, got 20"}},
       {"nan_vertex", kSim + floe("[[nan, 0.0], [10.0, 0.0], [10.0, 10.0]]"), {"vertices", "finite"}},
       {"infinite_dt", "[simulation]\ndt = inf\n", {"simulation.dt", "finite", ":2:"}},
-      {"zero_thickness", kSim + floe(kSquare, "thickness = 0.0\n").replace(kSim.size() + floe(kSquare).size() - 16, 16, ""), {"thickness"}},
+      {"zero_thickness", kSim + floe(kSquare, "", "0.0"), {"floes[0].thickness", "from 0.01 to 1000, got 0"}},
+      {"floe_thinner_than_any_ice", kSim + floe(kSquare, "", "1e-300"), {"floes[0].thickness", "from 0.01 to 1000, got 1e-300"}},
+      {"field_thinner_than_any_ice",
+       kSim + kDomain + "[field]\nconcentration = 0.3\nthickness = 1e-9\n",
+       {"field.thickness", "from 0.01 to 1000"}},
+      {"group_thicker_than_an_iceberg",
+       kSim + kDomain + "[field]\nconcentration = 0.3\ngroups = [{ coverage = 0.3, thickness = 5e3 }]\n",
+       {"thickness", "from 0.01 to 1000"}},
       {"negative_dt", "[simulation]\ndt = -0.1\n", {"simulation.dt", "positive"}},
       {"zero_duration", "[simulation]\nduration = 0.0\n", {"simulation.duration", "positive"}},
       {"zero_mass", kSim + "[vessel]\nmass = 0.0\n", {"vessel.mass", "from 1 to 1e+12"}},

@@ -185,6 +185,26 @@ TEST(GemCheck, ValidatesEveryThesisScenario) {
   }
 }
 
+// A .ice field's floe thinner than any ice (a 1e-200 m object once passed and blew up at its first
+// impulse) is refused at load, naming the file and the object.
+TEST(GemCheck, AnIceFieldsFloeThinnerThanAnyIceIsRefusedNamingTheObject) {
+  test::TempDir dir;
+  dir.write("thin.ice",
+            "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\" time=\"0\">\n"
+            "<object index=\"7\"><coordinates>10 0 20 0 20 10 10 10</coordinates><thickness>1e-200</thickness></object>\n"
+            "</frame>\n</iceFloeSim>\n");
+  const auto scenario = dir.write("thin.toml",
+                                  "[simulation]\ndt = 0.1\nsteps = 5\n[domain]\nx = [0.0, 100.0]\ny = [-20.0, 30.0]\n"
+                                  "[field]\nkind = \"file\"\nfile = \"thin.ice\"\n");
+  for (const std::string& command :
+       {"check " + scenario.string(), "run " + scenario.string() + " --quiet --out " + (dir.path() / "out").string()}) {
+    EXPECT_EQ(test::runGem(command, dir.path() / "log"), 2) << command;
+    const std::string log = test::readFile(dir.path() / "log");
+    EXPECT_NE(log.find("thin.ice object 7: a floe's thickness must be from 0.01 to 1000 m, got 1e-200"), std::string::npos) << log;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "summary.json"));
+}
+
 // A .ice field (object indices 0, 1) with the domain's walls: the floes keep their ids, the walls
 // get ids after them, and gem check and gem run agree (run used to fail on duplicate ids).
 TEST(GemRun, AnIceFieldWithWallsHasUniqueIds) {

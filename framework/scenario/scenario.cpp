@@ -122,7 +122,7 @@ void readField(TableReader& t, Scenario& s) {
   // is then read only when given, so that a run's scenario.toml shows no default that took no effect.
   const bool thicknessFromGroups = s.fieldKind == "random_convex" && t.has("groups") && !t.has("thickness");
   if (thicknessFromGroups) t.accept("thickness");
-  const Real thickness = thicknessFromGroups ? Real(0.7) : t.getPositive("thickness", Real(0.7));
+  const Real thickness = thicknessFromGroups ? Real(0.7) : t.getRealIn("thickness", Real(0.7), kLeastIceThickness, kMostIceThickness);
   const Real minGap = t.getNonNegative("min_gap", Real(0.05));
   if (s.fieldKind == "hexagons") {
     HexagonFieldSpec& h = s.hexagonField;
@@ -154,7 +154,7 @@ void readField(TableReader& t, Scenario& s) {
         const toml::table* gt = groups->get(g)->as_table();
         if (!gt) t.failAt(*groups->get(g), "field.groups: expected tables { coverage = ..., thickness = ... }");
         TableReader gr(gt, fmt::format("field.groups[{}]", g), s.fileName);
-        ThicknessGroup group{gr.getPositive("coverage", 0), gr.getPositive("thickness", 0)};
+        ThicknessGroup group{gr.getPositive("coverage", 0), gr.getRealIn("thickness", Real(0.7), kLeastIceThickness, kMostIceThickness)};
         if (!gr.has("coverage") || !gr.has("thickness")) gr.fail("coverage", "each group needs coverage and thickness");
         gr.finish();
         r.groups.push_back(group);
@@ -174,7 +174,7 @@ void readFloes(const toml::array& floes, TableReader& parent, Scenario& s) {
     auto vertices = t.findPoints("vertices");
     if (!vertices) t.fail("vertices", "each floe needs vertices = [[x, y], ...]");
     spec.vertices = *vertices;
-    spec.thickness = t.getReal("thickness", Real(0.7));
+    spec.thickness = t.getRealIn("thickness", Real(0.7), kLeastIceThickness, kMostIceThickness);
     spec.velocity = t.getVec2("velocity", Vec2{0, 0});
     if (!(std::fabs(spec.velocity.x) <= kMostStartSpeed && std::fabs(spec.velocity.y) <= kMostStartSpeed)) {
       t.report("velocity", fmt::format("each component must be within +-{:g} m/s, got [{:g}, {:g}]", kMostStartSpeed, spec.velocity.x,

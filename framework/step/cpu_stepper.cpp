@@ -41,6 +41,11 @@ void validateBodySpec(BodySpec& spec, int maxVertices) {
                                  spec.angularVelocity));
   if (!(spec.thickness > 0) || !std::isfinite(spec.thickness))
     throw InputError(fmt::format("{}: thickness must be a positive number, got {}", spec.origin, spec.thickness));
+  // A floe (a .ice field's too) from young ice to an iceberg: thinner, its mass was too small for
+  // a finite first impulse (the vessel's draft and the walls are checked where they are made).
+  if (spec.kind == BodyKind::Floe && !(spec.thickness >= kLeastIceThickness && spec.thickness <= kMostIceThickness))
+    throw InputError(fmt::format("{}: a floe's thickness must be from {:g} to {:g} m, got {:g}", spec.origin, kLeastIceThickness,
+                                 kMostIceThickness, spec.thickness));
   if (signedArea(spec.vertices.data(), n) < 0) reverseOrder(spec.vertices.data(), n);  // docs/model.md 1
   if (!isStrictlyConvexCCW(spec.vertices.data(), n, Real(1e-9)))
     throw InputError(

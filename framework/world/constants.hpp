@@ -13,4 +13,8 @@ constexpr Real kGravity = Real(9.81);  // m/s^2
 // that no step from it overflows. Each velocity component, m/s, and the angular velocity, rad/s.
 constexpr Real kMostStartSpeed = 100;
 constexpr Real kMostStartAngularSpeed = 100;
+
+// A floe's thickness, m: from young ice of a centimetre to an iceberg. Thinner, a floe's mass and
+// moment of inertia become so small that the first impulse on it overflowed the step.
+constexpr Real kLeastIceThickness = Real(0.01), kMostIceThickness = 1000;
 }  // namespace gem
