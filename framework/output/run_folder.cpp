@@ -15,17 +15,28 @@ namespace gem {
 
 namespace {
 void removePlots(const std::filesystem::path& dir, const std::function<bool(const std::filesystem::path&)>& staleTemporary);
+
+// Temporaries of another process (an earlier run that was killed), never this run's own.
+bool staleTemporary(const std::filesystem::path& p) {
+  static const std::string own = ".tmp-" + std::to_string(::getpid());
+  const std::string name = p.filename().string();
+  return name.find(".tmp-") != std::string::npos && name.substr(name.size() - std::min(name.size(), own.size())) != own;
+}
+
+// Every stale temporary in the folder and in frames/ (plots/ is removePlots').
+void removeStaleTemporaries(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (const fs::path& folder : {dir, dir / "frames"})
+    if (fs::is_directory(folder, ec))
+      for (const auto& entry : fs::directory_iterator(folder, ec))
+        if (entry.is_regular_file(ec) && staleTemporary(entry.path())) fs::remove(entry.path(), ec);
+}
 }  // namespace
 
 void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  // Temporaries of another process (an earlier run that was killed), never this run's own.
-  const std::string own = ".tmp-" + std::to_string(::getpid());
-  auto staleTemporary = [&](const fs::path& p) {
-    const std::string name = p.filename().string();
-    return name.find(".tmp-") != std::string::npos && name.substr(name.size() - std::min(name.size(), own.size())) != own;
-  };
   // gem-run.toml: GEM 0.2's name for scenario.toml. scenario.toml itself is not removed: it is
   // rewritten whole by recordScenario (and may be the very file this run reads).
   std::vector<std::string> files{"summary.json", "state.csv",    "timeseries.csv", "frames.pvd",   "frames.ice",
@@ -46,7 +57,10 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
 void clearRunEnd(const std::filesystem::path& dir) {
   std::error_code ec;
   for (const char* f : {"summary.json", "state.csv", kMovieFile}) std::filesystem::remove(dir / f, ec);
-  removePlots(dir, [](const std::filesystem::path&) { return false; });
+  // Called once every file the resume continues is adopted: what temporaries are left are the
+  // killed run's half-written ones (a checkpoint cut by kill -9 while it was being written).
+  removePlots(dir, staleTemporary);
+  removeStaleTemporaries(dir);
 }
 
 namespace {
