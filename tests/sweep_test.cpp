@@ -435,6 +435,24 @@ INSTANTIATE_TEST_SUITE_P(
                  {"bad_sweep.toml:7:", "also varied"}}),
     [](const auto& info) { return std::string(info.param.name); });
 
+// A case's override that the scenario refuses is named once, at its line in the sweep file: the
+// message once also quoted it as a command-line "--set KEY=VALUE" and repeated its key. An
+// override given to gem sweep itself with --set still says so.
+TEST(SweepMessages, AnOverrideIsNamedOnceAtItsLine) {
+  TempDir dir;
+  dir.write("base.toml", kBase);
+  const fs::path file =
+      dir.write("study.toml", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\nset = { \"vessel.mass\" = \"heavy\" }\n");
+  const fs::path log = dir.path() / "log.txt";
+  EXPECT_EQ(test::runGem("check " + file.string(), log), 2);
+  const std::string message = test::readFile(log);
+  EXPECT_NE(message.find("study.toml:5:25: case 0 \"a\": vessel.mass = 'heavy': expected a number"), std::string::npos) << message;
+  EXPECT_EQ(message.find("--set"), std::string::npos) << message;
+  dir.write("study.toml", "[sweep]\nbase = \"base.toml\"\n[[cases]]\nname = \"a\"\n");
+  EXPECT_EQ(test::runGem("check " + file.string() + " --set vessel.mass=-5", log), 2);
+  EXPECT_NE(test::readFile(log).find("--set vessel.mass=-5"), std::string::npos) << test::readFile(log);
+}
+
 // gem check takes a sweep file (one with a top-level [sweep] table; it once refused "sweep" as an
 // unknown scenario key): every case loaded as gem sweep loads it, then built and stepped once as
 // gem check does a scenario. It writes nothing and names the cases and the base.

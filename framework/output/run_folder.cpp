@@ -43,15 +43,14 @@ void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::st
                                  "gem.log",      "gem-run.toml", kMovieFile,       kCheckpointFile};
   files.insert(files.end(), recordFiles.begin(), recordFiles.end());
   for (const std::string& f : files) fs::remove(dir / f, ec);
+  removeStaleTemporaries(dir);
   const fs::path frames = dir / "frames";
   if (fs::is_directory(frames, ec)) {
     for (const auto& entry : fs::directory_iterator(frames, ec))
-      if (entry.path().extension() == ".vtp" || staleTemporary(entry.path())) fs::remove(entry.path(), ec);
+      if (entry.path().extension() == ".vtp") fs::remove(entry.path(), ec);
     if (fs::is_empty(frames, ec)) fs::remove(frames, ec);
   }
   removePlots(dir, staleTemporary);
-  for (const auto& entry : fs::directory_iterator(dir, ec))
-    if (entry.is_regular_file() && staleTemporary(entry.path())) fs::remove(entry.path(), ec);
 }
 
 void clearRunEnd(const std::filesystem::path& dir) {
