@@ -62,16 +62,15 @@ std::string caseLabel(const SweepDefinition& sweep, const SweepCase& c) {
   return fmt::format("case {} \"{}\"", &c - sweep.cases.data(), c.name);
 }
 
-// What a scenario's loader said about an override of the sweep file, as the message gives it after
-// "KEY = VALUE: ": without the "--set KEY=VALUE: " and the "KEY: " that the loader puts first for a
-// value that has no line of its own (the sweep file's line names it). An override from gem sweep's
-// own --set (no line) keeps them: they say where it came from.
-std::string overrideDetail(const SweepOverride& o, std::string message) {
-  if (o.line <= 0) return message;
-  const std::string assignment = "--set " + o.key + "=" + o.toml + ": ";
-  if (message.rfind(assignment, 0) == 0) message.erase(0, assignment.size());
+// An override as a message names it: "KEY = VALUE" for one the sweep file gives (its line is the
+// message's), "--set KEY=VALUE" for one given to gem sweep itself (no line); then what the
+// scenario's loader said about it, without the "--set KEY=VALUE: " and the "KEY: " that the loader
+// puts first for a value that has no line of its own.
+std::string overrideMessage(const SweepOverride& o, std::string message) {
+  const std::string assignment = "--set " + o.key + "=" + o.toml;
+  if (message.rfind(assignment + ": ", 0) == 0) message.erase(0, assignment.size() + 2);
   if (message.rfind(o.key + ": ", 0) == 0) message.erase(0, o.key.size() + 2);
-  return message;
+  return fmt::format("{}: {}", o.line > 0 ? o.key + " = " + o.toml : assignment, message);
 }
 
 // Loads a case as loadCase does; when its scenario is rejected, blames the sweep file's line for
@@ -94,8 +93,7 @@ Scenario validateCase(const SweepDefinition& sweep, const SweepCase& c, const fs
       try {
         loadScenario(c.base, {o.key + "=" + o.toml});
       } catch (const InputError& alone) {
-        throw InputError(sweep.fileName, o.line, o.column,
-                         fmt::format("{}: {} = {}: {}", where, o.key, o.toml, overrideDetail(o, alone.what())));
+        throw InputError(sweep.fileName, o.line, o.column, fmt::format("{}: {}", where, overrideMessage(o, alone.what())));
       }
     }
     throw InputError(sweep.fileName, c.line, c.column, fmt::format("{}: {}", where, error.what()));
@@ -127,8 +125,7 @@ void checkCaseFirstStep(const SweepDefinition& sweep, const SweepCase& c, const 
         continue;  // fails without it too (or does not load without it): not this one's fault alone
       }
       const SweepOverride& o = c.overrides[k];
-      throw InputError(sweep.fileName, o.line, o.column,
-                       fmt::format("{}: {} = {}: {}", where, o.key, o.toml, overrideDetail(o, error.what())));
+      throw InputError(sweep.fileName, o.line, o.column, fmt::format("{}: {}", where, overrideMessage(o, error.what())));
     }
     throw InputError(sweep.fileName, c.line, c.column, fmt::format("{}: {}", where, error.what()));
   }
