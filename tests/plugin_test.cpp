@@ -73,6 +73,7 @@ TEST(PluginErrors, EachExitsWithStatus2NamingTheFileAndTheCause) {
       {plugin("compiler_mismatch"), "compiler TurboC 3.0.0"},
       {dir.write("text.so", "not a library\n").string(), "cannot be loaded"},
       {plugin("throws_int"), "not a std::exception"},
+      {plugin("throws_at_load"), "a static initializer threw while the library loaded: throws_at_load: a static initializer throwing"},
       {plugin("unresolved_symbol"), "undefined symbol: gem_test_symbol_that_no_library_defines"},
   };
   for (const auto& c : cases) {
@@ -82,6 +83,25 @@ TEST(PluginErrors, EachExitsWithStatus2NamingTheFileAndTheCause) {
     EXPECT_TRUE(contains(text, c.cause)) << text;
     EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
     EXPECT_FALSE(contains(text, "Bad file descriptor")) << "a stale errno, not the cause: " << text;
+  }
+}
+
+// A plugin whose parse function throws a std::runtime_error (where TableReader::fail was meant):
+// refused as bad input naming the scenario, the event's table and the plugin, with its event off
+// as on (every event's table is read); it once ended gem as an internal error naming nothing.
+TEST(PluginErrors, AParseFunctionThatThrowsIsNamedWithItsEventAndPlugin) {
+  TempDir dir;
+  const fs::path log = dir.path() / "log.txt";
+  for (const char* enabled : {"false", "true"}) {
+    SCOPED_TRACE(enabled);
+    const fs::path scenario = dir.write("case.toml", kFloe + "[[plugins]]\npath = \"" + plugin("throws_in_parse") +
+                                                         "\"\n[events.throws_in_parse]\nenabled = " + enabled + "\n");
+    EXPECT_EQ(gem::test::runGem("check " + scenario.string(), log), 2);
+    const std::string text = readFile(log);
+    EXPECT_TRUE(contains(text, "case.toml:11:1: events.throws_in_parse: the plugin's parse function threw")) << text;
+    EXPECT_TRUE(contains(text, "parsing fails on purpose")) << text;
+    EXPECT_TRUE(contains(text, plugin("throws_in_parse"))) << text;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
   }
 }
 
@@ -120,6 +140,38 @@ TEST(PluginErrors, BrokenPluginOnGemPluginPathExits2) {
   EXPECT_TRUE(contains(readFile(log), "libnot_a_plugin.so: not a GEM plugin")) << readFile(log);
   EXPECT_EQ(run("GEM_PLUGIN_PATH=" + (dir.path() / "nowhere").string() + " " GEM_BINARY_DIR "/gem info", log), 2);
   EXPECT_TRUE(contains(readFile(log), "no such folder")) << readFile(log);
+}
+
+// A run whose plugin came from GEM_PLUGIN_PATH records it in its scenario.toml ([[plugins]], by
+// absolute path) and in gem.log: `gem run RUN_DIR/scenario.toml` repeats the run without the
+// variable (it once stopped at "events.floe_friction: unknown event"), and with it set again (the
+// same library is not loaded twice).
+TEST(PluginPath, ARunRecordsThePluginsOfGemPluginPath) {
+  TempDir dir;
+  fs::create_directories(dir.path() / "p");
+  fs::copy_file(plugin("floe_friction"), dir.path() / "p" / "libfloe_friction.so");
+  const fs::path scenario = dir.write("case.toml", kFloe +
+                                                       "[[floes]]\nvertices = [[10.5, 0.0], [20.0, 0.0], [20.0, 10.0], [10.5, 10.0]]\n"
+                                                       "thickness = 0.5\n[events.floe_friction]\nenabled = true\n");
+  const fs::path log = dir.path() / "log";
+  const std::string withPath = "GEM_PLUGIN_PATH=" + (dir.path() / "p").string() + " ";
+  ASSERT_EQ(
+      run(withPath + GEM_BINARY_DIR "/gem run " + scenario.string() + " --quiet --no-plots --out " + (dir.path() / "first").string(), log),
+      0)
+      << readFile(log);
+  const std::string recorded = readFile(dir.path() / "first" / "scenario.toml");
+  EXPECT_TRUE(contains(recorded, "[[plugins]]")) << recorded;
+  EXPECT_TRUE(contains(recorded, (dir.path() / "p" / "libfloe_friction.so").string())) << recorded;
+  EXPECT_TRUE(contains(readFile(dir.path() / "first" / "gem.log"), "libfloe_friction.so (floe_friction 0.1.0), from GEM_PLUGIN_PATH"));
+  for (const std::string& env : {std::string(), withPath}) {
+    SCOPED_TRACE(env);
+    ASSERT_EQ(run(env + GEM_BINARY_DIR "/gem run " + (dir.path() / "first" / "scenario.toml").string() + " --quiet --no-plots --out " +
+                      (dir.path() / "again").string(),
+                  log),
+              0)
+        << readFile(log);
+    EXPECT_EQ(readFile(dir.path() / "first" / "timeseries.csv"), readFile(dir.path() / "again" / "timeseries.csv"));
+  }
 }
 
 // A plugin's "drag" clashes with the built-in (exit 2, both origins named) unless its entry says

@@ -166,6 +166,8 @@ int commandRun(const RunArguments& a) {
     else
       log.say(fmt::format("gem run {}: {} steps of {:.3g} s, backend {}, broadphase {}", a.scenario, s.steps, static_cast<double>(s.dt),
                           sim.backend(), s.broadphase));
+    for (const LoadedPlugin& plugin : loadedPlugins())
+      log.note(fmt::format("  plugin         {}{}", plugin.origin, plugin.fromEnvironment ? ", from GEM_PLUGIN_PATH" : ""));
   };
   try {
     const RunSummary r = resume ? resumeScenario(s, options) : runScenario(s, options);

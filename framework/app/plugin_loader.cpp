@@ -6,8 +6,10 @@
 #include "framework/app/plugin_loader.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <mutex>
 #include <sstream>
 #include <system_error>
@@ -41,6 +43,36 @@ LoaderState& state() {
 
 std::string text(const char* s) { return s ? s : "(null)"; }
 
+// An exception thrown by a plugin's static initializer cannot pass through the dynamic loader:
+// it ends in std::terminate, inside dlopen. While a library loads, the terminate handler reports
+// it as any refused plugin is reported (the file and the cause, exit 2) instead of an abort.
+const char* g_loading = nullptr;  // the file being opened (loads are serialised by LoaderState's mutex)
+
+[[noreturn]] void reportThrowingInitializer() {
+  std::string what = "an exception that is not a std::exception";
+  try {
+    if (const std::exception_ptr e = std::current_exception()) std::rethrow_exception(e);
+  } catch (const std::exception& e) {
+    what = e.what();
+  } catch (...) {}
+  std::fprintf(stderr, "gem: error: plugin %s: cannot be loaded: a static initializer threw while the library loaded: %s\n",
+               g_loading ? g_loading : "?", what.c_str());
+  std::fflush(stderr);
+  std::_Exit(2);
+}
+
+struct TerminateReportsPlugin {
+  std::terminate_handler previous;
+  explicit TerminateReportsPlugin(const std::string& file) {
+    g_loading = file.c_str();
+    previous = std::set_terminate(reportThrowingInitializer);
+  }
+  ~TerminateReportsPlugin() {
+    std::set_terminate(previous);
+    g_loading = nullptr;
+  }
+};
+
 std::string majorOf(const std::string& version) { return version.substr(0, version.find('.')); }
 
 // The CUDA architectures of this GEM's device code; "" when it has no CUDA backend.
@@ -69,7 +101,7 @@ GemPluginDescriptor descriptorOf(const PluginNote& note) {
                              field("compiler_version"), field("gem"), field("name"), field("version")};
 }
 
-const LoadedPlugin& loadLocked(LoaderState& st, const fs::path& given, bool allowOverride) {
+const LoadedPlugin& loadLocked(LoaderState& st, const fs::path& given, bool allowOverride, bool fromEnvironment = false) {
   const std::string file = given.string();
   std::error_code ec;
   if (!fs::exists(given, ec)) throw InputError(fmt::format("plugin {}: no such file", file));
@@ -93,6 +125,7 @@ const LoadedPlugin& loadLocked(LoaderState& st, const fs::path& given, bool allo
 
   boost::dll::shared_library library;
   try {
+    const TerminateReportsPlugin guard(file);
     library.load(path, boost::dll::load_mode::rtld_now);
   } catch (const boost::dll::fs::system_error& e) {
     // Boost.DLL reports dlopen's failure as dlerror()'s text followed by ": " and the message of
@@ -125,7 +158,7 @@ const LoadedPlugin& loadLocked(LoaderState& st, const fs::path& given, bool allo
                     file));
   auto registerAll = library.get<void(Registry*)>("gem_plugin_register");
 
-  LoadedPlugin plugin{path, text(d->name), text(d->version), ""};
+  LoadedPlugin plugin{path, text(d->name), text(d->version), "", fromEnvironment};
   plugin.origin = fmt::format("{} ({} {})", path.string(), plugin.name, plugin.version);
   Registry& registry = Registry::global();
   registry.beginPlugin(plugin.origin, allowOverride);
@@ -198,9 +231,17 @@ void loadEnvironmentPlugins() {
     std::sort(files.begin(), files.end());
     for (const fs::path& f : files) {
       try {
-        loadLocked(st, f, false);
+        loadLocked(st, f, false, true);
       } catch (const InputError& e) {
-        throw InputError(fmt::format("GEM_PLUGIN_PATH: {}", e.what()));
+        // The registry's hint for a clash names a [[plugins]] entry's override, which a plugin of
+        // GEM_PLUGIN_PATH does not have (it never replaces another).
+        std::string message = e.what();
+        const std::string hint = "(to replace it, give the plugin's [[plugins]] entry override = true)";
+        if (const size_t at = message.find(hint); at != std::string::npos)
+          message.replace(at, hint.size(),
+                          "(GEM_PLUGIN_PATH never replaces an entry: keep one of the two in its folders, or load the replacing plugin "
+                          "from a scenario's [[plugins]] entry with override = true)");
+        throw InputError(fmt::format("GEM_PLUGIN_PATH: {}", message));
       }
     }
   }

@@ -12,9 +12,10 @@
 namespace gem {
 
 struct LoadedPlugin {
-  std::filesystem::path path;  // canonical
-  std::string name, version;   // from the descriptor
-  std::string origin;          // "PATH (NAME VERSION)": what gem info shows for its entries
+  std::filesystem::path path;    // canonical
+  std::string name, version;     // from the descriptor
+  std::string origin;            // "PATH (NAME VERSION)": what gem info shows for its entries
+  bool fromEnvironment = false;  // loaded from a folder of GEM_PLUGIN_PATH (first)
 };
 
 // Loads the plugin at `path` (relative to the working folder) and registers what it holds. A path

@@ -28,6 +28,7 @@
 #include "framework/output/ice_file_writer.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/app/interrupt.hpp"
+#include "framework/app/plugin_loader.hpp"
 #include "framework/step/cpu_stepper.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/output/vtk_writer.hpp"
@@ -175,7 +176,10 @@ class ScenarioRun {
     std::vector<std::string> recordFiles;
     for (const RecordOutputEntry* output : Registry::global().recordOutputs()) recordFiles.push_back(output->file);
     clearEarlierRun(m_dir, recordFiles);
-    recordScenario(m_dir, scenario);
+    std::vector<std::filesystem::path> environmentPlugins;
+    for (const LoadedPlugin& plugin : loadedPlugins())
+      if (plugin.fromEnvironment) environmentPlugins.push_back(plugin.path);
+    recordScenario(m_dir, scenario, environmentPlugins);
     m_scenarioChecksum = checksumOf(recordedScenarioText());
 
     auto has = [&](const char* f) { return std::find(out.formats.begin(), out.formats.end(), f) != out.formats.end(); };

@@ -97,8 +97,9 @@ void addMissing(toml::table& into, const toml::table& from) {
 
 }  // namespace
 
-void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) {
+void recordScenario(const std::filesystem::path& dir, const Scenario& scenario, const std::vector<std::filesystem::path>& morePlugins) {
   namespace fs = std::filesystem;
+  std::error_code ec;
   toml::table root = scenario.root;
   // Every key as it took effect, the defaults the scenario left out included: those of its tables
   // (loadScenario) and of every event's parameters (the stepper). Only the keys the choices made
@@ -125,6 +126,18 @@ void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) 
   if (scenario.stopWhen == "distance") sim.insert_or_assign("stop_distance", static_cast<double>(scenario.stopDistance));
   table("output").insert_or_assign("dir", scenario.output.dir.string());
   if (scenario.fieldKind == "file") table("field").insert_or_assign("file", scenario.fieldFile.lexically_normal().string());
+  if (!morePlugins.empty()) {
+    if (!root.contains("plugins")) root.insert("plugins", toml::array{});
+    if (toml::array* listed = root.get("plugins")->as_array()) {
+      for (const fs::path& plugin : morePlugins) {
+        bool already = false;
+        for (const toml::node& entry : *listed)
+          if (const toml::table* t = entry.as_table())
+            if (const auto path = t->get_as<std::string>("path"); path && fs::equivalent(fs::path(path->get()), plugin, ec)) already = true;
+        if (!already) listed->push_back(toml::table{{"path", plugin.string()}, {"override", false}});
+      }
+    }
+  }
   std::ostringstream out;
   out << "# The scenario of this run as gem read it: " << scenario.file.string() << "\n";
   // An override's value may span lines (a sweep's hull vertices): each line stays a comment, or
@@ -137,7 +150,6 @@ void recordScenario(const std::filesystem::path& dir, const Scenario& scenario) 
   out << "# gem " << GEM_VERSION << "; `gem run scenario.toml` repeats the run.\n\n";
   out << toml::toml_formatter{root, toml::toml_formatter::default_flags & ~toml::format_flags::indentation} << "\n";
   // A scenario kept in its own run folder under this name is the user's file: never overwritten.
-  std::error_code ec;
   if (fs::equivalent(dir / "scenario.toml", scenario.file, ec)) return;
   writeFileAtomically(dir / "scenario.toml", out.str());
 }

@@ -34,7 +34,8 @@ void clearRunEnd(const std::filesystem::path& dir);
 // that `gem run dir/scenario.toml` repeats it and loading it gives the same scenario. Left out: a
 // default hull's vertices (drawn from length and beam) and the broadphase settings not given (a
 // setting written down is one a CUDA run must honour). Skipped when dir/scenario.toml is the
-// scenario file itself.
-void recordScenario(const std::filesystem::path& dir, const Scenario& scenario);
+// scenario file itself. `morePlugins`: plugins the run had that the scenario does not list (those
+// of GEM_PLUGIN_PATH), recorded as [[plugins]] entries so that the record runs without the variable.
+void recordScenario(const std::filesystem::path& dir, const Scenario& scenario, const std::vector<std::filesystem::path>& morePlugins = {});
 
 }  // namespace gem

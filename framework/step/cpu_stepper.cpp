@@ -169,6 +169,36 @@ CpuStepper::~CpuStepper() {
   std::fprintf(stderr, "%s\n", line.c_str());
 }
 
+namespace {
+
+// Calls a plugin's parse function (make): what it throws other than an InputError (a
+// std::runtime_error where TableReader::fail was meant, or anything at all) is refused as bad input
+// naming the scenario, the event's table and the plugin, not left to end gem as an internal error
+// that names nothing. A built-in's exception stays an internal error.
+template <class Make>
+auto parsePluginSafely(const EventEntry& entry, const toml::table* table, const std::string& file, Make&& make) {
+  if (entry.origin == "built-in") return make();
+  auto refuse = [&](const std::string& what) {
+    const int line = table ? static_cast<int>(table->source().begin.line) : 0;
+    const int column = table ? static_cast<int>(table->source().begin.column) : 0;
+    return InputError(file, line, column,
+                      fmt::format("events.{}: the plugin's parse function threw instead of reporting through its TableReader: {} "
+                                  "(plugin {})",
+                                  entry.name, what, entry.origin));
+  };
+  try {
+    return make();
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw refuse(e.what());
+  } catch (...) {
+    throw refuse("an exception that is not a std::exception");
+  }
+}
+
+}  // namespace
+
 void CpuStepper::setUp() {
   const char* timing = std::getenv("GEM_CPU_TIMING");
   m_clock.on = timing && timing[0] == '1';
@@ -189,7 +219,8 @@ void CpuStepper::setUp() {
       TableReader reader(table, "events." + entry->name, m_scenario.fileName);
       reader.accept("enabled");
       EventConfig config{reader, m_scenario, m_streams, enabled};
-      auto instance = entry->makeCpu(config);  // parsed even when off, so its table is still checked
+      auto instance = parsePluginSafely(*entry, table, m_scenario.fileName,
+                                        [&] { return entry->makeCpu(config); });  // even when off: its table is checked
       reader.finish();
       if (enabled) m_events.push_back({entry->name, entry->phase, std::move(instance)});
     }
