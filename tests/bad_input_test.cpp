@@ -1,6 +1,7 @@
 // Bad input never crashes and never runs: each case exits with status 2, one clear message that
 // names the file and line (or the key), and leaves no summary.json (the list, item 7).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <fstream>
 #include <string>
@@ -403,6 +404,38 @@ TEST(BadInputCli, AFolderWhereTheRunWritesAFileIsRefusedBeforeAnyWork) {
     EXPECT_NE(text.find((out / name).string() + ": a folder where the run writes its file"), std::string::npos) << text;
     EXPECT_FALSE(std::filesystem::exists(out / "timeseries.csv")) << name;
     EXPECT_FALSE(std::filesystem::is_regular_file(out / "summary.json")) << name;
+  }
+}
+
+// A pipe or a folder where a reader expects a file (the .ice field, impacts.csv read back by gem
+// analyze) is refused at once, exit 2, naming the path: opening the pipe once blocked forever, and
+// the folder ended gem as an internal error in the C++ library's words.
+TEST(BadInputCli, APipeOrAFolderWhereAFileIsReadIsRefusedAtOnce) {
+  TempDir dir;
+  // Under `timeout`: a reader that opens the pipe would wait for a writer that never comes.
+  auto gemWithin30s = [&](const std::string& arguments) {
+    const char* staged = std::getenv("GEM_BINARY_DIR");
+    const int status = std::system(("timeout 30 " + std::string(staged ? staged : GEM_BINARY_DIR) + "/gem " + arguments + " > " +
+                                    (dir.path() / "log").string() + " 2>&1")
+                                       .c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  const std::filesystem::path pipe = dir.path() / "pack.ice";
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  const auto scenario = dir.write("field.toml", std::string(kSim) + "[field]\nkind = \"file\"\nfile = \"pack.ice\"\n");
+  EXPECT_EQ(gemWithin30s("check " + scenario.string()), 2);
+  EXPECT_NE(gem::test::readFile(dir.path() / "log").find(pipe.string() + ": not a regular file"), std::string::npos)
+      << gem::test::readFile(dir.path() / "log");
+  for (const bool folder : {false, true}) {
+    const std::filesystem::path run = dir.path() / (folder ? "run_folder" : "run_pipe");
+    std::filesystem::create_directories(run);
+    if (folder)
+      std::filesystem::create_directories(run / "impacts.csv");
+    else
+      ASSERT_EQ(::mkfifo((run / "impacts.csv").c_str(), 0600), 0);
+    EXPECT_EQ(gemWithin30s("analyze --quiet " + run.string()), 2) << folder;
+    const std::string text = gem::test::readFile(dir.path() / "log");
+    EXPECT_NE(text.find((run / "impacts.csv").string() + (folder ? ": a folder" : ": not a regular file")), std::string::npos) << text;
   }
 }
 

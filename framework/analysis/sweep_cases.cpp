@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include "framework/analysis/sweep_summary.hpp"
+#include "framework/api/input_size.hpp"
 #include "framework/api/errors.hpp"
 #include "framework/output/csv.hpp"
 
@@ -56,6 +57,7 @@ double valueNumber(const toml::table& root, const std::string& key) {
 // case.toml's header: `# Case "NAME" of the sweep FILE (gem sweep)` and `# base: PATH`. A case
 // name cannot hold a quote (sweep_file.cpp), so the first `" of the sweep ` ends it.
 void readCaseHeader(const fs::path& file, SweepCaseInfo& info) {
+  requireRegularFile(file, "case.toml");
   std::ifstream in(file);
   const std::string caseMark = "# Case \"", nameEnd = "\" of the sweep ", baseMark = "# base: ";
   for (std::string line; std::getline(in, line) && line.rfind("#", 0) == 0;) {

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "framework/api/errors.hpp"
+#include "framework/api/input_size.hpp"
 #include "framework/output/atomic_file.hpp"
 #include "framework/output/csv.hpp"
 
@@ -58,6 +59,7 @@ const std::vector<std::pair<std::string, std::string>>& columnKeys() {
 }  // namespace
 
 std::map<std::string, std::string> readSummaryJson(const fs::path& file) {
+  requireRegularFile(file, "summary.json");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError("cannot read " + file.string());
   const std::string text(std::istreambuf_iterator<char>(in), {});

@@ -14,6 +14,20 @@
 
 namespace gem {
 
+// A file a reader opens: refused unless it is a regular file, naming the path and what it is
+// instead. Checked before the open: opening a named pipe blocks until something writes to it
+// (gem analyze once waited forever on an impacts.csv that was a pipe), and a folder fails only at
+// the first read, with the C++ library's words ("basic_filebuf::underflow").
+inline void requireRegularFile(const std::filesystem::path& file, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(file, ec);
+  if (ec || !fs::exists(status)) throw InputError(fmt::format("{}: no such {}", file.string(), what));
+  if (fs::is_directory(status)) throw InputError(fmt::format("{}: a folder, not a {}", file.string(), what));
+  if (!fs::is_regular_file(status))
+    throw InputError(fmt::format("{}: not a regular file (a pipe or a device?), not a {}", file.string(), what));
+}
+
 // expansion: the reader's memory per byte of the file (its text plus what it builds from it).
 inline void requireFitsInMemory(const std::filesystem::path& file, double expansion) {
   std::error_code ec;

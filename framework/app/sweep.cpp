@@ -226,7 +226,10 @@ bool caseCompleted(const fs::path& dir) {
   }
 }
 
+// A file's text; "" for anything but a regular file (a pipe would block the open).
 std::string readText(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) return "";
   std::ifstream in(file, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});
 }

@@ -184,8 +184,7 @@ IceObject parseObject(pugi::xml_node node, bool firstFrame, const SourceMap& src
 }
 
 std::string readWholeFile(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path.string(), 0, 0, "is a directory, not a .ice file");
+  requireRegularFile(path, ".ice file");
   requireFitsInMemory(path, 4);  // the text, and pugixml's tree of it
   errno = 0;
   std::ifstream in(path, std::ios::binary);

@@ -154,6 +154,7 @@ CsvTable parseCsvTable(std::string_view text, const fs::path& file) {
 }
 
 CsvTable readCsvTable(const fs::path& file) {
+  requireRegularFile(file, "CSV file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot be opened");
   requireFitsInMemory(file, 6);  // the text, and its cells as strings
