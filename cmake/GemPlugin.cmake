@@ -48,6 +48,11 @@ function(gem_add_plugin name)
     message(FATAL_ERROR "gem_add_plugin(${name}): give SOURCES (at least the file with GEM_PLUGIN(\"name\", \"version\"))")
   endif()
   add_library(${name} MODULE ${ARG_SOURCES})
+  # Configured without a build type, CMake adds no -O flag: such a plugin would run its events
+  # unoptimised inside an optimised GEM. It gets Release's -O3 then; a build type given wins.
+  if(NOT CMAKE_BUILD_TYPE AND NOT CMAKE_CONFIGURATION_TYPES)
+    target_compile_options(${name} PRIVATE $<$<COMPILE_LANGUAGE:CXX>:-O3>)
+  endif()
   target_link_libraries(${name} PRIVATE gem::gem_core)
   target_compile_definitions(${name} PRIVATE GEM_BUILDING_PLUGIN)
   target_compile_features(${name} PRIVATE cxx_std_20)
