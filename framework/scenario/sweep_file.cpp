@@ -246,6 +246,8 @@ SweepDefinition readSweepFile(const fs::path& file) {
   top.finish();
   if (cases) {
     if (cases->empty()) top.fail("cases", "the list of cases is empty");
+    if (static_cast<long>(cases->size()) > kMaxSweepCases)
+      top.fail("cases", fmt::format("{} cases; a sweep holds at most {} (split it into several sweeps)", cases->size(), kMaxSweepCases));
     for (size_t k = 0; k < cases->size(); ++k) {
       const toml::table* t = cases->get(k)->as_table();
       if (!t) top.failAt(*cases->get(k), "cases: expected [[cases]] tables with name = \"...\" and set = { ... }");
@@ -281,6 +283,14 @@ SweepDefinition readSweepFile(const fs::path& file) {
     entries.push_back(std::move(e));
   }
 
+  // Every [[cases]] entry runs every combination of [parameters]: their product is the sweep's
+  // size, known before a case is made (1,000 entries times 1,000 seeds once grew past 7 GB).
+  const double total = static_cast<double>(entries.size()) * static_cast<double>(combinations.size());
+  if (total > static_cast<double>(kMaxSweepCases))
+    throw InputError(def.fileName, entries.front().line, entries.front().column,
+                     fmt::format("[[cases]] times [parameters]: {} x {} = {:.3g} cases; a sweep holds at most {} (split it into several "
+                                 "sweeps)",
+                                 entries.size(), combinations.size(), total, kMaxSweepCases));
   std::map<std::string, size_t> seen;
   for (const Entry& e : entries) {
     for (const Combination& c : combinations) {
