@@ -8,9 +8,9 @@ namespace gem {
 static ElasticContact::Params parseElasticContact(EventConfig& config) {
   TableReader& t = config.params;
   ElasticContact::Params p{};
-  p.sigmaMax = t.getPositive("sigma_max", Real(1e6));
-  p.stiffness = t.getPositive("k_ice", 100);
-  p.factor = t.getNonNegative("factor", Real(0.05));
+  p.sigmaMax = t.getPositive("sigma_max", Real(1e6), 1e9);  // ice is 1e6 to 1e7 Pa
+  p.stiffness = t.getPositive("k_ice", 100, 1e9);
+  p.factor = t.getRealIn("factor", Real(0.05), 0, 10);
   p.vessel = t.getBool("vessel", false);  // ice-ice only, as the thesis (docs/validation/sensitivity.md)
   return p;
 }

@@ -101,7 +101,7 @@ void FlexuralBreaking::apply(const Params& p, TopologyData& data) {
 
 static FlexuralBreaking::Params parseFlexuralBreaking(EventConfig& config) {
   FlexuralBreaking::Params p{};
-  p.minArea = config.params.getNonNegative("min_area", 1);
+  p.minArea = config.params.getRealIn("min_area", 1, 0, 1e8);
   p.breaks = config.records.open<BreakRequest>(kBreakStream);
   return p;
 }

@@ -11,12 +11,12 @@ namespace gem {
 // kinematics and the flexural limit use the same mu. Default 0.1, as ship_impact's.
 Real shipIceFriction(const Scenario& scenario) {
   TableReader t(scenario.eventTable("ship_impact"), "events.ship_impact", scenario.fileName);
-  return t.getNonNegative("hull_friction", kDefaultHullFriction);
+  return t.getRealIn("hull_friction", kDefaultHullFriction, 0, 10);
 }
 
 static Impact::Params parseImpact(EventConfig& config) {
   Impact::Params p{};
-  p.friction = config.params.getNonNegative("friction", 0);
+  p.friction = config.params.getRealIn("friction", 0, 0, 10);
   p.vesselFriction = shipIceFriction(config.scenario);
   return p;
 }

@@ -26,9 +26,9 @@ static ShipImpact::Params parseShipImpact(EventConfig& config) {
   p.gyrationX2 = Real(0.003) * v.length * v.length;  // A.67-A.69
   p.gyrationY2 = Real(0.05) * v.length * v.length;
   p.gyrationZ2 = Real(0.06) * v.length * v.length;
-  p.pressure = t.getPositive("pressure", Real(1e6));
-  p.flexuralStrength = t.getPositive("flexural_strength", Real(0.5e6));
-  p.hullFriction = t.getNonNegative("hull_friction", kDefaultHullFriction);  // the impact's too (impact.cpp)
+  p.pressure = t.getPositive("pressure", Real(1e6), 1e9);
+  p.flexuralStrength = t.getPositive("flexural_strength", Real(0.5e6), 1e9);
+  p.hullFriction = t.getRealIn("hull_friction", kDefaultHullFriction, 0, 10);  // the impact's too (impact.cpp)
   p.impacts = config.records.open<ImpactRecord>(kImpactStream);
   p.breaks = config.records.open<BreakRequest>(kBreakStream);
   return p;
