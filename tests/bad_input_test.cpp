@@ -448,6 +448,30 @@ TEST(BadInputCli, APipeOrAFolderWhereAFileIsReadIsRefusedAtOnce) {
   }
 }
 
+// Control characters a message quotes from the input are written out (\x1b), not sent to the
+// terminal: a value's escape sequences once retitled and cleared it.
+TEST(BadInputCli, AMessageQuotesControlCharactersAsEscapes) {
+  TempDir dir;
+  const auto scenario = dir.write("esc.toml", "[simulation]\nsteps = 5\nbackend = \"\\u001b]0;pwned\\u0007\\u001b[2J\"\n");
+  EXPECT_EQ(gem::test::runGem("check " + scenario.string(), dir.path() / "log"), 2);
+  const std::string text = gem::test::readFile(dir.path() / "log");
+  EXPECT_NE(text.find("esc.toml:3:"), std::string::npos) << text;
+  EXPECT_NE(text.find("\\x1b]0;pwned\\x07\\x1b[2J"), std::string::npos) << text;
+  EXPECT_EQ(text.find('\x1b'), std::string::npos) << text;
+}
+
+// An output path that is a pipe, a device or a folder is refused (exit 2), not replaced by the
+// file written in its place (gem view --out /dev/full once replaced the device, run as root).
+TEST(BadInputCli, AnOutputPathThatIsAPipeIsRefusedAndKept) {
+  TempDir dir;
+  const std::filesystem::path pipe = dir.path() / "table.csv";
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  EXPECT_EQ(gem::test::runGem("bench --backend cpu --cases 824 --steps 10 --csv " + pipe.string(), dir.path() / "log"), 2);
+  const std::string text = gem::test::readFile(dir.path() / "log");
+  EXPECT_NE(text.find(pipe.string() + ": a pipe, not a file GEM may write"), std::string::npos) << text;
+  EXPECT_TRUE(std::filesystem::is_fifo(pipe));
+}
+
 // A .ice field or a CSV read back whole that could not fit in memory is refused up front, naming
 // the file and its size (a sparse file of 200 GB here): it once grew until std::bad_alloc (exit 1)
 // or swapped for minutes.

@@ -403,6 +403,27 @@ TEST(GemRun, AReusedRunFolderHoldsOnlyItsLastRunAndRecordsItsScenario) {
   EXPECT_EQ(test::readFile(dir.path() / "again" / "state.csv"), test::readFile(out / "state.csv"));
 }
 
+// A reused run folder loses GEM's own files and their temporaries (NAME.tmp-PID of a killed run),
+// never a user's file, whatever its name: every name with ".tmp-" in it once went.
+TEST(GemRun, AReusedRunFolderKeepsTheUsersFilesWhateverTheirNames) {
+  test::TempDir dir;
+  const auto scenario = dir.write("busy.toml", test::kBusyScene);
+  const auto out = dir.path() / "out";
+  std::filesystem::create_directories(out / "frames");
+  for (const char* mine : {"important.tmp-1", "notes.tmp-2.txt", "notes.tmp-", "summary.json.tmp-x", "my.csv.tmp-3"})
+    dir.write(std::string("out/") + mine, "the user's\n");
+  for (const char* stale : {"timeseries.csv.tmp-999999999", "impacts.csv.tmp-999999999", "scenario.toml.tmp-999999999"})
+    dir.write(std::string("out/") + stale, "half a file\n");
+  dir.write("out/frames/frame_000003.vtp.tmp-999999999", "half a frame\n");
+  ASSERT_EQ(test::runGem("run " + scenario.string() + " --quiet --no-plots --steps 5 --out " + out.string(), dir.path() / "log"), 0)
+      << test::readFile(dir.path() / "log");
+  for (const char* mine : {"important.tmp-1", "notes.tmp-2.txt", "notes.tmp-", "summary.json.tmp-x", "my.csv.tmp-3"})
+    EXPECT_EQ(test::readFile(out / mine), "the user's\n") << mine;
+  for (const char* stale : {"timeseries.csv.tmp-999999999", "impacts.csv.tmp-999999999", "scenario.toml.tmp-999999999"})
+    EXPECT_FALSE(std::filesystem::exists(out / stale)) << stale;
+  EXPECT_FALSE(std::filesystem::exists(out / "frames" / "frame_000003.vtp.tmp-999999999"));
+}
+
 // The run's scenario.toml shows the values the scenario left to their defaults (docs/scenario.md
 // 2 documents them): the vessel's size, dof and the speed its thrust gives, the field generator's
 // settings, the output's frame_every and formats; and only those the choices made read.

@@ -4,7 +4,26 @@
 
 namespace gem {
 
-std::string InputError::shorten(const std::string& message) {
+namespace {
+// Control characters of the input a message quotes, written out as \xNN: a value's escape
+// sequences would otherwise reach the terminal (retitle it, clear it) and a NUL would cut the
+// message short where it is printed. Line breaks and tabs stay (several errors, one a line).
+std::string escapeControls(const std::string& message) {
+  std::string out;
+  out.reserve(message.size());
+  for (const char c : message) {
+    const auto u = static_cast<unsigned char>(c);
+    if ((u < 0x20 && c != '\n' && c != '\t') || u == 0x7f)
+      out += fmt::format("\\x{:02x}", u);
+    else
+      out += c;
+  }
+  return out;
+}
+}  // namespace
+
+std::string InputError::shorten(const std::string& raw) {
+  const std::string message = escapeControls(raw);
   if (message.size() <= kMaxMessage) return message;
   const size_t head = kMaxMessage * 2 / 3, tail = kMaxMessage / 4;
   return message.substr(0, head) + fmt::format(" [... {} characters left out ...] ", message.size() - head - tail) +

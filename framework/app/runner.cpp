@@ -417,7 +417,9 @@ class ScenarioRun {
     if (!in.atEnd()) throw InputError(name + ": damaged (bytes past its end)");
     // What the stopped run wrote at its end (summary, state, plots) describes a run that is not
     // over: gone, once the resume is sure to go ahead.
-    clearRunEnd(m_dir);
+    std::vector<std::string> recordFiles;
+    for (const RecordOutputEntry* output : Registry::global().recordOutputs()) recordFiles.push_back(output->file);
+    clearRunEnd(m_dir, recordFiles);
   }
 
   // scenario.toml as the run folder holds it (a checkpoint belongs to that text).

@@ -22,9 +22,22 @@ std::runtime_error writeError(const std::string& what, const std::filesystem::pa
   return std::runtime_error("cannot " + what + " " + path.string() + ": " + reason);
 }
 
+// The place a file is written to holds nothing or a regular file (or a link to one): the rename
+// at commit replaces whatever is there, and a device, a pipe or a folder given as an output path
+// (gem view --out /dev/full, once, as root) must be refused, not replaced by a file.
+void requireFilePlace(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status) || fs::is_regular_file(status)) return;
+  const char* what = fs::is_directory(status) ? "a folder" : fs::is_fifo(status) ? "a pipe" : "a device or other special file";
+  throw InputError(fmt::format("{}: {}, not a file GEM may write (it writes a new file in its place)", path.string(), what));
+}
+
 }  // namespace
 
 AtomicFile::AtomicFile(std::filesystem::path path) : m_path(std::move(path)) {
+  requireFilePlace(m_path);
   m_tempPath = m_path;
   m_tempPath += ".tmp-" + std::to_string(::getpid());
   errno = 0;
@@ -63,6 +76,7 @@ std::filesystem::path adoptForResume(const std::filesystem::path& path, const st
 
 AtomicFile::AtomicFile(std::filesystem::path path, const std::filesystem::path& earlierTemp, std::uint64_t bytes)
     : m_path(std::move(path)) {
+  requireFilePlace(m_path);
   m_tempPath = m_path;
   m_tempPath += ".tmp-" + std::to_string(::getpid());
   adoptForResume(m_path, earlierTemp, m_tempPath, bytes);

@@ -14,58 +14,98 @@
 namespace gem {
 
 namespace {
-void removePlots(const std::filesystem::path& dir, const std::function<bool(const std::filesystem::path&)>& staleTemporary);
+using Predicate = std::function<bool(const std::filesystem::path&)>;
+void removePlots(const std::filesystem::path& dir, const Predicate& staleTemporary);
 
-// Temporaries of another process (an earlier run that was killed), never this run's own.
-bool staleTemporary(const std::filesystem::path& p) {
-  static const std::string own = ".tmp-" + std::to_string(::getpid());
-  const std::string name = p.filename().string();
-  return name.find(".tmp-") != std::string::npos && name.substr(name.size() - std::min(name.size(), own.size())) != own;
+// The outputs of a run that the next run in the folder replaces (besides the record streams' files,
+// the frames and the plots). gem-run.toml: GEM 0.2's name for scenario.toml.
+const std::vector<std::string>& runOutputs() {
+  static const std::vector<std::string> files{"summary.json", "state.csv",    "timeseries.csv", "frames.pvd",   "frames.ice",
+                                              "gem.log",      "gem-run.toml", kMovieFile,       kCheckpointFile};
+  return files;
 }
 
-// Every stale temporary in the folder and in frames/ (plots/ is removePlots').
-void removeStaleTemporaries(const std::filesystem::path& dir) {
+// A temporary of another process (an earlier run that was killed; never this run's own): the name
+// of a file GEM writes there (`isGemFile`) followed by ".tmp-" and a process id, as AtomicFile
+// names them. A user's file stays, whatever its name (important.tmp-1, notes.tmp-2.txt).
+bool staleTemporaryOf(const std::filesystem::path& p, const std::function<bool(const std::string&)>& isGemFile) {
+  static const std::string own = std::to_string(::getpid());
+  const std::string name = p.filename().string();
+  const size_t at = name.rfind(".tmp-");
+  if (at == std::string::npos || at == 0) return false;
+  const std::string pid = name.substr(at + 5);
+  if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos || pid == own) return false;
+  return isGemFile(name.substr(0, at));
+}
+
+// A frame file of frames/: frame_ and digits, .vtp.
+bool isFrameFile(const std::string& name) {
+  return name.size() > 10 && name.rfind("frame_", 0) == 0 && name.compare(name.size() - 4, 4, ".vtp") == 0 &&
+         name.find_first_not_of("0123456789", 6) == name.size() - 4;
+}
+
+// Every stale temporary in the folder (of its files and the record streams', `recordFiles`) and in
+// frames/ (plots/ is removePlots').
+void removeStaleTemporaries(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  for (const fs::path& folder : {dir, dir / "frames"})
-    if (fs::is_directory(folder, ec))
-      for (const auto& entry : fs::directory_iterator(folder, ec))
-        if (entry.is_regular_file(ec) && staleTemporary(entry.path())) fs::remove(entry.path(), ec);
+  auto isRunFile = [&](const std::string& name) {
+    // scenario.toml and a sweep's case.toml are written the same way, though never removed.
+    return name == "scenario.toml" || name == "case.toml" ||
+           std::find(runOutputs().begin(), runOutputs().end(), name) != runOutputs().end() ||
+           std::find(recordFiles.begin(), recordFiles.end(), name) != recordFiles.end();
+  };
+  for (const bool frames : {false, true}) {
+    const fs::path folder = frames ? dir / "frames" : dir;
+    if (!fs::is_directory(folder, ec)) continue;
+    for (const auto& entry : fs::directory_iterator(folder, ec))
+      if (entry.is_regular_file(ec) && staleTemporaryOf(entry.path(), frames ? std::function<bool(const std::string&)>(isFrameFile)
+                                                                             : std::function<bool(const std::string&)>(isRunFile)))
+        fs::remove(entry.path(), ec);
+  }
+}
+
+// A stale temporary of a plot (plots/).
+bool stalePlotTemporary(const std::filesystem::path& p) {
+  return staleTemporaryOf(p, [](const std::string& name) {
+    for (const char* plot : kRunPlotNames)
+      for (const char* extension : {".svg", ".png"})
+        if (name == std::string(plot) + extension) return true;
+    return false;
+  });
 }
 }  // namespace
 
 void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  // gem-run.toml: GEM 0.2's name for scenario.toml. scenario.toml itself is not removed: it is
-  // rewritten whole by recordScenario (and may be the very file this run reads).
-  std::vector<std::string> files{"summary.json", "state.csv",    "timeseries.csv", "frames.pvd",   "frames.ice",
-                                 "gem.log",      "gem-run.toml", kMovieFile,       kCheckpointFile};
-  files.insert(files.end(), recordFiles.begin(), recordFiles.end());
-  for (const std::string& f : files) fs::remove(dir / f, ec);
-  removeStaleTemporaries(dir);
+  // scenario.toml is not removed: it is rewritten whole by recordScenario (and may be the very file
+  // this run reads).
+  for (const std::string& f : runOutputs()) fs::remove(dir / f, ec);
+  for (const std::string& f : recordFiles) fs::remove(dir / f, ec);
+  removeStaleTemporaries(dir, recordFiles);
   const fs::path frames = dir / "frames";
   if (fs::is_directory(frames, ec)) {
     for (const auto& entry : fs::directory_iterator(frames, ec))
       if (entry.path().extension() == ".vtp") fs::remove(entry.path(), ec);
     if (fs::is_empty(frames, ec)) fs::remove(frames, ec);
   }
-  removePlots(dir, staleTemporary);
+  removePlots(dir, stalePlotTemporary);
 }
 
-void clearRunEnd(const std::filesystem::path& dir) {
+void clearRunEnd(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles) {
   std::error_code ec;
   for (const char* f : {"summary.json", "state.csv", kMovieFile}) std::filesystem::remove(dir / f, ec);
   // Called once every file the resume continues is adopted: what temporaries are left are the
   // killed run's half-written ones (a checkpoint cut by kill -9 while it was being written).
-  removePlots(dir, staleTemporary);
-  removeStaleTemporaries(dir);
+  removePlots(dir, stalePlotTemporary);
+  removeStaleTemporaries(dir, recordFiles);
 }
 
 namespace {
 
 // The old plots describe the old run: gone, whether or not this run makes new ones (--no-plots).
-void removePlots(const std::filesystem::path& dir, const std::function<bool(const std::filesystem::path&)>& staleTemporary) {
+void removePlots(const std::filesystem::path& dir, const Predicate& staleTemporary) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path plots = dir / "plots";

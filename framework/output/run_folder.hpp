@@ -19,14 +19,15 @@ inline constexpr const char* kMovieFile = "movie.mp4";
 // Removes GEM's own outputs of an earlier run from dir (never other files): summary.json,
 // state.csv, timeseries.csv, the record streams' files (`recordFiles`), frames.pvd, frames.ice,
 // frames/*.vtp (and frames/ when that leaves it empty), the plots (kRunPlotNames, and plots/ when
-// that leaves it empty), movie.mp4, checkpoint.gem, and *.tmp-PID temporaries. Call it holding the
+// that leaves it empty), movie.mp4, checkpoint.gem, and the temporaries of those files (NAME.tmp-PID,
+// NAME one of them; never another name with .tmp- in it). Call it holding the
 // folder's lock (RunFolderLock): no other run of GEM is writing there.
 void clearEarlierRun(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles);
 
 // A resumed run (gem run --resume): removes what the stopped run wrote when it ended (summary.json,
 // state.csv, the plots, the movie), which describe a run that is not over; its streaming files and
-// frames stay, to be continued.
-void clearRunEnd(const std::filesystem::path& dir);
+// frames stay, to be continued; and the temporaries the stopped run left (as clearEarlierRun).
+void clearRunEnd(const std::filesystem::path& dir, const std::vector<std::string>& recordFiles);
 
 // Writes dir/scenario.toml: the scenario as this run read it (every --set applied, every key of
 // its tables resolved with the default it took where the file gave none, every event's table with
