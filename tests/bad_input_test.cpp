@@ -53,7 +53,7 @@ std::vector<BadCase> badCases() {
       {"group_thicker_than_an_iceberg",
        kSim + kDomain + "[field]\nconcentration = 0.3\ngroups = [{ coverage = 0.3, thickness = 5e3 }]\n",
        {"thickness", "from 0.01 to 1000"}},
-      {"negative_dt", "[simulation]\ndt = -0.1\n", {"simulation.dt", "positive"}},
+      {"negative_dt", "[simulation]\ndt = -0.1\n", {"simulation.dt", "from 1e-06 to 3600, got -0.1"}},
       {"zero_duration", "[simulation]\nduration = 0.0\n", {"simulation.duration", "positive"}},
       {"zero_mass", kSim + "[vessel]\nmass = 0.0\n", {"vessel.mass", "from 1 to 1e+12"}},
       {"overlap",
@@ -87,7 +87,12 @@ std::vector<BadCase> badCases() {
       {"arrays_50000_deep",
        "[simulation]\nx = " + std::string(50000, '[') + std::string(50000, ']') + "\n",
        {"nested more than 64 deep", ":2:"}},
-      {"tiny_dt_overflows_steps", "[simulation]\ndt = 1e-300\n", {"simulation.duration", "more than the 2e9"}},
+      {"tiny_dt", "[simulation]\ndt = 1e-300\n", {"simulation.dt", "from 1e-06 to 3600"}},
+      // 5e-324 s with a step count that fits: 1/dt is inf, and NaN once filled timeseries.csv.
+      {"subnormal_dt", "[simulation]\ndt = 5e-324\nsteps = 10\n", {"simulation.dt", "from 1e-06 to 3600"}},
+      {"duration_over_dt_past_the_step_cap", "[simulation]\ndt = 1e-6\nduration = 1e4\n", {"simulation.duration", "more than the 2e9"}},
+      // 1e-308 m once made walls too thin to be convex, refused naming no key.
+      {"walls_too_thin", kSim + kDomain + "walls = true\nwall_thickness = 1e-308\n", {"domain.wall_thickness", "from 0.01"}},
       {"huge_duration", "[simulation]\nduration = 1e300\n", {"simulation.duration", "more than the 2e9"}},
       {"non_convex_hull",
        kSim + "[vessel]\nvertices = [[-50.0, -10.0], [50.0, -10.0], [0.0, 0.0], [50.0, 10.0], [-50.0, 10.0]]\n"
@@ -98,10 +103,10 @@ std::vector<BadCase> badCases() {
        {"field: about", "floes", "GB"}},
       {"duration_below_one_step", "[simulation]\ndt = 0.1\nduration = 0.01\n", {"simulation.duration", "shorter than one step"}},
       // Values whose derived quantities overflow (the second hostile audit): refused, naming the key.
-      {"huge_dt_makes_the_time_infinite", "[simulation]\ndt = 1e308\nsteps = 5\n", {"simulation.dt", "at most 3600", ":2:"}},
+      {"huge_dt_makes_the_time_infinite", "[simulation]\ndt = 1e308\nsteps = 5\n", {"simulation.dt", "to 3600, got 1e+308", ":2:"}},
       {"huge_thickness_beyond_any_ice", kSim + floe(kSquare, "", "1e308"), {"floes[0].thickness", "from 0.01 to 1000, got 1e+308"}},
       {"domain_beyond_any_field", kSim + "[domain]\nx = [-1e308, 1e308]\ny = [-50.0, 50.0]\nwalls = true\n", {"domain.x", "within"}},
-      {"walls_too_thick", kSim + kDomain + "walls = true\nwall_thickness = 1e308\n", {"domain.wall_thickness", "at most"}},
+      {"walls_too_thick", kSim + kDomain + "walls = true\nwall_thickness = 1e308\n", {"domain.wall_thickness", "to 1e+07, got 1e+308"}},
       {"nul_in_output_dir", kSim + "[output]\ndir = \"a\\u0000b\"\n", {"output.dir", "NUL"}},
       {"empty_hull", kSim + "[vessel]\nvertices = []\nframe_angle_deg = []\n", {"vessel.vertices", "at least 3 vertices, got 0"}},
       // Values that passed gem check and made gem run fail at step 1 with a non-finite state (the

@@ -54,12 +54,18 @@ void applyOverride(toml::table& root, const std::string& assignment) {
 // The largest |coordinate| of a domain's edge, m: far past any ice field (10,000 km), and small enough
 // that the walls' and the field's arithmetic (spans, areas, cell counts) stays finite.
 constexpr Real kMostDomainCoordinate = 1e7;
+// A wall at least a centimetre thick: 1e-308 m made a rectangle too thin to be convex in doubles
+// ("[domain] wall along y0: the polygon is not convex", naming no key).
+constexpr Real kLeastWallThickness = 0.01;  // m
 
 // The vessel's length and beam, and its hull's coordinates (m): from a model in a tank to ten
 // kilometres; the default hull drawn from them stays a convex polygon of finite area.
 constexpr Real kLeastHullSize = Real(0.1), kMostHullSize = 1e4;
 
 constexpr Real kMostDt = 3600;  // s
+// At least a microsecond: the step's forces are impulses over dt, and below about 1e-308 s 1/dt is
+// inf (dt = 5e-324 s once wrote NaN to every ice_force_x of timeseries.csv, exit 0).
+constexpr Real kLeastDt = 1e-6;  // s
 
 Domain readDomain(TableReader& t, const Scenario& s) {
   Domain d = s.domain;
@@ -406,7 +412,7 @@ void readScenarioTables(Scenario& s) {
   {
     TableReader t(top.findTable("simulation"), "simulation", s.fileName);
     // At most an hour: a longer step is no ship-in-ice step, and from 1e300 s the first one overflowed.
-    s.dt = t.getPositive("dt", s.dt, kMostDt);
+    s.dt = t.getRealIn("dt", s.dt, kLeastDt, kMostDt);
     const bool hasSteps = t.has("steps");
     s.duration = t.getPositive("duration", s.duration);
     const std::int64_t steps = t.getInt("steps", 0, 1, 2000000000);
@@ -460,11 +466,9 @@ void readScenarioTables(Scenario& s) {
     // Without walls wall_thickness is read only when given (checked all the same): a run's
     // scenario.toml shows no default that took no effect.
     if (s.walls || t.has("wall_thickness"))
-      s.wallThickness = t.getPositive("wall_thickness", s.wallThickness);
+      s.wallThickness = t.getRealIn("wall_thickness", s.wallThickness, kLeastWallThickness, kMostDomainCoordinate);
     else
       t.accept("wall_thickness");
-    if (s.wallThickness > kMostDomainCoordinate)
-      t.fail("wall_thickness", fmt::format("must be at most {:g} m, got {:g}", kMostDomainCoordinate, s.wallThickness));
     t.finish();
   }
   if (const toml::table* v = top.findTable("vessel")) {
