@@ -147,6 +147,14 @@ std::vector<BadCase> badCases() {
        kSim + "[field]\nkind = \"file\"\nfile = \"spin.ice\"\n",
        {"spin.ice object 0", "angular velocity must be within +-100 rad/s"},
        "spin.ice"},
+      // Floes past +-1e7 m: a square 1e300 m across was refused as "not convex", one 1e15 m out ran.
+      {"ice_file_floe_beyond_any_sea",
+       kSim + "[field]\nkind = \"file\"\nfile = \"far.ice\"\n",
+       {"far.ice object 0", "each vertex coordinate must be within +-1e+07 m"},
+       "far.ice"},
+      {"floe_beyond_any_sea",
+       kSim + floe("[[1e15, 0.0], [1.00000001e15, 0.0], [1.00000001e15, 1e7], [1e15, 1e7]]"),
+       {"floes[0]", "each vertex coordinate must be within +-1e+07 m"}},
       // The hull's own keys are named, not the polygon drawn from them (vessel.vertices was blamed).
       {"vessel_length_beyond_any_ship",
        kSim + "[vessel]\nlength = 1e308\n",
@@ -188,6 +196,9 @@ TEST_P(BadInput, ExitsWithStatus2AndAClearMessageAndWritesNoSummary) {
   dir.write("spin.ice",
             "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 10 0 10 10 0 10</coordinates>"
             "<velocity x=\"0\" y=\"0\" a=\"1e300\"/><thickness>1</thickness></object>\n</frame></iceFloeSim>\n");
+  dir.write("far.ice",
+            "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 1e300 0 1e300 1e300 0 1e300"
+            "</coordinates><thickness>1</thickness></object>\n</frame></iceFloeSim>\n");
   const auto scenario = dir.write("case.toml", c.toml);
   const auto out = dir.path() / "run";
   for (const char* command : {"run", "check"}) {

@@ -53,7 +53,7 @@ void applyOverride(toml::table& root, const std::string& assignment) {
 
 // The largest |coordinate| of a domain's edge, m: far past any ice field (10,000 km), and small enough
 // that the walls' and the field's arithmetic (spans, areas, cell counts) stays finite.
-constexpr Real kMostDomainCoordinate = 1e7;
+constexpr Real kMostDomainCoordinate = kMostCoordinate;
 // A wall at least a centimetre thick: 1e-308 m made a rectangle too thin to be convex in doubles
 // ("[domain] wall along y0: the polygon is not convex", naming no key).
 constexpr Real kLeastWallThickness = 0.01;  // m

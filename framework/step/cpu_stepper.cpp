@@ -26,9 +26,14 @@ void validateBodySpec(BodySpec& spec, int maxVertices) {
   const int n = static_cast<int>(spec.vertices.size());
   if (n < 3 || n > maxVertices)
     throw InputError(fmt::format("{}: a {} needs 3 to {} vertices, got {}", spec.origin, bodyKindName(spec.kind), maxVertices, n));
-  for (const Vec2& v : spec.vertices)
+  for (const Vec2& v : spec.vertices) {
     if (!std::isfinite(v.x) || !std::isfinite(v.y))
       throw InputError(fmt::format("{}: vertex coordinates must be finite numbers", spec.origin));
+    // Walls are made from the domain's edges, which are checked, and reach a little past them.
+    if (spec.kind != BodyKind::Wall && !(std::fabs(v.x) <= kMostCoordinate && std::fabs(v.y) <= kMostCoordinate))
+      throw InputError(
+          fmt::format("{}: each vertex coordinate must be within +-{:g} m, got ({:g}, {:g})", spec.origin, kMostCoordinate, v.x, v.y));
+  }
   if (!std::isfinite(spec.velocity.x) || !std::isfinite(spec.velocity.y) || !std::isfinite(spec.angularVelocity))
     throw InputError(fmt::format("{}: velocity must be finite", spec.origin));
   // A body starts no faster than any ship or floe could (a .ice field's objects too): beyond it

@@ -17,4 +17,9 @@ constexpr Real kMostStartAngularSpeed = 100;
 // A floe's thickness, m: from young ice of a centimetre to an iceberg. Thinner, a floe's mass and
 // moment of inertia become so small that the first impulse on it overflowed the step.
 constexpr Real kLeastIceThickness = Real(0.01), kMostIceThickness = 1000;
+
+// The farthest from the origin a coordinate of the domain, the vessel or a floe may be, m: ten
+// thousand kilometres. Past it the geometry's tolerances (relative to the coordinates) swallow a
+// floe's shape: a floe 1e300 m out was refused as "not convex" instead of by its coordinates.
+constexpr Real kMostCoordinate = 1e7;
 }  // namespace gem
