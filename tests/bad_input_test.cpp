@@ -488,6 +488,23 @@ TEST(BadInputCli, AnOutputPathThatIsAPipeIsRefusedAndKept) {
   EXPECT_TRUE(std::filesystem::is_fifo(pipe));
 }
 
+// gem plot and gem movie name what is wrong with the run folder or the picture's name: a file
+// given as the run folder was "no such run folder", and --still --out x.jpg said "--still needs
+// --out FILE.png" though --out was given.
+TEST(BadInputCli, RunFolderCommandsSayWhatIsWrongWithTheirPaths) {
+  TempDir dir;
+  const auto file = dir.write("a.toml", kSim);
+  EXPECT_EQ(gem::test::runGem("plot " + file.string(), dir.path() / "log"), 2);
+  EXPECT_NE(gem::test::readFile(dir.path() / "log").find(file.string() + ": a file, not a run folder"), std::string::npos)
+      << gem::test::readFile(dir.path() / "log");
+  EXPECT_EQ(gem::test::runGem("movie " + (dir.path() / "nowhere").string(), dir.path() / "log"), 2);
+  EXPECT_NE(gem::test::readFile(dir.path() / "log").find("nowhere: no such run folder"), std::string::npos)
+      << gem::test::readFile(dir.path() / "log");
+  EXPECT_EQ(gem::test::runGem("movie " + dir.path().string() + " --still 0 --out x.jpg", dir.path() / "log"), 2);
+  EXPECT_NE(gem::test::readFile(dir.path() / "log").find("--out x.jpg: --still writes a PNG picture"), std::string::npos)
+      << gem::test::readFile(dir.path() / "log");
+}
+
 // A .ice field or a CSV read back whole that could not fit in memory is refused up front, naming
 // the file and its size (a sparse file of 200 GB here): it once grew until std::bad_alloc (exit 1)
 // or swapped for minutes.

@@ -18,6 +18,7 @@
 #include "framework/analysis/frame_picture.hpp"
 #include "framework/analysis/frame_series.hpp"
 #include "framework/api/errors.hpp"
+#include "framework/api/input_size.hpp"
 #include "framework/output/run_folder.hpp"
 
 namespace gem {
@@ -124,9 +125,10 @@ MovieResult writeMovie(const MovieOptions& o) {
   const auto [width, height] = parseSize(o.size);
   if (o.fps < 1 || o.fps > 240) throw InputError(fmt::format("--fps {}: expected 1 to 240 frames per second", o.fps));
   const FrameColor color = parseFrameColor(o.color);
-  if (o.still && (o.out.empty() || o.out.extension() != ".png"))
-    throw InputError("--still needs --out FILE.png: where to write the picture");
-  if (!fs::is_directory(o.runDir)) throw InputError(o.runDir.string() + ": no such run folder");
+  if (o.still && o.out.empty()) throw InputError("--still needs --out FILE.png: where to write the picture");
+  if (o.still && o.out.extension() != ".png" && o.out.extension() != ".PNG")
+    throw InputError(fmt::format("--out {}: --still writes a PNG picture: give a name ending in .png", o.out.string()));
+  requireFolder(o.runDir, "run folder");
   const fs::path ice = o.runDir / "frames.ice";
   if (!fs::exists(ice))
     throw InputError(

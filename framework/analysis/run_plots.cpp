@@ -9,6 +9,7 @@
 #include "framework/output/csv.hpp"
 #include "framework/analysis/svg_plot.hpp"
 #include "framework/api/errors.hpp"
+#include "framework/api/input_size.hpp"
 #include "framework/output/run_folder.hpp"
 
 namespace gem {
@@ -137,7 +138,7 @@ void plotImpacts(const fs::path& runDir, Writer& write, RunPlots& result) {
 }  // namespace
 
 RunPlots writeRunPlots(const fs::path& runDir) {
-  if (!fs::is_directory(runDir)) throw InputError(runDir.string() + ": no such run folder");
+  requireFolder(runDir, "run folder");
   if (!fs::exists(runDir / "timeseries.csv"))
     throw InputError(runDir.string() + ": not a run folder (no timeseries.csv; `gem run SCENARIO --out DIR` makes one)");
   RunPlots result;

@@ -28,6 +28,14 @@ inline void requireRegularFile(const std::filesystem::path& file, const std::str
     throw InputError(fmt::format("{}: not a regular file (a pipe or a device?), not a {}", file.string(), what));
 }
 
+// A folder a command reads (a run folder, a sweep's): refused when it is missing or a file.
+inline void requireFolder(const std::filesystem::path& dir, const std::string& what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(dir, ec)) return;
+  if (std::filesystem::exists(dir, ec)) throw InputError(fmt::format("{}: a file, not a {}", dir.string(), what));
+  throw InputError(fmt::format("{}: no such {}", dir.string(), what));
+}
+
 // expansion: the reader's memory per byte of the file (its text plus what it builds from it).
 inline void requireFitsInMemory(const std::filesystem::path& file, double expansion) {
   std::error_code ec;
