@@ -325,6 +325,14 @@ TEST(SweepSummary, ReadsGemJson) {
   EXPECT_EQ(std::stod(escaped.at("n")), 1000.0);
   EXPECT_THROW(readSummaryJson(dir.write("bad.json", "{\"a\": }")), InputError);  // bad input: exit 2
   EXPECT_THROW(readSummaryJson(dir.write("empty.json", "")), InputError);
+  // A value of summary.csv that is not a number: not GEM's summary (it once reached the CSV).
+  try {
+    readSummaryJson(dir.write("tampered.json", R"({"completed": true, "impacts": "lots"})"));
+    ADD_FAILURE() << "\"impacts\": \"lots\" was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("\"impacts\" is \"lots\", not a number"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(readSummaryJson(dir.write("nested.json", R"({"ship_speed": {"min": [1]}})")), InputError);
   // Nested 50,000 deep (a damaged file in a sweep being resumed): refused, not a stack overflow.
   std::string deep = "{\"a\": ";
   for (int k = 0; k < 50000; ++k) deep += "{\"a\": ";

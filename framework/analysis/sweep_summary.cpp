@@ -78,6 +78,19 @@ std::map<std::string, std::string> readSummaryJson(const fs::path& file) {
     throw malformed(e.what());
   }
   if (!root.is_object()) throw malformed("expected an object {...}");
+  // The values summary.csv takes are numbers (or null): a case whose summary says "impacts":
+  // "lots" is not a finished case, and "lots" once reached a numeric column of summary.csv.
+  for (const auto& [column, key] : columnKeys()) {
+    const nlohmann::json* value = &root;
+    for (size_t at = 0; value && at <= key.size();) {
+      const size_t dot = std::min(key.find('.', at), key.size());
+      const auto it = value->is_object() ? value->find(key.substr(at, dot - at)) : value->end();
+      value = value->is_object() && it != value->end() ? &*it : nullptr;
+      at = dot + 1;
+    }
+    if (value && !value->is_number() && !value->is_null())
+      throw malformed(fmt::format("\"{}\" is {}, not a number", key, value->dump().substr(0, 40)));
+  }
   std::map<std::string, std::string> out;
   flatten(root, "", out);
   return out;
