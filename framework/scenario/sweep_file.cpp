@@ -118,6 +118,10 @@ struct Combination {
 // and a gigabyte only to read (a fuzzing finding, docs/reliability.md); no study needs that many.
 constexpr long kMaxSweepCases = 100000;
 
+// A count of cases as a message gives it: exact (100001, not the "1e+05" that reads as the cap
+// itself) up to 1e15, then in powers of ten.
+std::string caseCount(double count) { return count < 1e15 ? fmt::format("{:.0f}", count) : fmt::format("{:.3g}", count); }
+
 std::vector<Combination> expandParameters(const std::vector<Leaf>& parameters, const TableReader& reader) {
   std::vector<Combination> out;
   if (parameters.empty()) return {Combination{}};
@@ -135,8 +139,8 @@ std::vector<Combination> expandParameters(const std::vector<Leaf>& parameters, c
   for (const toml::array* list : lists) product *= static_cast<double>(list->size());
   if (product > static_cast<double>(kMaxSweepCases))
     reader.failAt(*parameters.front().node,
-                  fmt::format("parameters: their product is {:.3g} cases; a sweep holds at most {} (split it into several sweeps)", product,
-                              kMaxSweepCases));
+                  fmt::format("parameters: their product is {} cases; a sweep holds at most {} (split it into several sweeps)",
+                              caseCount(product), kMaxSweepCases));
   std::vector<std::string> names = shortKeys;
   for (size_t i = 0; i < shortKeys.size(); ++i)
     if (std::count(shortKeys.begin(), shortKeys.end(), shortKeys[i]) > 1) names[i] = parameters[i].key;
@@ -288,9 +292,9 @@ SweepDefinition readSweepFile(const fs::path& file) {
   const double total = static_cast<double>(entries.size()) * static_cast<double>(combinations.size());
   if (total > static_cast<double>(kMaxSweepCases))
     throw InputError(def.fileName, entries.front().line, entries.front().column,
-                     fmt::format("[[cases]] times [parameters]: {} x {} = {:.3g} cases; a sweep holds at most {} (split it into several "
+                     fmt::format("[[cases]] times [parameters]: {} x {} = {} cases; a sweep holds at most {} (split it into several "
                                  "sweeps)",
-                                 entries.size(), combinations.size(), total, kMaxSweepCases));
+                                 entries.size(), combinations.size(), caseCount(total), kMaxSweepCases));
   std::map<std::string, size_t> seen;
   for (const Entry& e : entries) {
     for (const Combination& c : combinations) {
