@@ -83,6 +83,25 @@ TEST(Checkpoint, ASignalLeavesACheckpointAndTwoResumesMakeTheWholeRun) {
   expectSameRun(whole, part);
 }
 
+// A resume killed outright (kill -9, a crash, a batch system's hard limit) before it wrote a
+// checkpoint of its own had already taken the stopped run's files over under its own temporary
+// names, which the checkpoint does not know: the next resume finds them there and still ends as
+// the run that was never stopped (it once refused: "timeseries.csv is missing", for ever).
+TEST(Checkpoint, AResumeKilledBeforeItsFirstCheckpointCanBeResumed) {
+  TempDir dir;
+  const auto scenario = dir.write("busy.toml", kBusyScene);
+  const auto whole = dir.path() / "whole", part = dir.path() / "part";
+  ASSERT_EQ(test::runGem("run " + scenario.string() + kRunOptions + " --out " + whole.string(), dir.path() / "log"), 0);
+  ASSERT_EQ(shell(gemBinary() + " run " + scenario.string() + kRunOptions + " --out " + part.string() + " > /dev/null 2>&1 & p=$!; " +
+                  waitFor(part / "frames/frame_000003.vtp") + "kill -TERM $p; wait $p"),
+            143);
+  ASSERT_EQ(shell(gemBinary() + " run --resume " + part.string() + " --quiet --no-plots > /dev/null 2>&1 & p=$!; " +
+                  waitFor(part / "frames/frame_000010.vtp") + "kill -9 $p; wait $p"),
+            137);
+  ASSERT_EQ(test::runGem("run --resume " + part.string() + " --quiet --no-plots", dir.path() / "log"), 0) << readFile(dir.path() / "log");
+  expectSameRun(whole, part);
+}
+
 // What cannot be resumed is refused with exit 2 and a message naming the file: no checkpoint, a
 // damaged or cut one, a scenario.toml changed since, a folder that is no run's, and options that
 // would make it another run.

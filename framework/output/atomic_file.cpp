@@ -2,11 +2,13 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -61,7 +63,26 @@ std::filesystem::path adoptForResume(const std::filesystem::path& path, const st
                                      const std::filesystem::path& ownTemp, std::uint64_t bytes) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  const fs::path source = fs::is_regular_file(earlierTemp, ec) ? earlierTemp : fs::is_regular_file(path, ec) ? path : fs::path();
+  fs::path source = fs::is_regular_file(earlierTemp, ec) ? earlierTemp : fs::is_regular_file(path, ec) ? path : fs::path();
+  // A resume killed before its first checkpoint had already taken the file over under its own
+  // temporary name (NAME.tmp-ITSPID), which the checkpoint does not know: that file starts with the
+  // same bytes (it only ran on past them), so it serves as well. Without this the folder could
+  // never be resumed again.
+  if (source.empty()) {
+    // The recorded temporary's name without its process id: NAME.tmp-, or a writer's own infix.
+    std::string prefix = earlierTemp.filename().string();
+    prefix.erase(prefix.find_last_not_of("0123456789") + 1);
+    std::vector<fs::path> candidates;
+    for (const auto& entry : fs::directory_iterator(path.parent_path().empty() ? fs::path(".") : path.parent_path(), ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name.size() > prefix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
+          name.find_first_not_of("0123456789", prefix.size()) == std::string::npos && entry.is_regular_file(ec) &&
+          fs::file_size(entry.path(), ec) >= bytes && !ec)
+        candidates.push_back(entry.path());
+    }
+    std::sort(candidates.begin(), candidates.end());
+    if (!candidates.empty()) source = candidates.front();
+  }
   if (source.empty())
     throw InputError("cannot resume: " + path.string() + " is missing (neither it nor " + earlierTemp.filename().string() +
                      ", which the stopped run was writing, is there)");
