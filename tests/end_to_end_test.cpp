@@ -329,14 +329,14 @@ TEST(GemRun, ARunFolderInUseIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(out / ".gem-run.lock"));
 }
 
-// SIGTERM and Ctrl-C stop a run between two steps: exit 128 + the signal, a message, the CSVs whole
+// SIGTERM, Ctrl-C and SIGHUP stop a run between two steps: exit 128 + the signal, a message, the CSVs whole
 // under their final names, no temporary left behind, and a summary.json of the steps run that says
 // the run did not complete (and why); gem.log records the exit status.
 class GemRunSignal : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(GemRunSignal, KeepsTheFilesWholeAndSaysSo) {
   const std::string signal = GetParam();
-  const int number = signal == "INT" ? 2 : 15;
+  const int number = signal == "INT" ? 2 : signal == "HUP" ? 1 : 15;
   test::TempDir dir;
   const auto scenario = dir.write("busy.toml", test::kBusyScene);
   const auto out = dir.path() / "out";
@@ -348,7 +348,7 @@ TEST_P(GemRunSignal, KeepsTheFilesWholeAndSaysSo) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 128 + number) << test::readFile(dir.path() / "log");
   const std::string log = test::readFile(dir.path() / "log");
-  EXPECT_NE(log.find(signal == "INT" ? "interrupted (Ctrl-C)" : "interrupted (SIGTERM)"), std::string::npos) << log;
+  EXPECT_NE(log.find(signal == "INT" ? "interrupted (Ctrl-C)" : "interrupted (SIG" + signal + ")"), std::string::npos) << log;
   const std::string series = test::readFile(out / "timeseries.csv");
   EXPECT_EQ(series.rfind("t,", 0), 0u);
   EXPECT_EQ(series.back(), '\n');  // whole rows
@@ -367,7 +367,9 @@ TEST_P(GemRunSignal, KeepsTheFilesWholeAndSaysSo) {
     EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
 }
 
-INSTANTIATE_TEST_SUITE_P(Signals, GemRunSignal, ::testing::Values("TERM", "INT"));
+// HUP: a closed terminal (it once killed the run outright, with no checkpoint and its rows left in
+// temporaries).
+INSTANTIATE_TEST_SUITE_P(Signals, GemRunSignal, ::testing::Values("TERM", "INT", "HUP"));
 
 // A reused run folder describes only its last run: a re-run with frames off leaves none of the
 // earlier run's frames; the folder records the scenario as read (scenario.toml, overrides applied,

@@ -14,6 +14,10 @@ extern "C" void onInterrupt(int signal) { g_signal = signal; }
 void catchInterrupts() {
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
+  // A closed terminal (SIGHUP) stops the run as SIGTERM does, with a checkpoint and whole files:
+  // it once killed the run outright. Unless SIGHUP is ignored (`nohup gem run ...`): then the run
+  // is meant to outlive its terminal, and goes on.
+  if (std::signal(SIGHUP, onInterrupt) == SIG_IGN) std::signal(SIGHUP, SIG_IGN);
 }
 
 int interruptSignal() { return g_signal; }
@@ -24,7 +28,10 @@ void stopIfInterrupted(long step) {
   throw Interrupted(
       signal,
       fmt::format("interrupted ({}) after step {}: the files written so far are kept, whole; summary.json says \"completed\": false",
-                  signal == SIGINT ? "Ctrl-C" : "SIGTERM", step));
+                  signal == SIGINT   ? "Ctrl-C"
+                  : signal == SIGHUP ? "SIGHUP"
+                                     : "SIGTERM",
+                  step));
 }
 
 }  // namespace gem

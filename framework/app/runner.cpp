@@ -470,7 +470,7 @@ class ScenarioRun {
 
 // "SIGINT", "SIGTERM": the stop reason of a run a signal ended.
 std::string signalName(int signal) {
-  return signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : fmt::format("signal {}", signal);
+  return signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : signal == SIGHUP ? "SIGHUP" : fmt::format("signal {}", signal);
 }
 
 }  // namespace
