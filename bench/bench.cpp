@@ -115,6 +115,11 @@ CaseKey parseCase(const std::string& key) {
         fmt::format("gem bench --cases {}: valid cases are 456, 824 (the thesis fields) or a floe count "
                     "from 10 to 10^7 (random convex floes at 40 %), e.g. 10000 100000 1000000",
                     key));
+  // A field this machine could not hold is refused before it is generated (10^7 floes want about
+  // 30 GB: on a 24 GB machine it grew for minutes).
+  if (fieldMemoryNeed(static_cast<double>(n)) > 0.8 * machineMemory())
+    throw InputError(fmt::format("gem bench --cases {}: {} floes need about {:.3g} GB; this machine has {:.3g} GB: give fewer floes", key,
+                                 n, fieldMemoryNeed(static_cast<double>(n)) / 1e9, machineMemory() / 1e9));
   int power = 0;
   for (long m = n; m % 10 == 0 && m > 1; m /= 10) ++power;
   const bool powerOfTen = n == static_cast<long>(std::llround(std::pow(10.0, power)));

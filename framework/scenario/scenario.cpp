@@ -87,33 +87,6 @@ Domain readDomain(TableReader& t, const Scenario& s) {
   return d;
 }
 
-// A generated field's size is known before it is made: refuse one that could not fit in this
-// machine's memory, with the estimate, instead of growing until std::bad_alloc (docs/scenario.md).
-// About 3 KB a floe: its polygon and state, and the step's per-body and per-contact buffers.
-void checkFieldMemory(const Scenario& s) {
-  if (s.fieldKind != "random_convex" && s.fieldKind != "hexagons") return;
-  const double area = (static_cast<double>(s.domain.x1) - s.domain.x0) * (static_cast<double>(s.domain.y1) - s.domain.y0);
-  double floes = 0;
-  if (s.fieldKind == "hexagons") {
-    floes = s.hexagonField.count > 0
-                ? s.hexagonField.count
-                : area * s.hexagonField.concentration / (static_cast<double>(s.hexagonField.size) * s.hexagonField.size);
-  } else {
-    const RandomFieldSpec& r = s.randomField;
-    const double meanArea = static_cast<double>(r.sizeMean) * r.sizeMean + static_cast<double>(r.sizeSd) * r.sizeSd;
-    floes = r.count > 0 ? r.count : area * r.concentration / meanArea;
-  }
-  constexpr double kBytesPerFloe = 3072;
-  const double need = floes * kBytesPerFloe;
-  const double have = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
-  if (need > 0.8 * have || floes > 2e8)
-    throw InputError(
-        s.fileName, 0, 0,
-        fmt::format("field: about {:.3g} floes (the domain's {:.3g} m^2 x concentration / floe area), which need about {:.3g} GB; "
-                    "this machine has {:.3g} GB: make the [domain] smaller or the floes larger",
-                    floes, area, need / 1e9, have / 1e9));
-}
-
 void readField(TableReader& t, Scenario& s) {
   s.fieldKind = t.getChoice("kind", "random_convex", {"random_convex", "hexagons", "file"});
   if (s.fieldKind == "file") {
@@ -395,6 +368,35 @@ void readBroadphaseTables(const toml::table& tables, Scenario& s) {
 }
 
 }  // namespace
+
+double fieldMemoryNeed(double floes) { return floes * 3072; }
+
+double machineMemory() { return static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)); }
+
+// A generated field's size is known before it is made: refuse one that could not fit in this
+// machine's memory, with the estimate, instead of growing until std::bad_alloc (docs/scenario.md).
+// About 3 KB a floe: its polygon and state, and the step's per-body and per-contact buffers.
+void checkFieldMemory(const Scenario& s) {
+  if (s.fieldKind != "random_convex" && s.fieldKind != "hexagons") return;
+  const double area = (static_cast<double>(s.domain.x1) - s.domain.x0) * (static_cast<double>(s.domain.y1) - s.domain.y0);
+  double floes = 0;
+  if (s.fieldKind == "hexagons") {
+    floes = s.hexagonField.count > 0
+                ? s.hexagonField.count
+                : area * s.hexagonField.concentration / (static_cast<double>(s.hexagonField.size) * s.hexagonField.size);
+  } else {
+    const RandomFieldSpec& r = s.randomField;
+    const double meanArea = static_cast<double>(r.sizeMean) * r.sizeMean + static_cast<double>(r.sizeSd) * r.sizeSd;
+    floes = r.count > 0 ? r.count : area * r.concentration / meanArea;
+  }
+  const double need = fieldMemoryNeed(floes), have = machineMemory();
+  if (need > 0.8 * have || floes > 2e8)
+    throw InputError(
+        s.fileName, 0, 0,
+        fmt::format("field: about {:.3g} floes (the domain's {:.3g} m^2 x concentration / floe area), which need about {:.3g} GB; "
+                    "this machine has {:.3g} GB: make the [domain] smaller or the floes larger",
+                    floes, area, need / 1e9, have / 1e9));
+}
 
 const toml::table* Scenario::eventTable(const std::string& name) const {
   const toml::table* events = (document ? *document : root)["events"].as_table();

@@ -107,6 +107,14 @@ struct Scenario {
 // word is taken as a string). outDir, when not empty, replaces output.dir.
 Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
 
+// Refuses a generated field (random_convex, hexagons) that could not fit in this machine's memory,
+// with the estimate (loadScenario calls it).
+void checkFieldMemory(const Scenario& s);
+// The memory a run of `floes` floes needs, bytes: about 3 KB a floe (its polygon and state, and the
+// step's per-body and per-contact buffers); and this machine's memory, bytes.
+double fieldMemoryNeed(double floes);
+double machineMemory();
+
 // The thesis's open-water speed for a bollard thrust (interpolated in log-log), m/s.
 Real openWaterSpeedFor(Real bollardThrust);
 
