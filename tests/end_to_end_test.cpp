@@ -414,14 +414,16 @@ TEST(GemRun, AReusedRunFolderKeepsTheUsersFilesWhateverTheirNames) {
   std::filesystem::create_directories(out / "frames");
   for (const char* mine : {"important.tmp-1", "notes.tmp-2.txt", "notes.tmp-", "summary.json.tmp-x", "my.csv.tmp-3"})
     dir.write(std::string("out/") + mine, "the user's\n");
-  for (const char* stale : {"timeseries.csv.tmp-999999999", "impacts.csv.tmp-999999999", "scenario.toml.tmp-999999999"})
+  for (const char* stale :
+       {"timeseries.csv.tmp-999999999", "impacts.csv.tmp-999999999", "scenario.toml.tmp-999999999", "frames.ice.frames.tmp-999999999"})
     dir.write(std::string("out/") + stale, "half a file\n");
   dir.write("out/frames/frame_000003.vtp.tmp-999999999", "half a frame\n");
   ASSERT_EQ(test::runGem("run " + scenario.string() + " --quiet --no-plots --steps 5 --out " + out.string(), dir.path() / "log"), 0)
       << test::readFile(dir.path() / "log");
   for (const char* mine : {"important.tmp-1", "notes.tmp-2.txt", "notes.tmp-", "summary.json.tmp-x", "my.csv.tmp-3"})
     EXPECT_EQ(test::readFile(out / mine), "the user's\n") << mine;
-  for (const char* stale : {"timeseries.csv.tmp-999999999", "impacts.csv.tmp-999999999", "scenario.toml.tmp-999999999"})
+  for (const char* stale :
+       {"timeseries.csv.tmp-999999999", "impacts.csv.tmp-999999999", "scenario.toml.tmp-999999999", "frames.ice.frames.tmp-999999999"})
     EXPECT_FALSE(std::filesystem::exists(out / stale)) << stale;
   EXPECT_FALSE(std::filesystem::exists(out / "frames" / "frame_000003.vtp.tmp-999999999"));
 }

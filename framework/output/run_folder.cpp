@@ -50,8 +50,9 @@ void removeStaleTemporaries(const std::filesystem::path& dir, const std::vector<
   namespace fs = std::filesystem;
   std::error_code ec;
   auto isRunFile = [&](const std::string& name) {
-    // scenario.toml and a sweep's case.toml are written the same way, though never removed.
-    return name == "scenario.toml" || name == "case.toml" ||
+    // scenario.toml and a sweep's case.toml are written the same way, though never removed;
+    // frames.ice's writer keeps its frames in frames.ice.frames.tmp-PID (ice_file_writer.cpp).
+    return name == "scenario.toml" || name == "case.toml" || name == "frames.ice.frames" ||
            std::find(runOutputs().begin(), runOutputs().end(), name) != runOutputs().end() ||
            std::find(recordFiles.begin(), recordFiles.end(), name) != recordFiles.end();
   };
