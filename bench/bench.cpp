@@ -189,6 +189,9 @@ class Table {
       : m_name(std::move(name)), m_param(std::move(paramColumn)), m_csvPath(std::move(csvPath)) {
     m_csv = "case,backend,broadphase," + (m_param.empty() ? "" : m_param + ",") +
             "bodies,floes,ms_per_step,steps_per_s,floe_steps_per_s,real_time_factor,device\n";
+    // The header at once: a CSV path that cannot be written (a pipe, a folder, no such folder) is
+    // refused before any case runs, not after the first one.
+    if (!m_csvPath.empty()) writeFileAtomically(m_csvPath, m_csv);
   }
   void printHeader() const {
     std::printf("%-20s %-7s %-18s ", "case", "backend", "broadphase");

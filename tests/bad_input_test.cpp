@@ -486,6 +486,7 @@ TEST(BadInputCli, AnOutputPathThatIsAPipeIsRefusedAndKept) {
   EXPECT_EQ(gem::test::runGem("bench --backend cpu --cases 824 --steps 10 --csv " + pipe.string(), dir.path() / "log"), 2);
   const std::string text = gem::test::readFile(dir.path() / "log");
   EXPECT_NE(text.find(pipe.string() + ": a pipe, not a file GEM may write"), std::string::npos) << text;
+  EXPECT_EQ(text.find("ms/step"), std::string::npos) << "refused before any case ran: " << text;
   EXPECT_TRUE(std::filesystem::is_fifo(pipe));
 }
 

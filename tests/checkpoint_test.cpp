@@ -102,6 +102,23 @@ TEST(Checkpoint, AResumeKilledBeforeItsFirstCheckpointCanBeResumed) {
   expectSameRun(whole, part);
 }
 
+// A run folder whose frames were deleted after the stop cannot be resumed: the resume once went on
+// and wrote a frames.pvd listing thousands of frames that no longer existed.
+TEST(Checkpoint, AResumeRefusesAFolderWhoseFramesAreGone) {
+  TempDir dir;
+  const auto scenario = dir.write("busy.toml", kBusyScene);
+  const auto part = dir.path() / "part";
+  ASSERT_EQ(shell(gemBinary() + " run " + scenario.string() + kRunOptions + " --out " + part.string() + " > /dev/null 2>&1 & p=$!; " +
+                  waitFor(part / "frames/frame_000003.vtp") + "kill -INT $p; wait $p"),
+            130);
+  std::filesystem::remove_all(part / "frames");
+  EXPECT_EQ(test::runGem("run --resume " + part.string() + " --quiet --no-plots", dir.path() / "log"), 2);
+  const std::string text = readFile(dir.path() / "log");
+  EXPECT_NE(text.find("cannot resume: " + (part / "frames/frame_000000.vtp").string() + " is missing"), std::string::npos) << text;
+  // Refused before anything of the stopped run was touched: its summary still says it stopped.
+  EXPECT_EQ(readSummaryJson(part / "summary.json").at("completed"), "false");
+}
+
 // What cannot be resumed is refused with exit 2 and a message naming the file: no checkpoint, a
 // damaged or cut one, a scenario.toml changed since, a folder that is no run's, and options that
 // would make it another run.

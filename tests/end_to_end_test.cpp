@@ -329,6 +329,22 @@ TEST(GemRun, ARunFolderInUseIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(out / ".gem-run.lock"));
 }
 
+// A reader of gem run's report that goes away (`| true`) does not kill the run: it ends with the
+// status its gem.log records (it exited 141, SIGPIPE, where gem.log said 0).
+TEST(GemRun, AReaderThatGoesAwayDoesNotKillTheRun) {
+  test::TempDir dir;
+  const auto scenario = dir.write("busy.toml", test::kBusyScene);
+  const auto out = dir.path() / "out";
+  const std::string gem = std::string(std::getenv("GEM_BINARY_DIR") ? std::getenv("GEM_BINARY_DIR") : GEM_BINARY_DIR) + "/gem";
+  const std::string command = "bash -c '" + gem + " run " + scenario.string() + " --no-plots --steps 200 --out " + out.string() +
+                              " 2>/dev/null | true; exit ${PIPESTATUS[0]}'";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_NE(test::readFile(out / "gem.log").find("exit status 0"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(out / "summary.json"));
+}
+
 // SIGTERM, Ctrl-C and SIGHUP stop a run between two steps: exit 128 + the signal, a message, the CSVs whole
 // under their final names, no temporary left behind, and a summary.json of the steps run that says
 // the run did not complete (and why); gem.log records the exit status.

@@ -18,6 +18,10 @@ void catchInterrupts() {
   // it once killed the run outright. Unless SIGHUP is ignored (`nohup gem run ...`): then the run
   // is meant to outlive its terminal, and goes on.
   if (std::signal(SIGHUP, onInterrupt) == SIG_IGN) std::signal(SIGHUP, SIG_IGN);
+  // A reader of the terminal report that goes away (`gem run ... | head`) must not kill the run in
+  // the middle of its files: the report's writes fail instead, and the run ends as it would have,
+  // with the exit status its gem.log records (it once exited 141 where gem.log said 0).
+  std::signal(SIGPIPE, SIG_IGN);
 }
 
 int interruptSignal() { return g_signal; }

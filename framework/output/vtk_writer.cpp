@@ -14,6 +14,7 @@
 
 #include <fmt/format.h>
 
+#include "framework/api/errors.hpp"
 #include "framework/output/atomic_file.hpp"
 #include "framework/output/number_text.hpp"
 
@@ -244,6 +245,16 @@ VtkSeriesWriter::VtkSeriesWriter(std::filesystem::path runDir, bool binary, Bina
   in.get(times), in.get(firstIds);
   for (const double t : times) m_entries.push_back({t, frameFile(frameCount())});
   m_firstIds.insert(firstIds.begin(), firstIds.end());
+  // The frames the checkpoint's series lists must all be there: a resume once went on without a
+  // deleted frames/ and wrote a frames.pvd listing thousands of frames that no longer existed.
+  for (const Entry& e : m_entries) {
+    std::error_code missing;
+    if (!std::filesystem::is_regular_file(m_runDir / e.file, missing))
+      throw InputError(
+          fmt::format("cannot resume: {} is missing (the checkpoint's frames.pvd lists {} frames; the run's frames are "
+                      "gone: run it again from the start)",
+                      (m_runDir / e.file).string(), m_entries.size()));
+  }
   // Frames the stopped run wrote after its checkpoint go: the resumed run writes them again, and
   // one that stops earlier must not leave frames its series does not list.
   std::error_code ec;
