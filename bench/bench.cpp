@@ -20,6 +20,7 @@
 #include "framework/output/csv.hpp"
 #include "framework/output/output_path.hpp"
 #include "framework/api/errors.hpp"
+#include "framework/api/input_size.hpp"
 #include "framework/field/field_generator.hpp"
 #include "bench/geometry_bench.hpp"
 #include "framework/api/registry.hpp"

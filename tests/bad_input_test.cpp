@@ -6,6 +6,7 @@
 #include <fstream>
 #include <string>
 
+#include "framework/api/input_size.hpp"
 #include "framework/scenario/scenario.hpp"
 #include "test_support.hpp"
 

@@ -36,12 +36,15 @@ inline void requireFolder(const std::filesystem::path& dir, const std::string& w
   throw InputError(fmt::format("{}: no such {}", dir.string(), what));
 }
 
+// This machine's memory, bytes: what an input is measured against before it is read or made.
+inline double machineMemory() { return static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)); }
+
 // expansion: the reader's memory per byte of the file (its text plus what it builds from it).
 inline void requireFitsInMemory(const std::filesystem::path& file, double expansion) {
   std::error_code ec;
   const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
   if (ec) return;  // not a regular file: the reader says what it is
-  const double memory = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  const double memory = machineMemory();
   const double need = static_cast<double>(bytes) * expansion;
   if (memory > 0 && need > 0.8 * memory)
     throw InputError(fmt::format("{}: {:.3g} GB, too large to read: it would take about {:.3g} GB of this machine's {:.3g} GB of memory",

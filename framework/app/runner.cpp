@@ -86,6 +86,14 @@ void writeStateCsv(const std::filesystem::path& file, const World& w) {
   out.commit();
 }
 
+// The run-folder files of the registered record streams (impacts.csv, a plugin's): a new run and a
+// resume clear what an earlier run left of them.
+std::vector<std::string> recordFileNames() {
+  std::vector<std::string> files;
+  for (const RecordOutputEntry* output : Registry::global().recordOutputs()) files.push_back(output->file);
+  return files;
+}
+
 }  // namespace
 
 // summary.json through nlohmann-json, so that every string (a device name with quotes or
@@ -173,9 +181,7 @@ class ScenarioRun {
     m_summary.iceMassInitial = sim.hostWorld().floeMass();
     // What an earlier run left here goes (a stale summary or old frames must not sit beside this
     // run's files), and the scenario as read is recorded (scenario.toml).
-    std::vector<std::string> recordFiles;
-    for (const RecordOutputEntry* output : Registry::global().recordOutputs()) recordFiles.push_back(output->file);
-    clearEarlierRun(m_dir, recordFiles);
+    clearEarlierRun(m_dir, recordFileNames());
     std::vector<std::filesystem::path> environmentPlugins;
     for (const LoadedPlugin& plugin : loadedPlugins())
       if (plugin.fromEnvironment) environmentPlugins.push_back(plugin.path);
@@ -417,9 +423,7 @@ class ScenarioRun {
     if (!in.atEnd()) throw InputError(name + ": damaged (bytes past its end)");
     // What the stopped run wrote at its end (summary, state, plots) describes a run that is not
     // over: gone, once the resume is sure to go ahead.
-    std::vector<std::string> recordFiles;
-    for (const RecordOutputEntry* output : Registry::global().recordOutputs()) recordFiles.push_back(output->file);
-    clearRunEnd(m_dir, recordFiles);
+    clearRunEnd(m_dir, recordFileNames());
   }
 
   // scenario.toml as the run folder holds it (a checkpoint belongs to that text).

@@ -1,7 +1,5 @@
 #include "framework/scenario/scenario.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -11,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "framework/api/errors.hpp"
+#include "framework/api/input_size.hpp"
 #include "framework/api/registry.hpp"
 #include "framework/api/table_reader.hpp"
 #include "framework/world/constants.hpp"
@@ -370,8 +369,6 @@ void readBroadphaseTables(const toml::table& tables, Scenario& s) {
 }  // namespace
 
 double fieldMemoryNeed(double floes) { return floes * 3072; }
-
-double machineMemory() { return static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)); }
 
 // A generated field's size is known before it is made: refuse one that could not fit in this
 // machine's memory, with the estimate, instead of growing until std::bad_alloc (docs/scenario.md).

@@ -111,9 +111,8 @@ Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::
 // with the estimate (loadScenario calls it).
 void checkFieldMemory(const Scenario& s);
 // The memory a run of `floes` floes needs, bytes: about 3 KB a floe (its polygon and state, and the
-// step's per-body and per-contact buffers); and this machine's memory, bytes.
+// step's per-body and per-contact buffers); against machineMemory() (framework/api/input_size.hpp).
 double fieldMemoryNeed(double floes);
-double machineMemory();
 
 // The thesis's open-water speed for a bollard thrust (interpolated in log-log), m/s.
 Real openWaterSpeedFor(Real bollardThrust);
