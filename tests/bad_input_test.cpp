@@ -235,6 +235,14 @@ TEST(BadInputCli, NotAScenarioFileAndBadNumbersOnTheCommandLine) {
       {"run " + good.string() + " --steps -5", "--steps -5"},
       {"run " + good.string() + " --steps 0", "--steps 0"},
       {"run " + good.string() + " --duration nan", "--duration nan"},
+      // Each value is echoed as typed: CLI11 read '' as 0 and saturated a huge count.
+      {"run " + good.string() + " --steps ''", "--steps '': expected a whole number"},
+      {"run " + good.string() + " --steps 99999999999999999999", "--steps 99999999999999999999:"},
+      {"run " + good.string() + " --steps 12x", "--steps 12x:"},
+      {"run " + good.string() + " --duration ''", "--duration '': expected a positive number"},
+      {"run " + good.string() + " --duration 5s", "--duration 5s:"},
+      // An empty part of a --set key is the --set's fault, not the file's.
+      {"run " + good.string() + " --set simulation..dt=1", "--set simulation..dt=...: the key must be"},
       {"run " + good.string() + " --duration 1e300", "a run takes 1 to 2e9 steps"},
       {"sweep " + (dir.path() / "folder.toml").string(), "a folder, not a sweep file"},
       {"sweep " + dir.write("empty_sweep.toml", "").string(), "empty"},
@@ -257,6 +265,35 @@ TEST(BadInputCli, NotAScenarioFileAndBadNumbersOnTheCommandLine) {
   const auto huge = dir.write("huge.toml", kSim + "[simulation.extra]\n" + std::string(5000000, 'k') + " = 1\n");
   EXPECT_EQ(gem::test::runGem("check " + huge.string(), log), 2);
   EXPECT_LT(std::filesystem::file_size(log), 2000u) << "the message echoes the whole token";
+}
+
+// Links that lead nowhere, and files whose size the system does not know, are said to be what
+// they are: a loop of links was "no such scenario file", a dangling --out link "File exists", and a
+// /proc file (size 0, text inside) "empty".
+TEST(BadInputCli, LinksThatLeadNowhereAndFilesOfUnknownSizeAreNamedForWhatTheyAre) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  const auto good = dir.write("good.toml", kSim);
+  std::filesystem::create_symlink("loop_b.toml", dir.path() / "loop_a.toml");
+  std::filesystem::create_symlink("loop_a.toml", dir.path() / "loop_b.toml");
+  std::filesystem::create_symlink("missing.toml", dir.path() / "dangling.toml");
+  std::filesystem::create_symlink(dir.path() / "gone" / "run", dir.path() / "dangling_out");
+  const struct {
+    std::string arguments, expected;
+  } cases[] = {
+      {"check " + (dir.path() / "loop_a.toml").string(),
+       "loop_a.toml: cannot be read as a scenario file: Too many levels of symbolic links"},
+      {"check " + (dir.path() / "dangling.toml").string(), "dangling.toml: a symbolic link to missing.toml, which does not exist"},
+      {"run " + good.string() + " --quiet --out " + (dir.path() / "dangling_out").string(),
+       "dangling_out is a symbolic link to " + (dir.path() / "gone" / "run").string() + ", which does not exist"},
+      {"check /proc/self/status", "/proc/self/status:1:"},  // read and parsed, not "empty"
+  };
+  for (const auto& c : cases) {
+    EXPECT_EQ(gem::test::runGem(c.arguments, log), 2) << c.arguments;
+    const std::string text = gem::test::readFile(log);
+    EXPECT_NE(text.find(c.expected), std::string::npos) << c.arguments << ": " << text;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
+  }
 }
 
 // Every output place named on the command line (--out, --csv) is checked before any work: a file

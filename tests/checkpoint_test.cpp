@@ -156,6 +156,13 @@ TEST(Checkpoint, ResumeRefusesWhatItCannotContinue) {
   EXPECT_EQ(resume(), 2);
   EXPECT_TRUE(says("not a GEM checkpoint")) << readFile(log);
 
+  // A folder where the checkpoint should be is said to be one (not "no checkpoint here").
+  std::filesystem::remove(run / kCheckpointFile);
+  std::filesystem::create_directory(run / kCheckpointFile);
+  EXPECT_EQ(resume(), 2);
+  EXPECT_TRUE(says("checkpoint.gem: a folder, not a checkpoint file")) << readFile(log);
+  std::filesystem::remove(run / kCheckpointFile);
+
   writeCheckpoint(checkpoint);
   const std::string recorded = readFile(run / "scenario.toml");
   std::ofstream(run / "scenario.toml", std::ios::app) << "# edited\n";

@@ -22,7 +22,15 @@ inline void requireRegularFile(const std::filesystem::path& file, const std::str
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::file_status status = fs::status(file, ec);
-  if (ec || !fs::exists(status)) throw InputError(fmt::format("{}: no such {}", file.string(), what));
+  if (ec && ec != std::errc::no_such_file_or_directory)  // a loop of links, a folder not searchable
+    throw InputError(fmt::format("{}: cannot be read as a {}: {}", file.string(), what, ec.message()));
+  if (!fs::exists(status)) {
+    std::error_code linkError;
+    if (fs::is_symlink(fs::symlink_status(file, linkError)))
+      throw InputError(fmt::format("{}: a symbolic link to {}, which does not exist: no such {}", file.string(),
+                                   fs::read_symlink(file, linkError).string(), what));
+    throw InputError(fmt::format("{}: no such {}", file.string(), what));
+  }
   if (fs::is_directory(status)) throw InputError(fmt::format("{}: a folder, not a {}", file.string(), what));
   if (!fs::is_regular_file(status))
     throw InputError(fmt::format("{}: not a regular file (a pipe or a device?), not a {}", file.string(), what));

@@ -4,10 +4,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <new>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,8 +44,9 @@ namespace {
 struct RunArguments {
   std::string scenario, out, backend, broadphase;
   int threads = -1;  // --threads: simulation.threads (-1: the scenario's)
-  double duration = 0;
-  long steps = 0;
+  // --duration and --steps as typed: read here, so that an empty, partial or out-of-range value is
+  // refused with the text the user gave (CLI11 would read '' as 0 and saturate a huge count).
+  std::string durationText, stepsText;
   bool durationGiven = false, stepsGiven = false;  // set from the command line's counts
   std::vector<std::string> set;
   bool quiet = false;
@@ -51,6 +54,23 @@ struct RunArguments {
   bool noPlots = false;     // gem run --no-plots
   std::string resume;       // gem run --resume RUN_DIR
 };
+
+// The number a command-line value spells, the whole text and nothing else (no blank, no unit, no
+// trailing characters); nullopt when it is empty, not a number or out of the type's range.
+template <class T>
+std::optional<T> wholeText(const std::string& text) {
+  T value{};
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  if (text.empty() || error != std::errc() || stop != end) return std::nullopt;
+  return value;
+}
+
+// A command-line value as a message repeats it: quoted when empty or spaced, cut when long.
+std::string quotedArgument(const std::string& text) {
+  const std::string shown = text.size() > 40 ? text.substr(0, 40) + "..." : text;
+  return shown.empty() || shown.find_first_of(" \t") != std::string::npos ? "'" + shown + "'" : shown;
+}
 
 Scenario load(const RunArguments& a) {
   std::vector<std::string> overrides = a.set;
@@ -60,19 +80,22 @@ Scenario load(const RunArguments& a) {
   Scenario s = loadScenario(a.scenario, overrides);
   // --duration and --steps, when given, must make a run of 1 to 2e9 steps: never silently ignored.
   if (a.durationGiven) {
-    const double count = a.duration / static_cast<double>(s.dt);
-    if (!(a.duration > 0) || !std::isfinite(a.duration))
-      throw InputError(fmt::format("--duration {}: expected a positive number of seconds", a.duration));
+    const std::optional<double> duration = wholeText<double>(a.durationText);
+    if (!duration || !(*duration > 0) || !std::isfinite(*duration))
+      throw InputError(fmt::format("--duration {}: expected a positive number of seconds", quotedArgument(a.durationText)));
+    const double count = *duration / static_cast<double>(s.dt);
     if (!(count >= 0.5 && count <= 2e9))
-      throw InputError(fmt::format("--duration {}: {:.3g} steps of dt = {} s; a run takes 1 to 2e9 steps", a.duration, count, s.dt));
-    s.duration = static_cast<Real>(a.duration);
+      throw InputError(
+          fmt::format("--duration {}: {:.3g} steps of dt = {} s; a run takes 1 to 2e9 steps", quotedArgument(a.durationText), count, s.dt));
+    s.duration = static_cast<Real>(*duration);
     s.steps = std::lround(count);
   }
-  if (a.stepsGiven && !(a.steps >= 1 && a.steps <= 2000000000))
-    throw InputError(fmt::format("--steps {}: expected a whole number from 1 to 2e9", a.steps));
-  if (a.steps > 0) {
-    s.steps = a.steps;
-    s.duration = static_cast<Real>(a.steps) * s.dt;
+  if (a.stepsGiven) {
+    const std::optional<long long> steps = wholeText<long long>(a.stepsText);
+    if (!steps || !(*steps >= 1 && *steps <= 2000000000))
+      throw InputError(fmt::format("--steps {}: expected a whole number from 1 to 2e9", quotedArgument(a.stepsText)));
+    s.steps = static_cast<long>(*steps);
+    s.duration = static_cast<Real>(*steps) * s.dt;
   }
   if (!a.out.empty()) s.output.dir = fs::absolute(a.out);
   return s;
@@ -294,8 +317,10 @@ int main(int argc, char** argv) {
     c->add_option("--threads", args.threads, "CPU backend: threads stepping the field (simulation.threads; 0 = every core)")
         ->check(CLI::Range(0, 1024));
     auto* duration =
-        c->add_option("--duration", args.duration, "simulated time, s")->each([&](const std::string&) { args.durationGiven = true; });
-    c->add_option("--steps", args.steps, "number of steps")->excludes(duration)->each([&](const std::string&) { args.stepsGiven = true; });
+        c->add_option("--duration", args.durationText, "simulated time, s")->each([&](const std::string&) { args.durationGiven = true; });
+    c->add_option("--steps", args.stepsText, "number of steps")->excludes(duration)->each([&](const std::string&) {
+      args.stepsGiven = true;
+    });
     c->add_option("--set", args.set, "override a scenario key: --set simulation.dt=0.05")->take_all();
   };
   CLI::App* run = app.add_subcommand("run", "run a scenario and write its outputs");

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "framework/api/input_size.hpp"
 #include "framework/output/atomic_file.hpp"
 
 namespace gem {
@@ -90,6 +91,7 @@ void writeCheckpointFile(const std::filesystem::path& file, const std::string& p
 std::string readCheckpointFile(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::error_code ec;
+  if (std::filesystem::exists(file, ec)) requireRegularFile(file, "checkpoint file");  // a folder, a pipe: said as such
   if (!std::filesystem::is_regular_file(file, ec))
     throw InputError(name + ": no checkpoint here (a run writes one every output.checkpoint_every, and when Ctrl-C or SIGTERM stops it)");
   std::ifstream in(file, std::ios::binary);

@@ -16,6 +16,11 @@ void makeWritableFolder(const fs::path& folder, const std::string& what) {
   std::error_code ec;
   for (fs::path p = folder; !p.empty() && p != p.root_path(); p = p.parent_path())
     if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw InputError(fmt::format("{}: {} is a file, not a folder", what, p.string()));
+  // A link whose target is missing: the folder cannot be made through it ("File exists").
+  for (fs::path p = folder; !p.empty() && p != p.root_path(); p = p.parent_path())
+    if (fs::is_symlink(fs::symlink_status(p, ec)) && !fs::exists(p, ec))
+      throw InputError(
+          fmt::format("{}: {} is a symbolic link to {}, which does not exist", what, p.string(), fs::read_symlink(p, ec).string()));
   fs::create_directories(folder, ec);
   if (ec) throw InputError(fmt::format("{}: cannot make the folder {}: {}", what, folder.string(), ec.message()));
   if (::access(folder.c_str(), W_OK | X_OK) != 0) throw InputError(fmt::format("{}: cannot write in the folder {}", what, folder.string()));

@@ -1,6 +1,7 @@
 #include "framework/scenario/scenario.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -41,6 +42,14 @@ void applyOverride(toml::table& root, const std::string& assignment) {
   std::string part;
   std::vector<std::string> parts;
   while (std::getline(path, part, '.')) parts.push_back(part);
+  // Bare TOML keys joined by dots, each part named: "simulation..dt" or ".dt" would otherwise make
+  // a key "" that the scenario's reader blames on the file, not on the --set.
+  const bool bare = !key.empty() && key.back() != '.' && std::all_of(parts.begin(), parts.end(), [](const std::string& name) {
+    return !name.empty() && std::all_of(name.begin(), name.end(), [](unsigned char c) { return std::isalnum(c) || c == '_' || c == '-'; });
+  });
+  if (!bare)
+    throw InputError(fmt::format("--set {}=...: the key must be names of letters, digits, _ and - joined by dots, e.g. simulation.dt",
+                                 key.size() > 80 ? key.substr(0, 80) + "..." : key));
   for (size_t i = 0; i + 1 < parts.size(); ++i) {
     toml::node* next = table->get(parts[i]);
     if (!next) next = &table->insert_or_assign(parts[i], toml::table{}).first->second;

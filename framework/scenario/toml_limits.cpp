@@ -1,5 +1,7 @@
 #include "framework/scenario/toml_limits.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -7,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "framework/api/errors.hpp"
+#include "framework/api/input_size.hpp"
 
 namespace gem {
 
@@ -66,20 +69,26 @@ void checkTomlLimits(std::string_view text, const std::string& fileName) {
 
 std::string readTomlFile(const std::string& fileName, const char* what) {
   namespace fs = std::filesystem;
+  requireRegularFile(fileName, fmt::format("{} file", what));
   std::error_code ec;
-  const fs::file_status status = fs::status(fileName, ec);
-  if (ec || !fs::exists(status)) throw InputError(fmt::format("{}: no such {} file", fileName, what));
-  if (fs::is_directory(status)) throw InputError(fmt::format("{}: a folder, not a {} file", fileName, what));
-  if (!fs::is_regular_file(status))
-    throw InputError(fmt::format("{}: not a regular file (a device or a pipe?), not a {} file", fileName, what));
   const auto bytes = fs::file_size(fileName, ec);
   if (ec) throw InputError(fmt::format("{}: cannot be read: {}", fileName, ec.message()));
-  if (bytes == 0) throw InputError(fmt::format("{}: empty: a {} file holds at least one table", fileName, what));
   if (bytes > static_cast<std::uintmax_t>(kMaxTomlBytes))
     throw InputError(fmt::format("{}: {} MiB, larger than a {} file may be ({} MiB)", fileName, bytes >> 20, what, kMaxTomlBytes >> 20));
   std::ifstream in(fileName, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in && !in.eof()) throw InputError(fmt::format("{}: cannot be read", fileName));
+  if (!in) throw InputError(fmt::format("{}: cannot be read: {}", fileName, std::strerror(errno)));
+  // Read to the end, at most one byte past the limit: a file whose size the system does not know
+  // (those of /proc say 0) is measured by what it holds.
+  std::string text;
+  char chunk[1 << 16];
+  while (in && text.size() <= static_cast<size_t>(kMaxTomlBytes)) {
+    in.read(chunk, sizeof chunk);
+    text.append(chunk, static_cast<size_t>(in.gcount()));
+  }
+  if (in.bad()) throw InputError(fmt::format("{}: cannot be read", fileName));
+  if (text.empty()) throw InputError(fmt::format("{}: empty: a {} file holds at least one table", fileName, what));
+  if (text.size() > static_cast<size_t>(kMaxTomlBytes))
+    throw InputError(fmt::format("{}: larger than a {} file may be ({} MiB)", fileName, what, kMaxTomlBytes >> 20));
   checkTomlLimits(text, fileName);
   return text;
 }
