@@ -147,12 +147,17 @@ std::vector<BadCase> badCases() {
       {"floe_spin_beyond_any_floe", kSim + floe(kSquare, "angular_velocity = 1e300\n"), {"floes[0].angular_velocity", "from -100 to 100"}},
       {"ice_file_spin_beyond_any_floe",
        kSim + "[field]\nkind = \"file\"\nfile = \"spin.ice\"\n",
-       {"spin.ice object 0", "angular velocity must be within +-100 rad/s"},
+       {"spin.ice:3:1: object 0", "angular velocity must be within +-100 rad/s"},
        "spin.ice"},
+      // A polygon of a .ice field is blamed on its <object> element's line and column.
+      {"ice_file_polygon_not_convex",
+       kSim + "[field]\nkind = \"file\"\nfile = \"bent.ice\"\n",
+       {"bent.ice:4:3: object 1", "not convex"},
+       "bent.ice"},
       // Floes past +-1e7 m: a square 1e300 m across was refused as "not convex", one 1e15 m out ran.
       {"ice_file_floe_beyond_any_sea",
        kSim + "[field]\nkind = \"file\"\nfile = \"far.ice\"\n",
-       {"far.ice object 0", "each vertex coordinate must be within +-1e+07 m"},
+       {"far.ice:3:1: object 0", "each vertex coordinate must be within +-1e+07 m"},
        "far.ice"},
       {"floe_beyond_any_sea",
        kSim + floe("[[1e15, 0.0], [1.00000001e15, 0.0], [1.00000001e15, 1e7], [1e15, 1e7]]"),
@@ -198,6 +203,10 @@ TEST_P(BadInput, ExitsWithStatus2AndAClearMessageAndWritesNoSummary) {
   dir.write("spin.ice",
             "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 10 0 10 10 0 10</coordinates>"
             "<velocity x=\"0\" y=\"0\" a=\"1e300\"/><thickness>1</thickness></object>\n</frame></iceFloeSim>\n");
+  dir.write("bent.ice",
+            "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 10 0 10 10 0 10</coordinates>"
+            "<thickness>1</thickness></object>\n  <object index=\"1\"><coordinates>20 0 30 0 25 2 30 10 20 10</coordinates>"
+            "<thickness>1</thickness></object>\n</frame></iceFloeSim>\n");
   dir.write("far.ice",
             "<iceFloeSim numFrames=\"1\">\n<frame index=\"0\">\n<object index=\"0\"><coordinates>0 0 1e300 0 1e300 1e300 0 1e300"
             "</coordinates><thickness>1</thickness></object>\n</frame></iceFloeSim>\n");

@@ -200,7 +200,7 @@ TEST(GemCheck, AnIceFieldsFloeThinnerThanAnyIceIsRefusedNamingTheObject) {
        {"check " + scenario.string(), "run " + scenario.string() + " --quiet --out " + (dir.path() / "out").string()}) {
     EXPECT_EQ(test::runGem(command, dir.path() / "log"), 2) << command;
     const std::string log = test::readFile(dir.path() / "log");
-    EXPECT_NE(log.find("thin.ice object 7: a floe's thickness must be from 0.01 to 1000 m, got 1e-200"), std::string::npos) << log;
+    EXPECT_NE(log.find("thin.ice:3:1: object 7: a floe's thickness must be from 0.01 to 1000 m, got 1e-200"), std::string::npos) << log;
   }
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "summary.json"));
 }

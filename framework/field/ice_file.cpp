@@ -33,11 +33,18 @@ class SourceMap {
   SourceMap(std::string file, const std::string& content) : m_file(std::move(file)), m_content(content) {}
 
   InputError error(std::ptrdiff_t offset, const std::string& message) const {
-    int line = 1, column = 1;
+    const auto [line, column] = lineColumn(offset);
+    return InputError(m_file, line, column, message);
+  }
+  // Counted on from the last place asked for when this one is further on: the objects of a large
+  // field are asked for in file order, so their places take one pass over the file, not one each.
+  std::pair<int, int> lineColumn(std::ptrdiff_t offset) const {
     const auto end = static_cast<size_t>(std::clamp<std::ptrdiff_t>(offset, 0, std::ssize(m_content)));
     // A UTF-8 byte order mark is invisible in editors: do not count it as a column.
     const size_t start = m_content.starts_with("\xEF\xBB\xBF") ? 3 : 0;
-    for (size_t k = std::min(start, end); k < end; ++k) {
+    if (end < m_counted.at) m_counted = Counted{};
+    int line = m_counted.line, column = m_counted.column;
+    for (size_t k = std::max(std::min(start, end), m_counted.at); k < end; ++k) {
       const auto c = static_cast<unsigned char>(m_content[k]);
       if (c == '\n') {
         ++line;
@@ -46,18 +53,31 @@ class SourceMap {
         ++column;
       }
     }
-    return InputError(m_file, line, column, message);
+    m_counted = Counted{std::max(end, m_counted.at), line, column};
+    return {line, column};
   }
   // An element's offset_debug() points at its name; the reader's eye looks for the '<' before it.
-  InputError error(pugi::xml_node node, const std::string& message) const {
-    std::ptrdiff_t offset = node ? node.offset_debug() : 0;
-    if (node.type() == pugi::node_element && offset > 0) --offset;
-    return error(offset, message);
+  InputError error(pugi::xml_node node, const std::string& message) const { return error(offsetOf(node), message); }
+  // "FILE:LINE:COLUMN" of an element, for a message made later (a body's polygon checked when the
+  // world is built).
+  std::string place(pugi::xml_node node) const {
+    const auto [line, column] = lineColumn(offsetOf(node));
+    return m_file + ":" + std::to_string(line) + ":" + std::to_string(column);
   }
 
  private:
+  static std::ptrdiff_t offsetOf(pugi::xml_node node) {
+    std::ptrdiff_t offset = node ? node.offset_debug() : 0;
+    if (node.type() == pugi::node_element && offset > 0) --offset;
+    return offset;
+  }
   std::string m_file;
   const std::string& m_content;
+  struct Counted {
+    size_t at = 0;  // bytes counted so far, and the line and column they reach
+    int line = 1, column = 1;
+  };
+  mutable Counted m_counted;
 };
 
 // XML whitespace is exactly these four characters (XML 1.0, production S); no locale involved.
@@ -145,6 +165,7 @@ std::vector<Vec2> parseCoordinates(pugi::xml_node element, const SourceMap& src,
 IceObject parseObject(pugi::xml_node node, bool firstFrame, const SourceMap& src) {
   IceObject object;
   object.index = parseIndex(node, "index", src, "object");
+  if (firstFrame) object.place = src.place(node);
   const std::string what = "object " + std::to_string(object.index);
   if (node.attribute("kind")) {
     object.kind = parseKind(node, src, what);
@@ -285,7 +306,7 @@ std::vector<BodySpec> readIceInitialBodies(const std::filesystem::path& path) {
     spec.velocity = o.velocity;
     spec.angularVelocity = o.angularVelocity;
     spec.id = o.index;
-    spec.origin = path.string() + " object " + std::to_string(o.index);
+    spec.origin = o.place + ": object " + std::to_string(o.index);
     bodies.push_back(std::move(spec));
   }
   return bodies;

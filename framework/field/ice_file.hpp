@@ -49,6 +49,7 @@ struct IceObject {
   bool hasCoordinates = false, hasVelocity = false, hasThickness = false;
   bool hasKind = false;  // the kind attribute was given
   bool removed = false;  // <removed/> (GEM extension)
+  std::string place;     // "FILE:LINE:COLUMN" of its <object> element, for messages about the polygon
 };
 
 struct IceFrame {

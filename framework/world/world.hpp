@@ -23,7 +23,7 @@ struct BodySpec {
   Vec2 velocity{0, 0};         // m/s
   Real angularVelocity = 0;    // rad/s
   std::int64_t id = -1;        // -1: the world assigns the next free id
-  std::string origin;          // where it came from, for error messages ("field", "floes[3]", "pack.ice object 12")
+  std::string origin;          // where it came from, for error messages ("field", "floes[3]", "pack.ice:9:1: object 12")
 };
 
 struct World {
