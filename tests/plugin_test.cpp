@@ -75,6 +75,9 @@ TEST(PluginErrors, EachExitsWithStatus2NamingTheFileAndTheCause) {
       {plugin("throws_int"), "not a std::exception"},
       {plugin("throws_at_load"), "a static initializer threw while the library loaded: throws_at_load: a static initializer throwing"},
       {plugin("unresolved_symbol"), "undefined symbol: gem_test_symbol_that_no_library_defines"},
+      // What GEM writes itself, or a built-in writes, is not a plugin's to take.
+      {plugin("takes_impacts_csv"), "impacts.csv is written by the record output of stream \"impacts\" from built-in"},
+      {plugin("takes_steps_key"), "\"steps\" is a key GEM writes in summary.json itself"},
   };
   for (const auto& c : cases) {
     EXPECT_EQ(gem::test::runGem("info --plugin " + c.file, log), 2) << c.file;
@@ -101,6 +104,25 @@ TEST(PluginErrors, AParseFunctionThatThrowsIsNamedWithItsEventAndPlugin) {
     EXPECT_TRUE(contains(text, "case.toml:11:1: events.throws_in_parse: the plugin's parse function threw")) << text;
     EXPECT_TRUE(contains(text, "parsing fails on purpose")) << text;
     EXPECT_TRUE(contains(text, plugin("throws_in_parse"))) << text;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
+  }
+}
+
+// An event that opens a built-in's record stream with another record type: exit 2 naming both
+// events, the plugin and the scenario's line, whether the event is on or off.
+TEST(PluginErrors, AStreamOpenedWithAnotherTypeNamesBothEventsAndThePlugin) {
+  TempDir dir;
+  const fs::path log = dir.path() / "log.txt";
+  for (const char* enabled : {"false", "true"}) {
+    SCOPED_TRACE(enabled);
+    const fs::path scenario = dir.write("case.toml", kFloe + "[[plugins]]\npath = \"" + plugin("reuses_impacts_stream") +
+                                                         "\"\n[events.reuses_impacts_stream]\nenabled = " + enabled + "\n");
+    EXPECT_EQ(gem::test::runGem("check " + scenario.string(), log), 2);
+    const std::string text = readFile(log);
+    EXPECT_TRUE(contains(text, "events.reuses_impacts_stream (plugin " + plugin("reuses_impacts_stream"))) << text;
+    EXPECT_TRUE(contains(text, "events.ship_impact (built-in)")) << text;
+    EXPECT_TRUE(contains(text, "case.toml:11:1")) << text;
+    EXPECT_TRUE(contains(text, "the record stream \"impacts\"")) << text;
     EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
   }
 }

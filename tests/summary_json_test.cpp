@@ -4,8 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iterator>
+#include <set>
+
+#include <nlohmann/json.hpp>
 
 #include "framework/analysis/sweep_summary.hpp"
+#include "framework/api/registry.hpp"
 #include "framework/app/runner.hpp"
 #include "test_support.hpp"
 
@@ -36,4 +41,14 @@ TEST(SummaryJson, StringsAreEscapedAndReadBack) {
   EXPECT_EQ(text.rfind("{\n  \"gem_version\": ", 0), 0u) << text;
   EXPECT_LT(text.find("\"device\""), text.find("\"floes_initial\""));
   EXPECT_NE(text.find("\"resistance_in_ice_n\": null\n}\n"), std::string::npos) << text;
+}
+
+// The keys GEM writes itself are the ones a plugin's record output may not take (registry.hpp
+// kGemSummaryKeys): a key added to summaryJson and not reserved there would let a plugin overwrite it.
+TEST(SummaryJson, GemsOwnKeysAreExactlyTheReservedOnes) {
+  RunSummary s;
+  const nlohmann::json j = nlohmann::json::parse(summaryJson(s));
+  std::set<std::string> written, reserved(std::begin(kGemSummaryKeys), std::end(kGemSummaryKeys));
+  for (const auto& [key, value] : j.items()) written.insert(key);
+  EXPECT_EQ(written, reserved);
 }

@@ -3,6 +3,8 @@
 #include "framework/api/table_reader.hpp"
 
 #include <algorithm>
+#include <map>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -85,8 +87,53 @@ void Registry::commitPlugin() {
   if (!staging) return;
   checkClashes("event", staging->events, m_events, staging->allowOverride);
   checkClashes("broadphase", staging->broadphases, m_broadphases, staging->allowOverride);
+  checkRecordOutputs(*staging);
   for (EventEntry& e : staging->events) m_events.insert_or_assign(e.name, std::move(e));
   for (BroadphaseEntry& b : staging->broadphases) m_broadphases.insert_or_assign(b.name, std::move(b));
+  for (RecordOutputEntry& r : staging->recordOutputs) enterRecordOutput(std::move(r), staging->origin);
+}
+
+// A plugin's record outputs may not take what GEM writes itself, nor (but to replace it, with
+// override) what another entry writes: a plugin's impacts.csv once replaced ship_impact's rows, and
+// its count key "steps" the run's step count in summary.json, without a word.
+void Registry::checkRecordOutputs(const Staging& staging) const {
+  auto keysOf = [](const RecordOutputEntry& e) {
+    std::vector<std::string> keys;
+    for (const std::string* k : {&e.countKey, &e.statisticKey, &e.countInIceKey, &e.statisticInIceKey})
+      if (!k->empty()) keys.push_back(*k);
+    return keys;
+  };
+  const std::string& origin = staging.origin;
+  std::map<std::string, std::string> keyOwner;  // summary keys of the entries that stay, by owner
+  for (size_t k = 0; k < m_recordOutputs.size(); ++k) {
+    const RecordOutputEntry& e = m_recordOutputs[k];
+    const bool replaced = std::any_of(staging.recordOutputs.begin(), staging.recordOutputs.end(),
+                                      [&](const RecordOutputEntry& r) { return r.file == e.file && staging.allowOverride; });
+    if (replaced) continue;
+    for (const std::string& key : keysOf(e))
+      keyOwner.emplace(key, fmt::format("the record output {} of {}", e.file, m_recordOutputOrigins[k]));
+  }
+  std::set<std::string> files;
+  for (const RecordOutputEntry& r : staging.recordOutputs) {
+    const std::string what = fmt::format("plugin {}: the record output of stream \"{}\" to \"{}\"", origin, r.stream, r.file);
+    if (r.file.empty() || r.file == "." || r.file == ".." || r.file.find_first_of("/\\") != std::string::npos)
+      throw InputError(what + ": the file must be a plain file name in the run folder");
+    for (const char* own : kGemRunFiles)
+      if (r.file == own) throw InputError(fmt::format("{}: {} is a file GEM writes itself; choose another name", what, r.file));
+    if (!files.insert(r.file).second) throw InputError(fmt::format("{}: the plugin registers a record output to {} twice", what, r.file));
+    for (size_t k = 0; k < m_recordOutputs.size(); ++k)
+      if (m_recordOutputs[k].file == r.file && !staging.allowOverride)
+        throw InputError(
+            fmt::format("{}: {} is written by the record output of stream \"{}\" from {} (to replace it, give the "
+                        "plugin's [[plugins]] entry override = true)",
+                        what, r.file, m_recordOutputs[k].stream, m_recordOutputOrigins[k]));
+    for (const std::string& key : keysOf(r)) {
+      for (const char* own : kGemSummaryKeys)
+        if (key == own) throw InputError(fmt::format("{}: \"{}\" is a key GEM writes in summary.json itself; choose another", what, key));
+      const auto [it, fresh] = keyOwner.emplace(key, fmt::format("the record output {} of {}", r.file, origin));
+      if (!fresh) throw InputError(fmt::format("{}: the summary key \"{}\" is already written by {}", what, key, it->second));
+    }
+  }
 }
 
 const EventEntry* Registry::findEvent(const std::string& name) const {
@@ -137,12 +184,22 @@ std::vector<std::string> Registry::broadphaseNames() const {
 }
 
 void Registry::addRecordOutput(RecordOutputEntry entry) {
-  for (RecordOutputEntry& e : m_recordOutputs)
-    if (e.file == entry.file) {
-      e = std::move(entry);  // a plugin overriding the event that owns it replaces its writer
+  if (m_staging) {
+    m_staging->recordOutputs.push_back(std::move(entry));
+    return;
+  }
+  enterRecordOutput(std::move(entry), "built-in");
+}
+
+void Registry::enterRecordOutput(RecordOutputEntry entry, const std::string& origin) {
+  for (size_t k = 0; k < m_recordOutputs.size(); ++k)
+    if (m_recordOutputs[k].file == entry.file) {
+      m_recordOutputs[k] = std::move(entry);  // a plugin overriding the event that owns it replaces its writer
+      m_recordOutputOrigins[k] = origin;
       return;
     }
   m_recordOutputs.push_back(std::move(entry));
+  m_recordOutputOrigins.push_back(origin);
 }
 
 std::vector<const RecordOutputEntry*> Registry::recordOutputs() const {

@@ -132,6 +132,36 @@ struct RecordOutputEntry {
   std::string countInIceKey = {}, statisticInIceKey = {};
 };
 
+// What GEM writes itself, which no plugin's record output may take: file names of a run folder
+// (besides the record streams' files) and the keys of summary.json (besides the record totals).
+// runner.cpp's summaryJson writes exactly these keys (a test keeps the two equal).
+inline constexpr const char* kGemRunFiles[] = {"summary.json", "state.csv",      "timeseries.csv", "frames.pvd",   "frames.ice",
+                                               "frames",       "gem.log",        "scenario.toml",  "gem-run.toml", "plots",
+                                               "movie.mp4",    "checkpoint.gem", ".gem-run.lock",  "case.toml",    "summary.csv"};
+inline constexpr const char* kGemSummaryKeys[] = {"gem_version",
+                                                  "completed",
+                                                  "stop_reason",
+                                                  "steps",
+                                                  "sim_time_s",
+                                                  "wall_time_s",
+                                                  "real_time_factor",
+                                                  "backend",
+                                                  "driver",
+                                                  "broadphase",
+                                                  "device",
+                                                  "floes_initial",
+                                                  "floes_final",
+                                                  "floes_broken",
+                                                  "ice_mass_initial_kg",
+                                                  "ice_mass_final_kg",
+                                                  "rubble_mass_kg",
+                                                  "cases_on_device",
+                                                  "ship_speed",
+                                                  "net_thrust_n",
+                                                  "resistance_mean_n",
+                                                  "ship_speed_in_ice",
+                                                  "resistance_in_ice_n"};
+
 class Registry {
  public:
   static Registry& global();
@@ -144,7 +174,11 @@ class Registry {
   // By phase (pair, solo, motion, topology), then each event's declared order, then name: the
   // order in which every driver runs them.
   std::vector<const EventEntry*> events() const;
-  // The run folder's writers of record streams (impacts.csv), in registration order.
+  // The run folder's writers of record streams (impacts.csv), in registration order. A built-in
+  // entry for a file already written replaces its writer. A plugin's entry is staged and checked at
+  // commitPlugin: its file a plain name that is not one of GEM's own (kGemRunFiles) nor another
+  // entry's (unless the plugin may override, which replaces that entry), its summary keys none of
+  // GEM's (kGemSummaryKeys) nor another entry's.
   void addRecordOutput(RecordOutputEntry entry);
   std::vector<const RecordOutputEntry*> recordOutputs() const;
   std::vector<const BroadphaseEntry*> broadphases() const;
@@ -166,12 +200,16 @@ class Registry {
   std::map<std::string, EventEntry> m_events;
   std::map<std::string, BroadphaseEntry> m_broadphases;
   std::vector<RecordOutputEntry> m_recordOutputs;
+  std::vector<std::string> m_recordOutputOrigins;  // beside m_recordOutputs: "built-in" or the plugin's
   struct Staging {
     std::string origin;
     bool allowOverride = false;
     std::vector<EventEntry> events;
     std::vector<BroadphaseEntry> broadphases;
+    std::vector<RecordOutputEntry> recordOutputs;
   };
+  void checkRecordOutputs(const Staging& staging) const;
+  void enterRecordOutput(RecordOutputEntry entry, const std::string& origin);
   std::unique_ptr<Staging> m_staging;  // non-null while a plugin registers
 };
 

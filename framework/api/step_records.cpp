@@ -1,6 +1,8 @@
 #include "framework/api/step_records.hpp"
 
-#include <stdexcept>
+#include <fmt/format.h>
+
+#include "framework/api/errors.hpp"
 
 namespace gem {
 
@@ -13,14 +15,23 @@ int RecordStreams::find(const std::string& name) const {
 int RecordStreams::openBytes(const std::string& name, int recordSize, int stride) {
   const int existing = find(name);
   if (existing >= 0) {
-    if (m_streams[static_cast<size_t>(existing)].recordSize != recordSize)
-      throw std::logic_error("record stream \"" + name + "\" opened with records of " + std::to_string(recordSize) + " bytes and of " +
-                             std::to_string(m_streams[static_cast<size_t>(existing)].recordSize) + ": two events disagree on its type");
+    const RecordStreamInfo& first = m_streams[static_cast<size_t>(existing)];
+    if (first.recordSize != recordSize)
+      throw InputError(
+          fmt::format("{}: opens the record stream \"{}\" with records of {} bytes, but {} opened it with records of {} "
+                      "bytes: events that share a stream name share its record type (give a stream of your own a name "
+                      "of its own; the built-in streams are \"log\", \"impacts\" and \"breaks\")",
+                      m_opener, name, recordSize, first.openedBy, first.recordSize));
     return existing;
   }
   if (count() == kMaxRecordStreams)
-    throw std::logic_error("record stream \"" + name + "\": a run holds at most " + std::to_string(kMaxRecordStreams) + " streams");
-  m_streams.push_back({name, recordSize, stride});
+    throw InputError(fmt::format("{}: opens the record stream \"{}\", but a run holds at most {} record streams, and {} are open ({})",
+                                 m_opener, name, kMaxRecordStreams, count(), [&] {
+                                   std::string names;
+                                   for (const RecordStreamInfo& s : m_streams) names += (names.empty() ? "" : ", ") + s.name;
+                                   return names;
+                                 }()));
+  m_streams.push_back({name, recordSize, stride, m_opener});
   return count() - 1;
 }
 

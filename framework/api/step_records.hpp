@@ -14,8 +14,9 @@ namespace gem {
 
 struct RecordStreamInfo {
   std::string name;
-  int recordSize;  // bytes of one record
-  int stride;      // bytes of one row: tag + record, rounded up to 8
+  int recordSize;        // bytes of one record
+  int stride;            // bytes of one row: tag + record, rounded up to 8
+  std::string openedBy;  // who opened it first (setOpener), for a message about a clash
 };
 
 // The streams of one run, numbered from 0 (the log channels' stream) in the order they were opened.
@@ -24,7 +25,9 @@ class RecordStreams {
   RecordStreams() { openBytes("log", sizeof(LogRecord), recordStride<LogRecord>()); }
 
   // Opens the stream `name` for records of type Record, or returns the one already open under that
-  // name. A second type of another size under one name is a logic error (two events disagree).
+  // name. A second type of another size under one name, or a stream past kMaxRecordStreams, is an
+  // InputError naming the events (setOpener) that disagree: stream names are one namespace for
+  // built-in and plugin events alike.
   template <class Record>
   RecordStream<Record> open(const std::string& name) {
     static_assert(std::is_trivially_copyable_v<Record>, "a record is plain data: it is copied as bytes from the device");
@@ -33,10 +36,14 @@ class RecordStreams {
   int count() const { return static_cast<int>(m_streams.size()); }
   const RecordStreamInfo& info(int stream) const { return m_streams[static_cast<size_t>(stream)]; }
   int find(const std::string& name) const;  // -1 when not open
+  // Who opens the streams from now on, as a message names them ("FILE:LINE:COL: events.NAME (plugin
+  // ORIGIN)"): the stepper sets it before each event's parse.
+  void setOpener(std::string opener) { m_opener = std::move(opener); }
 
  private:
   int openBytes(const std::string& name, int recordSize, int stride);
   std::vector<RecordStreamInfo> m_streams;
+  std::string m_opener = "GEM";
 };
 
 // The rows one step produced, stream by stream, in the CPU's order: by event (their declared

@@ -223,6 +223,11 @@ void CpuStepper::setUp() {
       if (defaults) defaults->record("events." + entry->name + ".enabled", enabled);
       TableReader reader(table, "events." + entry->name, m_scenario.fileName);
       reader.accept("enabled");
+      const std::string place = table
+                                    ? fmt::format("{}:{}:{}", m_scenario.fileName, table->source().begin.line, table->source().begin.column)
+                                    : m_scenario.fileName;
+      m_streams.setOpener(
+          fmt::format("{}: events.{} ({})", place, entry->name, entry->origin == "built-in" ? "built-in" : "plugin " + entry->origin));
       EventConfig config{reader, m_scenario, m_streams, enabled};
       auto instance = parsePluginSafely(*entry, table, m_scenario.fileName,
                                         [&] { return entry->makeCpu(config); });  // even when off: its table is checked
