@@ -1,8 +1,12 @@
 // The broadphase interface: proposes candidate pairs, knows nothing about events
 // (docs/architecture.md "The one idea"). Every strategy must be conservative: it may propose pairs that
 // do not touch (the narrowphase drops them) but must never miss a pair whose polygons overlap.
-// Pairs come out as (a, b) slot indices with a < b, sorted by (a, b): so the contact set and the
-// order in which each body sums its contacts do not depend on the strategy (bit-identical runs).
+// Every pair whose bounding circles overlap is enough, and so is every pair whose world boxes
+// overlap (each set holds every pair whose polygons overlap; neither holds the other).
+// The narrowphase gets the pairs as (a, b) slot indices with a < b, sorted by (a, b), each once: so
+// the contact set and the order in which each body sums its contacts do not depend on the strategy
+// (bit-identical runs). The built-in strategies return them so; a plugin's may return them in any
+// order and orientation, repeated, and the CPU stepper normalises them (normalizeCandidatePairs).
 #pragma once
 #include <algorithm>
 #include <iterator>
@@ -15,7 +19,7 @@
 namespace gem {
 
 struct CandidatePair {
-  int a, b;  // slot indices, a < b
+  int a, b;  // slot indices; a < b once normalised (normalizeCandidatePairs)
 };
 
 // The settings of the built-in strategies, as a scenario gives them ([broadphase.NAME], or the
@@ -23,11 +27,13 @@ struct CandidatePair {
 // (`static constexpr const char* kSettings[] = {"skin", "cell_size"};` in its class, the CPU and
 // the device part each for itself): a key given for a strategy that does not declare it is refused
 // when the scenario is read, and one that a backend's part of the strategy does not honour is
-// refused by that backend, never silently ignored.
+// refused by that backend, never silently ignored. A plugin's strategy may declare only these keys
+// (broadphaseSettingKeys): it cannot add keys of its own. Every strategy gets the whole struct,
+// with the defaults below where the scenario gives nothing.
 struct BroadphaseSettings {
   Real skin = 2;                   // m: extra margin of a kept neighbour list (docs/model.md 9)
-  Real fixedRadius = 0;            // m: fixed_radius's global radius; 0 = 2 x the largest bounding radius
-  Real cellSize = 0;               // m: uniform_grid's cell size; 0 = the largest bounding diameter + skin
+  Real fixedRadius = 0;            // m: fixed_radius's global radius; 0 = 2 x the largest floe bounding radius + skin
+  Real cellSize = 0;               // m: uniform_grid's cell size; 0 = 2 x the largest floe bounding radius (no skin)
   std::vector<std::string> given;  // the keys the scenario set ("skin", "cell_size", ...)
 };
 
@@ -73,8 +79,10 @@ class Broadphase {
  public:
   virtual ~Broadphase() = default;
   virtual std::string name() const = 0;
-  // Candidate pairs for the world as it is now (sorted, a < b). A strategy that keeps a list
-  // between steps rebuilds it itself when the never-miss rule of docs/model.md 9 asks.
+  // Candidate pairs for the world as it is now; `pairs` still holds the last step's: clear it
+  // first. The built-ins return them sorted by (a, b) with a < b, each once; a plugin's may come in
+  // any order and orientation, repeated, or as (i, i) (normalizeCandidatePairs, above). A strategy
+  // that keeps a list between steps rebuilds it itself when the never-miss rule of docs/model.md 9 asks.
   virtual void findCandidates(const World& world, std::vector<CandidatePair>& pairs) = 0;
   // Bodies were added, removed or reordered: any kept list is stale.
   virtual void invalidate() = 0;
