@@ -3,28 +3,12 @@
 #include <algorithm>
 #include <unordered_set>
 
+#include "events/flexural_cut.hpp"
 #include "framework/api/parallel.hpp"
 #include "framework/api/table_reader.hpp"
 #include "framework/world/world.hpp"
-#include "geometry/split.hpp"
 
 namespace gem {
-
-// Drops the vertex with the smallest turn until the polygon has at most `limit` vertices: a cut adds
-// one vertex, and a floe may have at most kMaxFloeVertices.
-static void limitVertices(std::vector<Vec2>& v, int limit) {
-  while (static_cast<int>(v.size()) > limit) {
-    const int n = static_cast<int>(v.size());
-    int flattest = 0;
-    Real smallest = INFINITY;
-    for (int i = 0; i < n; ++i) {
-      const Vec2 a = v[(i + n - 1) % n], b = v[i], c = v[(i + 1) % n];
-      const Real turn = std::fabs(cross(b - a, c - b));
-      if (turn < smallest) smallest = turn, flattest = i;
-    }
-    v.erase(v.begin() + flattest);
-  }
-}
 
 std::vector<std::int64_t> FlexuralBreaking::bodiesRead(const Params& p, const StepRecords& records) {
   std::vector<std::int64_t> ids;
@@ -62,40 +46,33 @@ void FlexuralBreaking::apply(const Params& p, TopologyData& data) {
   for (const BreakRequest& request : breaks) {
     const int i = slotOf(request.floeId);
     if (i < 0 || !done.insert(i).second) continue;
-    Vec2 polygon[kMaxVertices];
-    const int n = world.worldVertices(i, polygon);
-    Vec2 left[kMaxClipVertices], right[kMaxClipVertices];
-    int nLeft = 0, nRight = 0;
-    const Vec2 linePoint = request.point + request.cuspLength * request.normal;
-    splitByLine(polygon, n, linePoint, perpLeft(request.normal), left, &nLeft, right, &nRight);
-    if (nLeft < 3 || nRight < 3) continue;  // the cut misses the floe
+    FloePiece cut[2];
+    if (!cutFloe(world.local(i), world.vertexCount[i], world.position(i), world.angle[i], world.velocity(i), world.omega[i], request,
+                 p.minArea, cut))
+      continue;  // the cut misses
 
     remove[i] = 1;
     ++data.floesBroken;
-    const Vec2 centroid = world.position(i), velocity = world.velocity(i);
-    for (auto [v, count] : {std::pair<const Vec2*, int>{left, nLeft}, {right, nRight}}) {
-      BodySpec piece;
-      piece.kind = BodyKind::Floe;
-      piece.vertices.assign(v, v + count);
-      limitVertices(piece.vertices, kMaxFloeVertices);
-      const Real area = signedArea(piece.vertices.data(), static_cast<int>(piece.vertices.size()));
-      if (area < p.minArea) {
-        data.rubbleMass += kRhoIce * area * world.thickness[i];
+    for (const FloePiece& piece : cut) {
+      if (piece.rubble) {
+        data.rubbleMass += kRhoIce * piece.area * world.thickness[i];
         continue;
       }
-      const Vec2 pieceCentroid = areaCentroid(piece.vertices.data(), static_cast<int>(piece.vertices.size()));
-      piece.thickness = world.thickness[i];
-      piece.velocity = velocity + crossZ(world.omega[i], pieceCentroid - centroid);
-      piece.angularVelocity = world.omega[i];
-      piece.origin = "break";
-      pieces.push_back(std::move(piece));
+      BodySpec spec;
+      spec.kind = BodyKind::Floe;
+      spec.vertices.assign(piece.vertices, piece.vertices + piece.count);
+      spec.thickness = world.thickness[i];
+      spec.velocity = piece.velocity;
+      spec.angularVelocity = world.omega[i];
+      spec.origin = "break";
+      pieces.push_back(std::move(spec));
     }
   }
   if (data.floesBroken == 0) return;
   // On the CPU stepper's pool when it lent one and the world is large (framework/api/parallel.hpp).
   const bool pooled = parallelTasks(world.size(), 4096) > 1;
   world.removeBodies(remove, pooled ? World::TaskRunner(parallelEach) : World::TaskRunner());
-  for (const BodySpec& piece : pieces) world.addBody(piece);
+  for (const BodySpec& piece : pieces) world.addPiece(piece);
   data.changed = true;
 }
 

@@ -8,7 +8,8 @@
 // the parent: v_i = v + omega x (centroid_i - centroid), omega_i = omega. A piece smaller than
 // min_area leaves the simulation as rubble; its mass is counted in the summary (rubble_mass_kg).
 // A floe is broken at most once per step; a cut that misses the floe leaves it whole.
-// Host only: it changes the set of bodies.
+// The cut itself is events/flexural_cut.hpp (host and device): this event runs it on the host
+// (CPU stepper, the device-wide CUDA driver); the resident CUDA driver runs it in its kernel.
 #pragma once
 #include <cstdint>
 #include <vector>

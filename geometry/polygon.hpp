@@ -42,8 +42,19 @@ struct MassProperties {
   Real izz;             // polar moment about the centroid, I_xx + I_yy, m^4
 };
 
+// The trigonometry of massProperties: libm's (the host's, or CUDA's on the device). The pieces of
+// a break take geometry/portable_trig.hpp's PortableTrig instead, the same bits on both.
+struct LibmTrig {
+  GEM_HD static Real atan2(Real y, Real x) { return std::atan2(y, x); }
+  GEM_HD static void sinCos(Real angle, Real* s, Real* c) {
+    *c = std::cos(angle);
+    *s = std::sin(angle);
+  }
+};
+
 // Mass properties of a counter-clockwise polygon (A.1 to A.16). J_xx here is the integral of
 // y'^2 (bending about x), J_yy of x'^2, J_xy of x'y' over the area.
+template <class Trig = LibmTrig>
 GEM_HD inline MassProperties massProperties(const Vec2* v, int n) {
   MassProperties p{};
   p.area = signedArea(v, n);
@@ -58,9 +69,10 @@ GEM_HD inline MassProperties massProperties(const Vec2* v, int n) {
   p.jxx /= Real(12);
   p.jyy /= Real(12);
   p.jxy /= Real(24);
-  p.principalAngle = Real(0.5) * std::atan2(Real(-2) * p.jxy, p.jxx - p.jyy);
+  p.principalAngle = Real(0.5) * Trig::atan2(Real(-2) * p.jxy, p.jxx - p.jyy);
   // Moments in the frame rotated by theta_p (A.11, A.12): the product of inertia vanishes there.
-  Real c = std::cos(p.principalAngle), s = std::sin(p.principalAngle);
+  Real c, s;
+  Trig::sinCos(p.principalAngle, &s, &c);
   p.ixx = p.jxx * c * c + p.jyy * s * s - Real(2) * p.jxy * s * c;
   p.iyy = p.jxx * s * s + p.jyy * c * c + Real(2) * p.jxy * s * c;
   p.izz = p.jxx + p.jyy;

@@ -77,11 +77,26 @@ std::string residentProgramOf(const std::vector<const CpuStepper*>& members, cud
   };
   std::vector<Placed> placed;
   int offset = 0;
+  // The topology phase runs in the kernel when it holds the scenario's one topology event
+  // (flexural_breaking); otherwise a step with its rows ends the launch for the host's phase.
+  int topologyEvents = 0;
+  for (const EnabledEvent& event : events) topologyEvents += event.phase == EventPhase::Topology;
   for (size_t e = 0; e < events.size(); ++e) {
     const EnabledEvent& event = events[e];
-    if (event.phase == EventPhase::Topology) continue;  // runs on the host
     const EventEntry* entry = Registry::global().findEvent(event.name);
-    if (entry && entry->origin != "built-in")
+    const bool builtIn = !entry || entry->origin == "built-in";
+    if (event.phase == EventPhase::Topology) {
+      size_t size = 0;
+      const std::vector<int> streams = event.instance->streamsRead();
+      if (topologyEvents == 1 && builtIn && streams.size() == 1 && cuda::residentTopologyEvent(event.name, &size)) {
+        program.breakingOffset = offset;
+        program.breakingStream = streams.front();
+        placed.push_back(Placed{e, size, offset});
+        offset += static_cast<int>((size + 15) / 16 * 16);
+      }
+      continue;
+    }
+    if (!builtIn)
       return "event \"" + event.name + "\" comes from a plugin (" + entry->origin +
              "), and the resident kernel holds GEM's own events only";
     const cuda::ResidentPhase phase = event.phase == EventPhase::Pair   ? cuda::kResidentPair
@@ -108,20 +123,21 @@ std::string residentProgramOf(const std::vector<const CpuStepper*>& members, cud
   return "";
 }
 
-// Rows [first, from.size()) of `from` appended to `to`, ids shifted by idOffset.
-void appendRows(World& to, const World& from, int first, std::int64_t idOffset) {
-  const size_t f = static_cast<size_t>(first);
-  for (size_t i = f; i < from.id.size(); ++i) to.id.push_back(from.id[i] + idOffset);
-  to.kind.insert(to.kind.end(), from.kind.begin() + first, from.kind.end());
-  to.vertexCount.insert(to.vertexCount.end(), from.vertexCount.begin() + first, from.vertexCount.end());
+// Rows [first, end) of `from` appended to `to`, ids shifted by idOffset.
+void appendRows(World& to, const World& from, int first, int end, std::int64_t idOffset) {
+  const size_t f = static_cast<size_t>(first), e = static_cast<size_t>(end);
+  for (size_t i = f; i < e; ++i) to.id.push_back(from.id[i] + idOffset);
+  to.kind.insert(to.kind.end(), from.kind.begin() + first, from.kind.begin() + end);
+  to.vertexCount.insert(to.vertexCount.end(), from.vertexCount.begin() + first, from.vertexCount.begin() + end);
   to.localVertices.insert(to.localVertices.end(), from.localVertices.begin() + static_cast<std::ptrdiff_t>(f * kMaxVertices),
-                          from.localVertices.end());
+                          from.localVertices.begin() + static_cast<std::ptrdiff_t>(e * kMaxVertices));
   std::vector<Real> World::*reals[] = {&World::x,          &World::y,          &World::angle,          &World::vx,
                                        &World::vy,         &World::omega,      &World::area,           &World::thickness,
                                        &World::mass,       &World::invMass,    &World::invInertia,     &World::gyration2,
                                        &World::gyrationX2, &World::gyrationY2, &World::principalAngle, &World::radius};
-  for (auto r : reals) (to.*r).insert((to.*r).end(), (from.*r).begin() + first, (from.*r).end());
+  for (auto r : reals) (to.*r).insert((to.*r).end(), (from.*r).begin() + first, (from.*r).begin() + end);
 }
+void appendRows(World& to, const World& from, int first, std::int64_t idOffset) { appendRows(to, from, first, from.size(), idOffset); }
 
 }  // namespace
 
@@ -311,12 +327,37 @@ void CudaBatch::runBatch(long step) {
   stopAtMultipleOf(s.output.checkpointEverySteps);  // a checkpoint needs the state on the host
   if (step < s.steps) end = std::min(end, s.steps);
   Stopwatch clock;
+  if (m_device->resident()) {
+    // New bodies of breaks in the resident kernel take each case's next ids.
+    std::vector<std::int64_t> nextIds;
+    for (const CudaStepper* m : m_members) nextIds.push_back(m->m_cpu->world().nextId);
+    m_device->setNextIds(nextIds);
+  }
   m_device->run(step, s.dt, static_cast<int>(end - step), *m_result);
+  if (!m_result->edits.empty()) followDeviceEdits();
   m_resultFirst = step;
   times.batch += clock.lap();
   ++times.batches;
   indexRows();
   for (CudaStepper* m : m_members) m->m_hostCurrent = false;
+}
+
+// The resident kernel broke floes during the run and left the device state dense (runResident):
+// each case's mirror follows, as its own topology phase would have left it (World::removeBodies,
+// then the new bodies appended), with the shapes and mass properties the device made.
+void CudaBatch::followDeviceEdits() {
+  const cuda::DeviceBodyEdits& edits = m_result->edits;
+  for (int w = 0; w < worlds(); ++w) {
+    CudaStepper& m = *m_members[static_cast<size_t>(w)];
+    std::vector<std::int64_t> removed;
+    for (std::int64_t id : edits.removedIds)
+      if (worldOfId(id) == w) removed.push_back(id - idOffset(w));
+    World added;
+    for (int k = 0; k < edits.added.size(); ++k)
+      if (edits.addedWorlds.empty() || edits.addedWorlds[static_cast<size_t>(k)] == w) appendRows(added, edits.added, k, k + 1, -idOffset(w));
+    m.followDeviceEdit(removed, added, edits.nextIds.at(static_cast<size_t>(w)));
+  }
+  m_slotsOfWorld.clear();
 }
 
 void CudaBatch::indexRows() {

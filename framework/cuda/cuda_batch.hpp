@@ -75,6 +75,7 @@ class CudaBatch {
 
  private:
   void runBatch(long step);
+  void followDeviceEdits();  // the mirrors after the resident kernel's breaks (runBatch)
   void applyEdits();
   void reSortAlongCurve();
 

@@ -91,6 +91,8 @@ long CudaStepper::broadphaseRebuilds() const {
   return b ? b->rebuilds() : 0;
 }
 
+long CudaStepper::residentLaunches() const { return m_batch->device().residentLaunches(); }
+
 std::string CudaStepper::driver() const { return m_batch->device().resident() ? "resident" : "device"; }
 
 double CudaStepper::deviceSeconds() const { return m_batch->times.batch; }
@@ -285,7 +287,15 @@ void CudaStepper::runTopology() {
   std::sort(removedDevice.begin(), removedDevice.end());
   batch.times.bookkeeping += clock.lap();
   batch.addEdit(m_world, removedDevice, w, firstAdded);
+  followEdit(removedDevice, removedMirror, firstAdded);
+  batch.times.bookkeeping += clock.lap();
+}
 
+// The device's edit of this world (removedDevice: its device slots, ascending, that left;
+// removedMirror: the same bodies' mirror rows, ascending; the mirror's rows from firstAdded on are
+// the new bodies, which the device appends in the same order) in the mirror's bookkeeping.
+void CudaStepper::followEdit(const std::vector<int>& removedDevice, const std::vector<int>& removedMirror, int firstAdded) {
+  const World& w = world();
   // The mirror's order after a device re-sort: device slot j (a survivor) held device slot
   // keptDevice[j], i.e. mirror body pendingOrder[keptDevice[j]], which the removal moved down.
   if (!m_pendingOrder.empty()) {
@@ -306,7 +316,39 @@ void CudaStepper::runTopology() {
   }
   m_slotOfId.clear();
   if (m_vesselSlot >= 0) m_vesselSlot = slotOfId()[static_cast<size_t>(m_vesselId)];
-  batch.times.bookkeeping += clock.lap();
+}
+
+// The resident kernel's breaks in this world (CudaBatch::followDeviceEdits): the bodies of ids
+// `removed` (the case's own; ids unknown here were made and broken within the run) leave the
+// mirror, the rows of `added` are appended, as the device has already done it.
+void CudaStepper::followDeviceEdit(const std::vector<std::int64_t>& removed, const World& added, std::int64_t nextId) {
+  World& w = world();
+  const std::vector<int>& slotOf = slotOfId();
+  std::vector<int> removedDevice, removedMirror;
+  for (const std::int64_t id : removed) {
+    const int k = id >= 0 && id < static_cast<std::int64_t>(slotOf.size()) ? slotOf[static_cast<size_t>(id)] : -1;
+    if (k < 0) continue;
+    removedDevice.push_back(k);
+    removedMirror.push_back(mirrorSlot(k));
+  }
+  std::sort(removedDevice.begin(), removedDevice.end());
+  std::sort(removedMirror.begin(), removedMirror.end());
+  std::vector<char> remove(static_cast<size_t>(w.size()), 0);
+  for (const int i : removedMirror) remove[static_cast<size_t>(i)] = 1;
+  w.removeBodies(remove);
+  const int firstAdded = w.size();
+  for (int k = 0; k < added.size(); ++k) {
+    const size_t r = static_cast<size_t>(k);
+    w.id.push_back(added.id[r]), w.kind.push_back(added.kind[r]), w.vertexCount.push_back(added.vertexCount[r]);
+    w.localVertices.insert(w.localVertices.end(), added.localVertices.begin() + static_cast<std::ptrdiff_t>(r * kMaxVertices),
+                           added.localVertices.begin() + static_cast<std::ptrdiff_t>((r + 1) * kMaxVertices));
+    for (auto real : {&World::x, &World::y, &World::angle, &World::vx, &World::vy, &World::omega, &World::area, &World::thickness,
+                      &World::mass, &World::invMass, &World::invInertia, &World::gyration2, &World::gyrationX2, &World::gyrationY2,
+                      &World::principalAngle, &World::radius})
+      (w.*real).push_back((added.*real)[r]);
+  }
+  w.nextId = std::max(w.nextId, nextId);
+  followEdit(removedDevice, removedMirror, firstAdded);
 }
 
 void CudaStepper::flushPendingOrder() {
@@ -395,7 +437,14 @@ void CudaStepper::step() {
   for (const EnabledEvent& e : m_cpu->events())
     if (e.phase == EventPhase::Topology)
       for (int q : e.instance->streamsRead()) topology = topology || m_records.rowCount(q) > 0;
-  if (topology) runTopology();
+  // The resident kernel may have run it already (resident_kernel.cuh breakFloes): then the
+  // device's count of it is this step's, and the mirror followed after the run (followDeviceEdit).
+  if (mine.topologyOnDevice) {
+    m_rubbleMass += mine.rubbleMass;
+    m_floesBroken += mine.floesBroken;
+  } else if (topology) {
+    runTopology();
+  }
 
   const long done = m_step++;
   m_time = stepTime(m_step, scenario().dt);

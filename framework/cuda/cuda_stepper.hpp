@@ -71,6 +71,8 @@ class CudaStepper final : public Stepper {
   void restoreState(const StepperState& state) override;
   // Rebuilds of the device broadphase's kept list (0 for one that keeps none): reads the device.
   long broadphaseRebuilds() const;
+  // Launches of the resident kernel so far (0 on the device-wide driver): breaks no longer end one.
+  long residentLaunches() const;
   // Tests, alone only: run the topology phase through a whole-world round trip (download, edit,
   // upload), the reference that the device edit must match bit for bit.
   void setTopologyThroughHost(bool on) { m_topologyThroughHost = on; }
@@ -84,6 +86,9 @@ class CudaStepper final : public Stepper {
   bool deviceAhead() const;                           // the device has run steps that step() has not handed out yet
   void runTopology();                                 // phase 6 on the mirror, replayed on the device (CudaBatch::addEdit)
   void followReorder(const std::vector<int>& order);  // a device re-sort of this world's bodies
+  // A topology edit of this world (runTopology's, or the resident kernel's) in the mirror's order.
+  void followEdit(const std::vector<int>& removedDevice, const std::vector<int>& removedMirror, int firstAdded);
+  void followDeviceEdit(const std::vector<std::int64_t>& removed, const World& added, std::int64_t nextId);
   void flushPendingOrder();                           // the mirror into the device's order
   void locateVessel();                                // m_vesselSlot from the mirror (in the device's order)
   int mirrorSlot(int deviceSlot) const;               // the host mirror's row of a device slot

@@ -200,6 +200,10 @@ inline void awaitHostCopies() { GEM_CUDA_CHECK(cudaStreamSynchronize(cudaStreamL
 // Everything that follows from n and the ids: the hash table, the key widths, the per-step buffers
 // (device_state.cu).
 void sizeForBodies(DeviceState& d, std::int64_t nextId);
+// DeviceStep::editBodies on a state (edits.cu): the resident driver makes its state dense with it
+// after a launch whose breaks added bodies in the kernel.
+bool editDeviceBodies(DeviceState& d, const std::vector<int>& removedSlots, const World& from, int firstAdded,
+                      const std::vector<int>& addedWorlds, const std::vector<int>& vesselDofs);
 // Each world's vessel slot, to the device (device_state.cu).
 void uploadVessels(DeviceState& d);
 // The resident driver's contact keys of the last step, (lo << 32) | hi, sorted (world 0), and the

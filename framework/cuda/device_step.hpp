@@ -31,6 +31,24 @@ struct WorldStepRecord {
   Vec2 vesselImpulse;                   // N s, this step's contact impulses on the world's vessel
   Vec2 vesselPosition, vesselVelocity;  // after the step (zero in a world without a vessel)
   Real vesselAngle;
+  // The resident driver's breaks in the kernel (resident_kernel.cuh): 1 when the kernel ran this
+  // world's topology phase itself this step (the host's then has nothing to do), with the floes it
+  // broke and the mass that left as rubble (kg), as FlexuralBreaking::apply counts them.
+  int topologyOnDevice, floesBroken;
+  Real rubbleMass;
+};
+
+// What the resident driver's breaks in the kernel changed during a run of steps (the device state
+// is dense again when run() returns: DeviceStep::editBodies made it so). removedIds: device ids
+// of the bodies that left (broken floes, the pieces of a launch among them); added: the new
+// bodies that remain, as on the device after the run (shapes, mass properties and kinematics),
+// their worlds addedWorlds; nextIds: per world, its next free id (the case's own, not shifted).
+struct DeviceBodyEdits {
+  std::vector<std::int64_t> removedIds;
+  World added;
+  std::vector<int> addedWorlds;
+  std::vector<std::int64_t> nextIds;
+  bool empty() const { return removedIds.empty(); }
 };
 
 // What a run of steps hands back: copied off the device once, through pinned buffers, at its end
@@ -41,6 +59,7 @@ struct DeviceBatchResult {
   std::vector<StepRecord> steps;
   std::vector<WorldStepRecord> worldSteps;                // steps.size() x worlds: step s's world w at s * worlds + w
   std::vector<unsigned char> records[kMaxRecordStreams];  // rows (RecordTag + record) of each stream
+  DeviceBodyEdits edits;                                  // the resident kernel's breaks (empty: none)
 };
 
 class DeviceStep {
@@ -105,6 +124,11 @@ class DeviceStep {
   // paramsStride bytes, the Params of world w's events at the program's offsets.
   void useResident(const ResidentProgram& program, const std::vector<unsigned char>& params, int paramsStride);
   bool resident() const;
+  // The resident driver's breaks in the kernel give new bodies the next ids of their world: each
+  // world's next free id (the case's own), before each run.
+  void setNextIds(const std::vector<std::int64_t>& nextIds);
+  // Launches of the resident kernel so far (a break in the kernel no longer ends one).
+  long residentLaunches() const;
   // Steps kept on the device between two copies to the host (the ring's length), and threads per
   // block of the per-body and per-contact kernels. Before the first run.
   void configure(int copyBackEvery, int blockSize);

@@ -197,7 +197,11 @@ void DeviceStep::downloadKinematics(const std::vector<int>& deviceSlots, const s
 
 bool DeviceStep::editBodies(const std::vector<int>& removedSlots, const World& from, int firstAdded, const std::vector<int>& addedWorlds,
                             const std::vector<int>& vesselDofs) {
-  DeviceState& d = *m_state;
+  return editDeviceBodies(*m_state, removedSlots, from, firstAdded, addedWorlds, vesselDofs);
+}
+
+bool editDeviceBodies(DeviceState& d, const std::vector<int>& removedSlots, const World& from, int firstAdded,
+                      const std::vector<int>& addedWorlds, const std::vector<int>& vesselDofs) {
   const int before = d.n, removedCount = static_cast<int>(removedSlots.size());
   const int kept = before - removedCount, added = from.size() - firstAdded, n = kept + added;
   if (kept < 0 || added < 0 || (!addedWorlds.empty() && addedWorlds.size() != static_cast<size_t>(added)) ||

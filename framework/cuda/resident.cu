@@ -24,8 +24,16 @@ struct ResidentState {
   // a topology edit, a re-sort).
   std::vector<int> worldOfMembers;
   bool membersBuilt = false;
-  DeviceArray<int> members, memberBegin, previousCount;
+  DeviceArray<int> members, memberBegin, memberCount, previousCount;
   int mostBodies = 0;
+  // Breaks in the kernel (ResidentBreaking): the new bodies a world may add in a launch
+  // (GEM_RESIDENT_SPARE, default kSpareBodies; 0: every break ends the launch, as the device-wide
+  // driver's does), each world's next id, the spare slots taken and the bodies gone.
+  int spare = 0;
+  std::vector<std::int64_t> nextIds;
+  DeviceArray<std::int64_t> nextId;
+  DeviceArray<int> spareUsed;
+  DeviceArray<unsigned char> gone;
   // Per-world scratch (ResidentArgs).
   int capacity = 0, capacitySort = 0, bodySort = 0;
   int startCapacity = 0;  // GEM_CUDA_CAPACITY (tests force the regrowth path with it); 0: 4 x bodies + 256
@@ -79,25 +87,146 @@ int powerOfTwoAtLeast(int n) {
   return m;
 }
 
-// Each world's slots, ascending, one world after the other.
+// New bodies a world may add by breaks in one launch (ResidentBreaking). The 70-run load study
+// breaks about 10 floes a case over its 3,600 steps; a launch is at most copy_back_every steps.
+constexpr int kSpareBodies = 64;
+
+// Each world's slots, ascending, one world after the other, each with room for its spare bodies.
 void buildMembers(DeviceState& d, ResidentState& r) {
   const int worlds = d.worlds;
-  std::vector<int> begin(static_cast<size_t>(worlds) + 1, 0), members(d.worldHost.size());
-  for (int w : d.worldHost) ++begin[static_cast<size_t>(w) + 1];
+  std::vector<int> begin(static_cast<size_t>(worlds) + 1, 0), count(static_cast<size_t>(worlds), 0);
+  for (int w : d.worldHost) ++count[static_cast<size_t>(w)];
   r.mostBodies = 0;
   for (int w = 0; w < worlds; ++w) {
-    r.mostBodies = std::max(r.mostBodies, begin[static_cast<size_t>(w) + 1]);
-    begin[static_cast<size_t>(w) + 1] += begin[static_cast<size_t>(w)];
+    r.mostBodies = std::max(r.mostBodies, count[static_cast<size_t>(w)]);
+    begin[static_cast<size_t>(w) + 1] = begin[static_cast<size_t>(w)] + count[static_cast<size_t>(w)] + r.spare;
   }
+  std::vector<int> members(static_cast<size_t>(std::max(begin.back(), 1)), 0);
   std::vector<int> at(begin.begin(), begin.end() - 1);
   for (size_t k = 0; k < d.worldHost.size(); ++k)
     members[static_cast<size_t>(at[static_cast<size_t>(d.worldHost[k])]++)] = static_cast<int>(k);
   r.members.upload(members.data(), members.size());
   r.memberBegin.upload(begin.data(), begin.size());
+  r.memberCount.upload(count.data(), count.size());
   r.worldOfMembers = d.worldHost;
   r.membersBuilt = true;
-  r.bodySort = powerOfTwoAtLeast(std::max(r.mostBodies, 1));
+  // A world grows by its spare bodies at most in a launch: the sorts and the shared memory have room.
+  r.bodySort = powerOfTwoAtLeast(std::max(r.mostBodies + r.spare, 1));
   r.sweepKeys.ensure(static_cast<size_t>(worlds) * static_cast<size_t>(r.bodySort));
+}
+
+// Room past the state's n bodies for every world's spare ones, the first n rows kept.
+void makeSpareRoom(DeviceState& d, ResidentState& r) {
+  const size_t n = static_cast<size_t>(d.n), room = n + static_cast<size_t>(d.worlds) * static_cast<size_t>(r.spare);
+  d.id.ensureKeeping(room, n), d.kind.ensureKeeping(room, n), d.vertexCount.ensureKeeping(room, n), d.dof.ensureKeeping(room, n);
+  d.world.ensureKeeping(room, n), d.isLarge.ensureKeeping(room, n), d.local.ensureKeeping(room * kMaxVertices, n * kMaxVertices);
+  for (GraphArray<Real>* a : {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.area, &d.thickness, &d.mass, &d.invMass, &d.invInertia,
+                              &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle, &d.radius})
+    a->ensureKeeping(room, n);
+  // The per-step views are written by every step's prepare: no rows to keep.
+  d.worldVertices.ensure(room * kMaxVertices);
+  d.boxes.ensure(room), d.pairBodies.ensure(room), d.soloBodies.ensure(room), d.changes.ensure(room), d.motionBodies.ensure(room);
+  r.gone.ensure(room);
+  GEM_CUDA_CHECK(cudaMemset(r.gone.get(), 0, room));
+  if (d.worlds == 1) {
+    // The frames' contact force by id: room for the ids the launch may give, the new ones 0.
+    const size_t ids = static_cast<size_t>(r.nextIds.at(0)) + static_cast<size_t>(r.spare), kept = d.contactImpulseOfId.capacity();
+    if (d.contactImpulseOfId.ensureKeeping(ids, kept))
+      GEM_CUDA_CHECK(cudaMemset(d.contactImpulseOfId.get() + kept, 0, (d.contactImpulseOfId.capacity() - kept) * sizeof(Real)));
+  }
+}
+
+// Rows [first, first + count) of a device array into the host vector's end.
+template <class T, class Array>
+void appendDeviceRows(std::vector<T>& to, const Array& from, size_t first, size_t count) {
+  const size_t at = to.size();
+  to.resize(at + count);
+  if (count) GEM_CUDA_CHECK(cudaMemcpy(to.data() + at, from.get() + first, count * sizeof(T), cudaMemcpyDeviceToHost));
+}
+
+// After a launch whose breaks added bodies in the kernel: the state made dense again, as the
+// device-wide driver's edits leave it (the bodies that left compacted out, the others in their
+// order, the new ones after them in the order they were made, world by world), and what changed
+// appended to `edits` for the host's mirrors.
+void makeDense(DeviceState& d, ResidentState& r, DeviceBodyEdits& edits) {
+  const int worlds = d.worlds, n = d.n;
+  std::vector<int> used(static_cast<size_t>(worlds));
+  r.spareUsed.download(used.data(), used.size());
+  std::vector<std::int64_t> nextIds(static_cast<size_t>(worlds));
+  r.nextId.download(nextIds.data(), nextIds.size());
+  const size_t first = static_cast<size_t>(n), room = static_cast<size_t>(worlds) * static_cast<size_t>(r.spare);
+  std::vector<unsigned char> gone(first + room);
+  r.gone.download(gone.data(), gone.size());
+  std::vector<std::int64_t> ids;
+  appendDeviceRows(ids, d.id, 0, first + room);
+
+  // The bodies that left: of the state (compacted out), and new ones broken again in the launch.
+  std::vector<int> removedSlots;
+  for (int k = 0; k < n; ++k)
+    if (gone[static_cast<size_t>(k)]) removedSlots.push_back(k), edits.removedIds.push_back(ids[static_cast<size_t>(k)]);
+  // The new ones that stay: their rows as the kernel made them, and their kinematics now.
+  World added;
+  std::vector<int> addedWorlds;
+  World spareRows;
+  appendDeviceRows(spareRows.id, d.id, first, room), appendDeviceRows(spareRows.kind, d.kind, first, room);
+  appendDeviceRows(spareRows.vertexCount, d.vertexCount, first, room);
+  appendDeviceRows(spareRows.localVertices, d.local, first * kMaxVertices, room * kMaxVertices);
+  std::vector<Real> World::*reals[] = {&World::x,          &World::y,          &World::angle,          &World::vx,
+                                       &World::vy,         &World::omega,      &World::area,           &World::thickness,
+                                       &World::mass,       &World::invMass,    &World::invInertia,     &World::gyration2,
+                                       &World::gyrationX2, &World::gyrationY2, &World::principalAngle, &World::radius};
+  const GraphArray<Real>* arrays[] = {&d.x,    &d.y,       &d.angle,   &d.vx,         &d.vy,         &d.omega,
+                                      &d.area, &d.thickness, &d.mass,  &d.invMass,    &d.invInertia, &d.gyration2,
+                                      &d.gyrationX2, &d.gyrationY2, &d.principalAngle, &d.radius};
+  for (size_t a = 0; a < std::size(reals); ++a) appendDeviceRows(spareRows.*reals[a], *arrays[a], first, room);
+  for (int w = 0; w < worlds; ++w)
+    for (int t = 0; t < used[static_cast<size_t>(w)]; ++t) {
+      const size_t k = static_cast<size_t>(w) * static_cast<size_t>(r.spare) + static_cast<size_t>(t);
+      if (gone[first + k]) {
+        edits.removedIds.push_back(spareRows.id[k]);
+        continue;
+      }
+      added.id.push_back(spareRows.id[k]), added.kind.push_back(spareRows.kind[k]), added.vertexCount.push_back(spareRows.vertexCount[k]);
+      added.localVertices.insert(added.localVertices.end(), spareRows.localVertices.begin() + static_cast<std::ptrdiff_t>(k * kMaxVertices),
+                                 spareRows.localVertices.begin() + static_cast<std::ptrdiff_t>((k + 1) * kMaxVertices));
+      for (auto real : reals) (added.*real).push_back((spareRows.*real)[k]);
+      addedWorlds.push_back(w);
+    }
+  // The ids the dense state has room for: the world's own next id alone, or every world's stride.
+  added.nextId = worlds == 1 ? nextIds[0] : static_cast<std::int64_t>(worlds) * d.idStride;
+  editDeviceBodies(d, removedSlots, added, 0, worlds == 1 ? std::vector<int>{} : addedWorlds, std::vector<int>(static_cast<size_t>(worlds), 3));
+  r.membersBuilt = false;
+
+  // For the host: a body made and gone within the run was never in a mirror; made in an earlier
+  // launch of the run and gone in this one, it leaves the run's added rows instead.
+  std::vector<char> dropped(edits.added.id.size(), 0);
+  bool anyDropped = false;
+  std::vector<std::int64_t> removed;
+  for (std::int64_t id : edits.removedIds) {
+    const auto it = std::find(edits.added.id.begin(), edits.added.id.end(), id);
+    if (it == edits.added.id.end()) {
+      removed.push_back(id);
+    } else {
+      dropped[static_cast<size_t>(it - edits.added.id.begin())] = 1, anyDropped = true;
+    }
+  }
+  edits.removedIds.swap(removed);
+  if (anyDropped) {
+    std::vector<int> keptWorlds;
+    for (size_t k = 0; k < dropped.size(); ++k)
+      if (!dropped[k]) keptWorlds.push_back(edits.addedWorlds[k]);
+    edits.added.removeBodies(dropped);
+    edits.addedWorlds.swap(keptWorlds);
+  }
+  for (int k = 0; k < added.size(); ++k) {
+    edits.added.id.push_back(added.id[static_cast<size_t>(k)]), edits.added.kind.push_back(added.kind[static_cast<size_t>(k)]);
+    edits.added.vertexCount.push_back(added.vertexCount[static_cast<size_t>(k)]);
+    for (auto real : reals) (edits.added.*real).push_back((added.*real)[static_cast<size_t>(k)]);
+  }
+  edits.added.localVertices.insert(edits.added.localVertices.end(), added.localVertices.begin(), added.localVertices.end());
+  edits.addedWorlds.insert(edits.addedWorlds.end(), addedWorlds.begin(), addedWorlds.end());
+  edits.nextIds = nextIds;
+  r.nextIds = nextIds;
 }
 
 // Room for `capacity` candidate pairs in every world; the previous step's pairs are kept.
@@ -139,9 +268,19 @@ void DeviceStep::useResident(const ResidentProgram& program, const std::vector<u
   r.paramsStride = paramsStride;
   r.params.upload(params.data(), std::max<size_t>(params.size(), 1));
   if (const char* start = std::getenv("GEM_CUDA_CAPACITY")) r.startCapacity = std::max(1, std::atoi(start));
+  // GEM_RESIDENT_SPARE=N: room for N new bodies a world and launch (0: breaks end the launch).
+  r.spare = kSpareBodies;
+  if (const char* spare = std::getenv("GEM_RESIDENT_SPARE")) r.spare = std::max(0, std::atoi(spare));
+  if (program.breakingOffset < 0) r.spare = 0;
 }
 
 bool DeviceStep::resident() const { return m_state->resident != nullptr; }
+
+void DeviceStep::setNextIds(const std::vector<std::int64_t>& nextIds) {
+  if (m_state->resident) m_state->resident->nextIds = nextIds;
+}
+
+long DeviceStep::residentLaunches() const { return m_state->resident ? m_state->resident->launches : 0; }
 
 std::vector<unsigned long long> residentPreviousKeys(const DeviceState& d) {
   const ResidentState& r = *d.resident;
@@ -183,8 +322,6 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     const char* stage = std::getenv("GEM_RESIDENT_STAGE_VERTICES");
     r.vertexRoom = stage && std::strcmp(stage, "0") == 0 ? 0 : 8 * r.mostBodies;
   }
-  const std::size_t shared = residentSharedBytes(r.mostBodies, r.vertexRoom);
-  const int grid = std::max(1, std::min(d.worlds, multiprocessors * std::max(1, residentBlocksPerMultiprocessor(shared))));
 
   // GEM_RESIDENT_CLIP=thread: the contact geometry a thread a pair, as before the warp's clipping
   // (a switch for the side-by-side figures in docs/performance.md; the results are the same).
@@ -192,11 +329,23 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     const char* v = std::getenv("GEM_RESIDENT_CLIP");
     return v && std::strcmp(v, "thread") == 0;
   }();
-  awaitHostCopies();  // members, params, the kept pairs: read by the launches below
   long next = firstStep;
   int remaining = steps;
   while (remaining > 0) {
     const int batch = std::min(remaining, d.ringSize);
+    const bool breaking = r.spare > 0;
+    if (breaking) {
+      if (r.nextIds.size() != static_cast<size_t>(d.worlds)) throw std::logic_error("runResident: each world's next id is needed (setNextIds)");
+      if (!r.membersBuilt || r.worldOfMembers != d.worldHost) buildMembers(d, r);
+      makeSpareRoom(d, r);
+      r.nextId.upload(r.nextIds.data(), r.nextIds.size());
+      r.spareUsed.ensure(static_cast<size_t>(d.worlds));
+      GEM_CUDA_CHECK(cudaMemset(r.spareUsed.get(), 0, sizeof(int) * static_cast<size_t>(d.worlds)));
+    }
+    // The largest world, its spare bodies included, sets the launch's shared memory.
+    const std::size_t shared = residentSharedBytes(r.mostBodies + r.spare, r.vertexRoom);
+    const int grid = std::max(1, std::min(d.worlds, multiprocessors * std::max(1, residentBlocksPerMultiprocessor(shared))));
+    awaitHostCopies();  // members, params, the kept pairs, the spare room: read by the launch below
     GEM_CUDA_CHECK(cudaMemsetAsync(r.control.get(), 0, sizeof(ResidentControl), d.stream));
     GEM_CUDA_CHECK(cudaMemsetAsync(r.recordCount.get(), 0, sizeof(int) * kMaxRecordStreams, d.stream));
     ResidentArgs a{};
@@ -205,7 +354,12 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     a.vessel = d.vessel.get();
     a.motion = d.motionBodies.get();
     a.impulseOfId = d.worlds == 1 ? d.contactImpulseOfId.get() : nullptr;
-    a.members = r.members.get(), a.memberBegin = r.memberBegin.get(), a.worlds = d.worlds;
+    a.members = r.members.get(), a.memberBegin = r.memberBegin.get(), a.memberCount = r.memberCount.get(), a.worlds = d.worlds;
+    a.breaking = ResidentBreaking{breaking ? r.program.breakingOffset : -1, r.spare, d.n, r.spareUsed.get(), r.nextId.get(), r.gone.get(),
+                                  ResidentBodyRows{d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.world.get(), d.local.get(),
+                                                   d.area.get(), d.thickness.get(), d.mass.get(), d.invMass.get(), d.invInertia.get(),
+                                                   d.gyration2.get(), d.gyrationX2.get(), d.gyrationY2.get(), d.principalAngle.get(),
+                                                   d.radius.get(), d.isLarge.get()}};
     a.capacity = r.capacity, a.capacitySort = r.capacitySort, a.bodySort = r.bodySort;
     a.sweepKeys = r.sweepKeys.get(), a.pairKeys = r.pairKeys.get(), a.idKeys = r.idKeys.get(), a.bKeys = r.bKeys.get();
     a.previous = r.previous.get(), a.previousCount = r.previousCount.get();
@@ -216,7 +370,12 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     a.params = r.params.get(), a.paramsStride = r.paramsStride;
     for (int q = 0; q < d.recordStreams; ++q)
       a.sink.streams[q] = RecordBuffer{d.records[q].get(), d.recordStride[q], d.recordCapacity, r.recordCount.get() + q};
+    // The kernel's own topology phase takes its stream's rows; any other topology stream halts.
     a.haltStreams = d.haltStreams;
+    if (breaking) {
+      const int q = r.program.breakingStream;
+      if (q >= 0) a.haltStreams &= ~(1u << q);
+    }
     a.firstStep = next, a.dt = dt, a.steps = batch;
     a.clipByThread = clipByThread;
     a.sharedBytes = shared;
@@ -256,6 +415,7 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
                              d.h_worldRing + static_cast<size_t>(done) * static_cast<size_t>(d.worlds));
     next += done;
     remaining -= done;
+    if (control.floesBroken > 0) makeDense(d, r, result.edits);
     if (control.haltReason == kHaltBreak) break;
     if (control.haltReason != kHaltOverflow) continue;
     // A step overflowed and left every world alone: grow what it passed, run it again.

@@ -39,6 +39,11 @@ struct ResidentEventCall {
 struct ResidentProgram {
   int pairCount = 0, soloCount = 0, motionCount = 0;
   ResidentEventCall pair[kResidentMaxEvents], solo[kResidentMaxEvents], motion[kResidentMaxEvents];
+  // The topology phase in the kernel: where flexural_breaking's Params sit in each world's row
+  // (residentTopologyKind), or -1 when the kernel does not run the scenario's topology events
+  // (none, or one it does not hold): a step with their rows then ends the launch for the host's.
+  int breakingOffset = -1;
+  int breakingStream = -1;  // the record stream of its requests (the host's halt takes it out)
 };
 
 // The phases the kernel times (ResidentControl::phaseCycles, kResidentPhaseNames).
@@ -56,6 +61,7 @@ struct ResidentControl {
   long long phaseCycles[kResidentPhases];
   long long pairCounts[3];  // block 0's first world, over the launch: candidate pairs, overlapping, contacts
   int verticesNeeded;       // the most vertices a world had (the next launch's shared memory for them)
+  int floesBroken;          // by the kernel's topology phase, every world (the state is made dense after)
 };
 // The phases' names, in the kernel's order.
 inline constexpr const char* kResidentPhaseNames[kResidentPhases] = {
@@ -63,15 +69,44 @@ inline constexpr const char* kResidentPhaseNames[kResidentPhases] = {
     "contact geometry", "onset",           "events",     "sorts", "first barrier", "gather, motion, write-back",
     "second barrier",   "step edges"};
 
+// The rows of a body the kernel writes when a break adds it (PrepareArgs holds them read-only).
+struct ResidentBodyRows {
+  std::int64_t* id;
+  BodyKind* kind;
+  int *vertexCount, *dof, *world;
+  Vec2* local;
+  Real *area, *thickness, *mass, *invMass, *invInertia, *gyration2, *gyrationX2, *gyrationY2, *principalAngle, *radius;
+  unsigned char* isLarge;
+};
+
+// Breaks in the kernel: each world may add up to `spare` bodies in a launch, into the slots
+// spareFirst + w x spare + [0, spare) past the state's bodies (spareUsed[w] of them taken); a world
+// whose step asks for more stops the launch there, and the host's topology phase does that step.
+// A body that leaves is marked in gone[slot] and dropped from its world's members; its slot keeps
+// its rows until the host makes the state dense again (runResident, DeviceStep::editBodies).
+struct ResidentBreaking {
+  int offset;  // ResidentProgram::breakingOffset (-1: none in the kernel)
+  int spare, spareFirst;
+  int* spareUsed;            // per world
+  std::int64_t* nextId;      // per world: the case's next own id
+  unsigned char* gone;       // per slot, spare slots included
+  ResidentBodyRows rows;
+};
+
 struct ResidentArgs {
   PrepareArgs prepare;  // the world's arrays, cellKey nullptr
   Real *x, *y, *angle, *vx, *vy, *omega;
   const int* vessel;  // per world: its vessel's slot, -1 none
   MotionBody* motion;
   Real* impulseOfId;  // one world: |its contact impulses| by body id (the frames' contact_force); else null
-  // Worlds: world w's bodies are members[memberBegin[w] .. memberBegin[w + 1]), ascending slots.
-  const int *members, *memberBegin;
+  // Worlds: world w's bodies are members[memberBegin[w] .. memberBegin[w] + memberCount[w]), in the
+  // order of its own run (ascending slots; the bodies a break adds after the others), with room for
+  // the spare bodies a launch may add.
+  int* members;
+  const int* memberBegin;
+  int* memberCount;
   int worlds;
+  ResidentBreaking breaking;
   // Per-world scratch: `capacity` candidate pairs, pow2 of it for the sorts, `bodySort` for the sweep.
   int capacity, capacitySort, bodySort;
   unsigned long long *sweepKeys, *pairKeys, *idKeys, *bKeys, *previous;
@@ -103,6 +138,9 @@ enum ResidentPhase : int { kResidentPair = 0, kResidentSolo = 1, kResidentMotion
 // resident_events.cu: the built-in events the kernel holds. Returns the event's kind and the size
 // of its Params, or -1 when the kernel does not hold an event of that name and phase.
 int residentEventKind(const std::string& name, ResidentPhase phase, std::size_t* paramsSize);
+// The topology events the kernel holds (only flexural_breaking): true, with the size of its
+// Params, when the kernel can run `name` itself.
+bool residentTopologyEvent(const std::string& name, std::size_t* paramsSize);
 // A launch's dynamic shared memory holds, for the world a block steps: the sweep's keys, the boxes
 // and inverse masses (bodySort of each), the offsets of each body's vertices and of each body's
 // candidate pairs (bodySort + 1 of each), then as many of the world's vertices as fit in the rest

@@ -9,6 +9,8 @@
 #include "events/drag.hpp"
 #include "events/elastic_contact.hpp"
 #include "events/environmental_force.hpp"
+#include "events/flexural_breaking.hpp"
+#include "events/flexural_cut.hpp"
 #include "events/impact.hpp"
 #include "events/motion.hpp"
 #include "events/propulsion.hpp"
@@ -23,6 +25,23 @@ namespace {
 using BuiltIn = resident::EventSet<resident::Pair<Impact>, resident::Pair<ElasticContact>, resident::Pair<ShipImpact>, resident::Solo<Drag>,
                                    resident::Solo<EnvironmentalForce>, resident::Solo<EnvironmentalForce>, resident::Solo<Propulsion>,
                                    resident::Solo<Autopilot>, resident::Motion<Motion>>;
+
+// The topology event the kernel runs itself (breakFloes): flexural_breaking, its Params read from
+// each world's row, its cut the host's (events/flexural_cut.hpp).
+struct Breaking {
+  using Request = BreakRequest;
+  using Piece = FloePiece;
+  __device__ static int stream(const unsigned char* row, int offset) {
+    return resident::paramsAt<FlexuralBreaking::Params>(row, offset).breaks.index;
+  }
+  __device__ static Real minArea(const unsigned char* row, int offset) {
+    return resident::paramsAt<FlexuralBreaking::Params>(row, offset).minArea;
+  }
+  __device__ static bool cut(const Vec2* local, int n, Vec2 centroid, Real angle, Vec2 velocity, Real omega, const BreakRequest& request,
+                             Real minArea, FloePiece pieces[2]) {
+    return cutFloe(local, n, centroid, angle, velocity, omega, request, minArea, pieces);
+  }
+};
 
 struct Entry {
   const char* name;
@@ -50,6 +69,12 @@ int residentEventKind(const std::string& name, ResidentPhase phase, std::size_t*
   return -1;
 }
 
+bool residentTopologyEvent(const std::string& name, std::size_t* paramsSize) {
+  if (name != "flexural_breaking") return false;
+  if (paramsSize) *paramsSize = sizeof(FlexuralBreaking::Params);
+  return true;
+}
+
 std::size_t residentSharedBytes(int bodies, int vertices) {
   int sorted = 1;
   while (sorted < bodies) sorted <<= 1;
@@ -62,7 +87,7 @@ std::size_t residentSharedBytes(int bodies, int vertices) {
 static void allowShared(std::size_t shared) {
   static std::size_t allowed = 0;
   if (shared <= allowed) return;
-  GEM_CUDA_CHECK(cudaFuncSetAttribute(resident::residentKernel<BuiltIn>, cudaFuncAttributeMaxDynamicSharedMemorySize,
+  GEM_CUDA_CHECK(cudaFuncSetAttribute(resident::residentKernel<BuiltIn, Breaking>, cudaFuncAttributeMaxDynamicSharedMemorySize,
                                       static_cast<int>(kResidentSharedBytes)));
   allowed = kResidentSharedBytes;
 }
@@ -70,21 +95,21 @@ static void allowShared(std::size_t shared) {
 void launchResident(const ResidentArgs& args, int grid, std::size_t shared, cudaStream_t stream) {
   allowShared(shared);
   if (grid == 1) {
-    resident::residentKernel<BuiltIn><<<1, kResidentBlock, shared, stream>>>(args, shared > 0);
+    resident::residentKernel<BuiltIn, Breaking><<<1, kResidentBlock, shared, stream>>>(args, shared > 0);
     GEM_CUDA_CHECK_LAUNCH();
     return;
   }
   ResidentArgs copy = args;
   bool staged = shared > 0;
   void* params[] = {&copy, &staged};
-  GEM_CUDA_CHECK(cudaLaunchCooperativeKernel(reinterpret_cast<void*>(resident::residentKernel<BuiltIn>), dim3(static_cast<unsigned>(grid)),
+  GEM_CUDA_CHECK(cudaLaunchCooperativeKernel(reinterpret_cast<void*>(resident::residentKernel<BuiltIn, Breaking>), dim3(static_cast<unsigned>(grid)),
                                              dim3(kResidentBlock), params, shared, stream));
 }
 
 int residentBlocksPerMultiprocessor(std::size_t shared) {
   allowShared(shared);
   int blocks = 0;
-  GEM_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, resident::residentKernel<BuiltIn>, kResidentBlock, shared));
+  GEM_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, resident::residentKernel<BuiltIn, Breaking>, kResidentBlock, shared));
   return blocks;
 }
 

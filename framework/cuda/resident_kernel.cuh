@@ -1,6 +1,9 @@
 // Internal to framework/cuda: the resident driver's kernel (resident.cuh says what it is), a template
 // over the table of events it holds; resident_events.cu instantiates it with the built-in events.
 //
+// The table is Events (pair, solo and motion evaluators) and Breaking (the topology event, with
+// its cut: events/flexural_cut.hpp through resident_events.cu, the one file that names events).
+//
 // One block steps one world at a time; a block of a launch of many worlds takes worlds blockIdx.x,
 // blockIdx.x + gridDim.x, ... Per step and world:
 //   1. prepare every body (body_phases.cuh), and key it by its box's left edge;
@@ -10,7 +13,10 @@
 //   4. the pair events, contact by contact, each contact's events in the declared order; the solo
 //      events, body by body;
 //   -- a grid barrier: every world knows whether any overflowed a buffer or asked for a break --
-//   5. gather in the CPU's order, the motion events, write-back; this step's pairs kept for onset.
+//   5. gather in the CPU's order, the motion events, write-back; this step's pairs kept for onset;
+//   6. the topology phase, when the kernel holds the scenario's (flexural_breaking: breakFloes):
+//      the floes cut, their pieces added into the world's spare slots, so that a break does not
+//      end the launch (the host makes the state dense again after it: resident.cu);
 //   -- a grid barrier: the step is over everywhere --
 // A step that overflowed leaves every world's state alone (phase 5 is where the state is written),
 // so the host can grow the buffer and run it again, bit-identically.
@@ -112,7 +118,24 @@ struct MotionCall {
 // Keys sorted in shared memory up to this many, in global memory past it.
 constexpr int kSharedSort = 2048;
 
+// The most break requests a world's step may have for the kernel's topology phase (more: the
+// launch stops there and the host's topology phase runs that step).
+constexpr int kResidentMostBreaks = 32;
+
+// A world's break requests of one step (breakFloes).
+struct BreakScratch {
+  int count, unique, piecesKept, floesBroken;
+  Real rubbleMass;
+  int row[kResidentMostBreaks];        // the rows of the request stream, in the CPU's order
+  std::int64_t floeId[kResidentMostBreaks];
+  int place[kResidentMostBreaks];      // the floe's place in the world (-1: not there)
+  int firstPiece[kResidentMostBreaks]; // the request's first new body among the step's
+  int cut[kResidentMostBreaks];        // 1: the floe was cut
+  Real rubble[kResidentMostBreaks][2]; // the mass each of its pieces took away as rubble, kg
+};
+
 struct BlockShared {
+  BreakScratch breaks;
   int scan[33];
   int count;
   long long cycles[kResidentPhases], stamp;  // block 0's time by phase (ResidentControl::phaseCycles)
@@ -271,7 +294,7 @@ __device__ inline int readShared(const int* p) { return *static_cast<const volat
 
 struct WorldScratch {
   int begin, n;
-  const int* members;
+  const int* members;  // the world's slots (a.members + begin)
   unsigned long long *sweep, *pairs, *ids, *bs, *previous;
   Contact* candidates;
   int *flag, *touching, *survivors;
@@ -284,7 +307,7 @@ __device__ inline WorldScratch scratchOf(const ResidentArgs& a, int w) {
   const size_t cap = static_cast<size_t>(a.capacity), sortCap = static_cast<size_t>(a.capacitySort), ww = static_cast<size_t>(w);
   WorldScratch s;
   s.begin = a.memberBegin[w];
-  s.n = a.memberBegin[w + 1] - s.begin;
+  s.n = a.memberCount[w];
   s.members = a.members + s.begin;
   s.sweep = a.sweepKeys + ww * static_cast<size_t>(a.bodySort);
   s.pairs = a.pairKeys + ww * sortCap;
@@ -574,6 +597,172 @@ __device__ void secondHalf(const ResidentArgs& a, int w, int contacts, const Ste
   __syncthreads();
 }
 
+// The topology phase of world w in step s, after its write-back (docs/model.md 6, as
+// FlexuralBreaking::apply does it on the host): its requests of the step in the CPU's order (by
+// event, then contact), the first for each floe, each floe cut by events/flexural_cut.hpp from its
+// moved state, the pieces added into the world's spare slots with World::addPiece's rows
+// (bodyMassRow with the portable trigonometry) and new ids, the floe and rubble out of the world's members. A world with more
+// requests than its room stops the launch after this step instead (halt), and leaves the step to
+// the host. Returns nothing; the world's record of the step says what it did.
+template <class Breaking>
+__device__ void breakFloes(const ResidentArgs& a, int w, int s, int parity, WorldStepRecord& record, BlockShared& sh) {
+  const ResidentBreaking& br = a.breaking;
+  const PrepareArgs& p = a.prepare;
+  const unsigned char* row = a.params + static_cast<size_t>(w) * static_cast<size_t>(a.paramsStride);
+  const int q = Breaking::stream(row, br.offset);
+  if (q < 0 || q >= kMaxRecordStreams || !a.sink.streams[q].count) return;
+  const RecordBuffer& buffer = a.sink.streams[q];
+  // This step's rows: nothing is pushed after the first barrier, and the step before ended its rows.
+  const int begin = s > 0 ? a.ring[s - 1].recordEnd[q] : 0;
+  const int end = min(readShared(buffer.count), buffer.capacity);
+  auto tagOf = [&](int r) {
+    RecordTag t;
+    memcpy(&t, buffer.rows + static_cast<size_t>(r) * static_cast<size_t>(buffer.stride), sizeof t);
+    return t;
+  };
+  auto requestOf = [&](int r) {
+    typename Breaking::Request request;
+    memcpy(&request, buffer.rows + static_cast<size_t>(r) * static_cast<size_t>(buffer.stride) + sizeof(RecordTag), sizeof request);
+    return request;
+  };
+  BreakScratch& b = sh.breaks;
+  if (threadIdx.x == 0) b.count = 0;
+  __syncthreads();
+  for (int r = begin + static_cast<int>(threadIdx.x); r < end; r += blockDim.x)
+    if (tagOf(r).world == w) {
+      const int k = atomicAdd(&b.count, 1);
+      if (k < kResidentMostBreaks) b.row[k] = r;
+    }
+  __syncthreads();
+  const int count = b.count;
+  if (count == 0) return;
+  const int room = br.spare - br.spareUsed[w];
+  if (threadIdx.x == 0) {
+    // The CPU's order of the rows (by event, then contact), then the first request of each floe.
+    for (int i = 1; i < min(count, kResidentMostBreaks); ++i)
+      for (int j = i; j > 0; --j) {
+        const RecordTag x = tagOf(b.row[j - 1]), y = tagOf(b.row[j]);
+        if (x.event < y.event || (x.event == y.event && x.contact <= y.contact)) break;
+        const int t = b.row[j - 1];
+        b.row[j - 1] = b.row[j], b.row[j] = t;
+      }
+    int unique = 0;
+    for (int i = 0; i < min(count, kResidentMostBreaks); ++i) {
+      const std::int64_t id = requestOf(b.row[i]).floeId;
+      bool seen = false;
+      for (int j = 0; j < unique; ++j) seen = seen || b.floeId[j] == id;
+      if (seen) continue;
+      b.row[unique] = b.row[i], b.floeId[unique] = id, b.place[unique] = -1;
+      ++unique;
+    }
+    b.unique = unique;
+    // Two pieces a request at most: a world without the room leaves the step to the host.
+    if (count > kResidentMostBreaks || 2 * unique > room) {
+      b.unique = -1;
+      a.control->halt[parity] = 1;
+      atomicMax(&a.control->haltReason, kHaltBreak);
+    }
+  }
+  __syncthreads();
+  const int unique = b.unique;
+  if (unique < 0) return;
+  const std::int64_t idBase = static_cast<std::int64_t>(w) * p.idStride;
+  WorldScratch ws = scratchOf(a, w);
+  for (int i = threadIdx.x; i < ws.n; i += blockDim.x) {
+    const std::int64_t own = p.id[ws.members[i]] - idBase;
+    for (int j = 0; j < unique; ++j)
+      if (b.floeId[j] == own) b.place[j] = i;
+  }
+  __syncthreads();
+  // Each request's cut on a thread of its own, from the floe's moved state, as the host's.
+  typename Breaking::Piece pieces[2];
+  bool cut = false;
+  const int j = threadIdx.x;
+  if (j < unique && b.place[j] >= 0) {
+    const int slot = ws.members[b.place[j]];
+    cut = Breaking::cut(p.local + static_cast<size_t>(slot) * kMaxVertices, p.vertexCount[slot], Vec2{a.x[slot], a.y[slot]}, a.angle[slot],
+                        Vec2{a.vx[slot], a.vy[slot]}, a.omega[slot], requestOf(b.row[j]), Breaking::minArea(row, br.offset), pieces);
+  }
+  if (j < unique) {
+    b.cut[j] = cut ? 1 : 0;
+    b.firstPiece[j] = cut ? (pieces[0].rubble ? 0 : 1) + (pieces[1].rubble ? 0 : 1) : 0;
+    // The mass each piece takes away as rubble (0 for a piece that stays: adding it changes no sum).
+    for (int k = 0; k < 2; ++k)
+      b.rubble[j][k] = cut && pieces[k].rubble ? kRhoIce * pieces[k].area * p.thickness[ws.members[b.place[j]]] : Real(0);
+  }
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    // In the requests' order, as the host's loop: the new bodies' places, the rubble's mass.
+    int kept = 0, broken = 0;
+    Real rubble = 0;
+    for (int k = 0; k < unique; ++k) {
+      const int here = b.firstPiece[k];
+      b.firstPiece[k] = kept;
+      kept += here;
+      broken += b.cut[k];
+      if (b.cut[k]) rubble += b.rubble[k][0], rubble += b.rubble[k][1];
+    }
+    b.piecesKept = kept, b.floesBroken = broken, b.rubbleMass = rubble;
+  }
+  __syncthreads();
+  const int used = br.spareUsed[w];
+  if (cut) {
+    const int parent = ws.members[b.place[j]];
+    const ResidentBodyRows& out = br.rows;
+    int k = b.firstPiece[j];
+    for (const auto& piece : pieces) {
+      if (piece.rubble) continue;
+      const int slot = br.spareFirst + w * br.spare + used + k;
+      const BodyMassRow m =
+          bodyMassRow<PortableTrig>(piece.vertices, piece.count, p.thickness[parent], false, out.local + static_cast<size_t>(slot) * kMaxVertices);
+      out.id[slot] = idBase + br.nextId[w] + k;
+      out.kind[slot] = BodyKind::Floe;
+      out.vertexCount[slot] = piece.count;
+      out.dof[slot] = degreesOfFreedom(BodyKind::Floe, 0);
+      out.world[slot] = w;
+      out.isLarge[slot] = 0;  // only the device-wide driver's grid reads it; the dense state sets it again
+      out.area[slot] = m.area, out.thickness[slot] = p.thickness[parent], out.mass[slot] = m.mass, out.invMass[slot] = m.invMass;
+      out.invInertia[slot] = m.invInertia, out.gyration2[slot] = m.gyration2, out.gyrationX2[slot] = m.gyrationX2;
+      out.gyrationY2[slot] = m.gyrationY2, out.principalAngle[slot] = m.principalAngle, out.radius[slot] = m.radius;
+      a.x[slot] = m.centroid.x, a.y[slot] = m.centroid.y, a.angle[slot] = 0;
+      a.vx[slot] = piece.velocity.x, a.vy[slot] = piece.velocity.y, a.omega[slot] = a.omega[parent];
+      br.gone[slot] = 0;
+      ++k;
+    }
+    br.gone[parent] = 1;
+  }
+  __syncthreads();
+  // The members: the cut floes out (the others keep their order), the new bodies after them, as
+  // World::removeBodies and World::addBody leave the host's world.
+  // The world's sweep keys in global memory are the scratch (2 x bodySort ints, bodySort >= n + 1;
+  // the next step's prepare writes them anew); the pair buffers may be smaller than the world.
+  const int n = ws.n;
+  int* flag = reinterpret_cast<int*>(ws.sweep);
+  int* survivors = flag + n + 1;
+  for (int i = threadIdx.x; i < n; i += blockDim.x) flag[i] = br.gone[ws.members[i]] ? 0 : 1;
+  if (threadIdx.x == 0) flag[n] = 0;
+  __syncthreads();
+  const int stay = blockExclusiveScan(flag, n + 1, sh);
+  for (int i = threadIdx.x; i < n; i += blockDim.x)
+    if (flag[i + 1] != flag[i]) survivors[flag[i]] = ws.members[i];
+  __syncthreads();
+  int* members = a.members + ws.begin;
+  const int added = b.piecesKept;
+  for (int i = threadIdx.x; i < stay + added; i += blockDim.x)
+    members[i] = i < stay ? survivors[i] : br.spareFirst + w * br.spare + used + (i - stay);
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    a.memberCount[w] = stay + added;
+    br.spareUsed[w] = used + added;
+    br.nextId[w] += added;
+    record.topologyOnDevice = 1;
+    if (b.floesBroken > 0) atomicAdd(&a.control->floesBroken, b.floesBroken);
+    record.floesBroken = b.floesBroken;
+    record.rubbleMass = b.rubbleMass;
+  }
+  __syncthreads();
+}
+
 // Is any record stream past its capacity (the step is then run again with more room)?
 __device__ inline bool recordsOverflowed(const RecordSink& sink) {
   for (int q = 0; q < kMaxRecordStreams; ++q)
@@ -581,7 +770,7 @@ __device__ inline bool recordsOverflowed(const RecordSink& sink) {
   return false;
 }
 
-template <class Events>
+template <class Events, class Breaking>
 __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a, bool staged) {
   __shared__ BlockShared sh;
   extern __shared__ __align__(16) unsigned char dynamicShared[];
@@ -624,11 +813,12 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a,
       }
       a.ring[s] = r;
       control.stepsDone = s + 1;
+      // The reason is the most pressing of those given (a world's breakFloes may give one too).
       if (topology) {
         control.halt[parity] = 1;
-        control.haltReason = kHaltBreak;
+        atomicMax(&control.haltReason, kHaltBreak);
       } else if (s + 1 == a.steps) {
-        control.haltReason = kHaltDone;
+        atomicMax(&control.haltReason, kHaltDone);
       }
     }
     if (!overflow) {
@@ -638,6 +828,7 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a,
         const int contacts = record.contacts;
         __syncthreads();
         secondHalf<Events>(a, w, contacts, ctx, record);
+        if (a.breaking.offset >= 0) breakFloes<Breaking>(a, w, s, parity, record, sh);
       }
     }
     mark(sh, 11);
@@ -652,7 +843,7 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a,
         // The overflowed step's rows are dropped: the counters go back to its start.
         for (int q = 0; q < kMaxRecordStreams; ++q)
           if (a.sink.streams[q].count) *a.sink.streams[q].count = control.recordBegin[q];
-        control.haltReason = kHaltOverflow;
+        atomicMax(&control.haltReason, kHaltOverflow);
       }
       break;
     }

@@ -366,6 +366,7 @@ void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& resu
   DeviceState& d = *m_state;
   result.steps.clear(), result.worldSteps.clear();
   for (auto& rows : result.records) rows.clear();
+  result.edits = DeviceBodyEdits{};
   result.worlds = d.worlds;
   if (d.n == 0) {
     result.steps.assign(static_cast<size_t>(steps), StepRecord{});

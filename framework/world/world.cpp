@@ -21,36 +21,40 @@ const char* bodyKindName(BodyKind kind) {
   return "unknown";
 }
 
-int World::addBody(const BodySpec& spec) {
+template <class Trig>
+static int addRow(World& w, const BodySpec& spec);
+
+int World::addBody(const BodySpec& spec) { return addRow<LibmTrig>(*this, spec); }
+int World::addPiece(const BodySpec& spec) { return addRow<PortableTrig>(*this, spec); }
+
+template <class Trig>
+static int addRow(World& w, const BodySpec& spec) {
   const int n = static_cast<int>(spec.vertices.size());
   if (n < 3 || n > kMaxVertices) throw std::invalid_argument("World::addBody: vertex count out of range");
-  MassProperties mp = massProperties(spec.vertices.data(), n);
-
-  const int slot = size();
-  id.push_back(spec.id >= 0 ? spec.id : nextId);
-  nextId = std::max(nextId, id.back() + 1);
-  kind.push_back(spec.kind);
-  vertexCount.push_back(n);
-  localVertices.resize(localVertices.size() + kMaxVertices, Vec2{0, 0});
-  for (int k = 0; k < n; ++k) local(slot)[k] = spec.vertices[k] - mp.centroid;
-  x.push_back(mp.centroid.x);
-  y.push_back(mp.centroid.y);
-  angle.push_back(0);
-  vx.push_back(spec.velocity.x);
-  vy.push_back(spec.velocity.y);
-  omega.push_back(spec.angularVelocity);
-  area.push_back(mp.area);
-  thickness.push_back(spec.thickness);
-  const Real m = kRhoIce * mp.area * spec.thickness;  // docs/model.md 1; the vessel's mass is set by its owner
-  mass.push_back(m);
-  const bool immovable = spec.kind == BodyKind::Wall;
-  invMass.push_back(immovable ? Real(0) : Real(1) / m);
-  gyration2.push_back(mp.izz / mp.area);
-  gyrationX2.push_back(mp.ixx / mp.area);
-  gyrationY2.push_back(mp.iyy / mp.area);
-  invInertia.push_back(immovable ? Real(0) : Real(1) / (m * gyration2.back()));
-  principalAngle.push_back(mp.principalAngle);
-  radius.push_back(boundingRadius(local(slot), n));
+  const int slot = w.size();
+  w.id.push_back(spec.id >= 0 ? spec.id : w.nextId);
+  w.nextId = std::max(w.nextId, w.id.back() + 1);
+  w.kind.push_back(spec.kind);
+  w.vertexCount.push_back(n);
+  w.localVertices.resize(w.localVertices.size() + kMaxVertices, Vec2{0, 0});
+  // The vessel's mass is set by its owner (addVessel).
+  const BodyMassRow row = bodyMassRow<Trig>(spec.vertices.data(), n, spec.thickness, spec.kind == BodyKind::Wall, w.local(slot));
+  w.x.push_back(row.centroid.x);
+  w.y.push_back(row.centroid.y);
+  w.angle.push_back(0);
+  w.vx.push_back(spec.velocity.x);
+  w.vy.push_back(spec.velocity.y);
+  w.omega.push_back(spec.angularVelocity);
+  w.area.push_back(row.area);
+  w.thickness.push_back(spec.thickness);
+  w.mass.push_back(row.mass);
+  w.invMass.push_back(row.invMass);
+  w.gyration2.push_back(row.gyration2);
+  w.gyrationX2.push_back(row.gyrationX2);
+  w.gyrationY2.push_back(row.gyrationY2);
+  w.invInertia.push_back(row.invInertia);
+  w.principalAngle.push_back(row.principalAngle);
+  w.radius.push_back(row.radius);
   return slot;
 }
 

@@ -10,6 +10,7 @@
 #include "framework/world/body_kind.hpp"
 #include "framework/world/constants.hpp"
 #include "geometry/polygon.hpp"
+#include "geometry/portable_trig.hpp"
 
 namespace gem {
 
@@ -25,6 +26,33 @@ struct BodySpec {
   std::int64_t id = -1;        // -1: the world assigns the next free id
   std::string origin;          // where it came from, for error messages ("field", "floes[3]", "pack.ice:9:1: object 12")
 };
+
+// A body's shape and mass row as World::addBody makes it, written once for the host and the device
+// (the resident CUDA kernel adds the pieces of a break itself): the centroid, the vertices about it
+// (n into local), and the mass properties. Mass is rho_ice * area * thickness (docs/model.md 1); a
+// wall keeps that mass but is immovable (invMass and invInertia 0).
+struct BodyMassRow {
+  Vec2 centroid;
+  Real area, mass, invMass, gyration2, gyrationX2, gyrationY2, invInertia, principalAngle, radius;
+};
+// Trig: massProperties' (LibmTrig; PortableTrig for the pieces of a break, World::addPiece).
+template <class Trig = LibmTrig>
+GEM_HD inline BodyMassRow bodyMassRow(const Vec2* vertices, int n, Real thickness, bool immovable, Vec2* local) {
+  const MassProperties mp = massProperties<Trig>(vertices, n);
+  BodyMassRow row;
+  row.centroid = mp.centroid;
+  for (int k = 0; k < n; ++k) local[k] = vertices[k] - mp.centroid;
+  row.area = mp.area;
+  row.mass = kRhoIce * mp.area * thickness;
+  row.invMass = immovable ? Real(0) : Real(1) / row.mass;
+  row.gyration2 = mp.izz / mp.area;
+  row.gyrationX2 = mp.ixx / mp.area;
+  row.gyrationY2 = mp.iyy / mp.area;
+  row.invInertia = immovable ? Real(0) : Real(1) / (row.mass * row.gyration2);
+  row.principalAngle = mp.principalAngle;
+  row.radius = boundingRadius(local, n);
+  return row;
+}
 
 struct World {
   // Identity and shape.
@@ -58,6 +86,9 @@ struct World {
   // Mass is rho_ice * area * thickness (docs/model.md 1); a wall keeps that mass but is immovable
   // (invMass and invInertia 0); the vessel's mass is set by its owner (addVessel).
   int addBody(const BodySpec& spec);
+  // The same for a piece of a broken floe, its mass properties by the portable trigonometry
+  // (geometry/portable_trig.hpp): the resident CUDA kernel makes the very same rows on the device.
+  int addPiece(const BodySpec& spec);
   // Removes the bodies whose flag is set, keeping the order of the others.
   // forEachTask, when given, runs tasks 0 .. count - 1 on the caller's threads (a topology event
   // passes framework/api/parallel.hpp's parallelEach when the CPU stepper has lent its pool): each
