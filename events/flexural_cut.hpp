@@ -53,8 +53,7 @@ GEM_HD inline bool cutFloe(const Vec2* local, int n, Vec2 centroid, Real angle, 
   Vec2 polygon[kMaxVertices];
   toWorldPortable(local, n, centroid, angle, polygon);
   const Vec2 linePoint = request.point + request.cuspLength * request.normal;
-  splitByLine(polygon, n, linePoint, perpLeft(request.normal), pieces[0].vertices, &pieces[0].count, pieces[1].vertices,
-              &pieces[1].count);
+  splitByLine(polygon, n, linePoint, perpLeft(request.normal), pieces[0].vertices, &pieces[0].count, pieces[1].vertices, &pieces[1].count);
   if (pieces[0].count < 3 || pieces[1].count < 3) return false;
   for (int k = 0; k < 2; ++k) {
     FloePiece& piece = pieces[k];

@@ -73,7 +73,8 @@ TEST(PortableTrig, APieceHasTheMassPropertiesOfAnyBodyWithinRounding) {
   EXPECT_EQ(a.area, b.area);  // no trigonometry in these
   EXPECT_EQ(a.mass, b.mass);
   EXPECT_EQ(a.gyration2, b.gyration2);
-  for (size_t k = 0; k < a.localVertices.size(); ++k) EXPECT_TRUE(a.localVertices[k].x == b.localVertices[k].x && a.localVertices[k].y == b.localVertices[k].y);
+  for (size_t k = 0; k < a.localVertices.size(); ++k)
+    EXPECT_TRUE(a.localVertices[k].x == b.localVertices[k].x && a.localVertices[k].y == b.localVertices[k].y);
   EXPECT_NEAR(a.principalAngle[0], b.principalAngle[0], 1e-15);
   EXPECT_NEAR(a.gyrationX2[0], b.gyrationX2[0], 1e-14 * a.gyrationX2[0]);
   EXPECT_NEAR(a.gyrationY2[0], b.gyrationY2[0], 1e-14 * a.gyrationY2[0]);

@@ -354,7 +354,8 @@ void CudaBatch::followDeviceEdits() {
       if (worldOfId(id) == w) removed.push_back(id - idOffset(w));
     World added;
     for (int k = 0; k < edits.added.size(); ++k)
-      if (edits.addedWorlds.empty() || edits.addedWorlds[static_cast<size_t>(k)] == w) appendRows(added, edits.added, k, k + 1, -idOffset(w));
+      if (edits.addedWorlds.empty() || edits.addedWorlds[static_cast<size_t>(k)] == w)
+        appendRows(added, edits.added, k, k + 1, -idOffset(w));
     m.followDeviceEdit(removed, added, edits.nextIds.at(static_cast<size_t>(w)));
   }
   m_slotsOfWorld.clear();

@@ -89,9 +89,9 @@ class CudaStepper final : public Stepper {
   // A topology edit of this world (runTopology's, or the resident kernel's) in the mirror's order.
   void followEdit(const std::vector<int>& removedDevice, const std::vector<int>& removedMirror, int firstAdded);
   void followDeviceEdit(const std::vector<std::int64_t>& removed, const World& added, std::int64_t nextId);
-  void flushPendingOrder();                           // the mirror into the device's order
-  void locateVessel();                                // m_vesselSlot from the mirror (in the device's order)
-  int mirrorSlot(int deviceSlot) const;               // the host mirror's row of a device slot
+  void flushPendingOrder();              // the mirror into the device's order
+  void locateVessel();                   // m_vesselSlot from the mirror (in the device's order)
+  int mirrorSlot(int deviceSlot) const;  // the host mirror's row of a device slot
   const std::vector<int>& slotOfId();
 
   World& world();  // the host mirror (the CPU simulation's world, never stepped there)

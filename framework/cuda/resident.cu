@@ -175,8 +175,8 @@ void makeDense(DeviceState& d, ResidentState& r, DeviceBodyEdits& edits) {
                                        &World::vy,         &World::omega,      &World::area,           &World::thickness,
                                        &World::mass,       &World::invMass,    &World::invInertia,     &World::gyration2,
                                        &World::gyrationX2, &World::gyrationY2, &World::principalAngle, &World::radius};
-  const GraphArray<Real>* arrays[] = {&d.x,    &d.y,       &d.angle,   &d.vx,         &d.vy,         &d.omega,
-                                      &d.area, &d.thickness, &d.mass,  &d.invMass,    &d.invInertia, &d.gyration2,
+  const GraphArray<Real>* arrays[] = {&d.x,          &d.y,          &d.angle,          &d.vx,      &d.vy,         &d.omega,
+                                      &d.area,       &d.thickness,  &d.mass,           &d.invMass, &d.invInertia, &d.gyration2,
                                       &d.gyrationX2, &d.gyrationY2, &d.principalAngle, &d.radius};
   for (size_t a = 0; a < std::size(reals); ++a) appendDeviceRows(spareRows.*reals[a], *arrays[a], first, room);
   for (int w = 0; w < worlds; ++w)
@@ -194,7 +194,8 @@ void makeDense(DeviceState& d, ResidentState& r, DeviceBodyEdits& edits) {
     }
   // The ids the dense state has room for: the world's own next id alone, or every world's stride.
   added.nextId = worlds == 1 ? nextIds[0] : static_cast<std::int64_t>(worlds) * d.idStride;
-  editDeviceBodies(d, removedSlots, added, 0, worlds == 1 ? std::vector<int>{} : addedWorlds, std::vector<int>(static_cast<size_t>(worlds), 3));
+  editDeviceBodies(d, removedSlots, added, 0, worlds == 1 ? std::vector<int>{} : addedWorlds,
+                   std::vector<int>(static_cast<size_t>(worlds), 3));
   r.membersBuilt = false;
 
   // For the host: a body made and gone within the run was never in a mirror; made in an earlier
@@ -335,7 +336,8 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     const int batch = std::min(remaining, d.ringSize);
     const bool breaking = r.spare > 0;
     if (breaking) {
-      if (r.nextIds.size() != static_cast<size_t>(d.worlds)) throw std::logic_error("runResident: each world's next id is needed (setNextIds)");
+      if (r.nextIds.size() != static_cast<size_t>(d.worlds))
+        throw std::logic_error("runResident: each world's next id is needed (setNextIds)");
       if (!r.membersBuilt || r.worldOfMembers != d.worldHost) buildMembers(d, r);
       makeSpareRoom(d, r);
       r.nextId.upload(r.nextIds.data(), r.nextIds.size());
@@ -355,11 +357,16 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     a.motion = d.motionBodies.get();
     a.impulseOfId = d.worlds == 1 ? d.contactImpulseOfId.get() : nullptr;
     a.members = r.members.get(), a.memberBegin = r.memberBegin.get(), a.memberCount = r.memberCount.get(), a.worlds = d.worlds;
-    a.breaking = ResidentBreaking{breaking ? r.program.breakingOffset : -1, r.spare, d.n, r.spareUsed.get(), r.nextId.get(), r.gone.get(),
-                                  ResidentBodyRows{d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.world.get(), d.local.get(),
-                                                   d.area.get(), d.thickness.get(), d.mass.get(), d.invMass.get(), d.invInertia.get(),
-                                                   d.gyration2.get(), d.gyrationX2.get(), d.gyrationY2.get(), d.principalAngle.get(),
-                                                   d.radius.get(), d.isLarge.get()}};
+    a.breaking = ResidentBreaking{
+        breaking ? r.program.breakingOffset : -1,
+        r.spare,
+        d.n,
+        r.spareUsed.get(),
+        r.nextId.get(),
+        r.gone.get(),
+        ResidentBodyRows{d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.world.get(), d.local.get(), d.area.get(),
+                         d.thickness.get(), d.mass.get(), d.invMass.get(), d.invInertia.get(), d.gyration2.get(), d.gyrationX2.get(),
+                         d.gyrationY2.get(), d.principalAngle.get(), d.radius.get(), d.isLarge.get()}};
     a.capacity = r.capacity, a.capacitySort = r.capacitySort, a.bodySort = r.bodySort;
     a.sweepKeys = r.sweepKeys.get(), a.pairKeys = r.pairKeys.get(), a.idKeys = r.idKeys.get(), a.bKeys = r.bKeys.get();
     a.previous = r.previous.get(), a.previousCount = r.previousCount.get();

@@ -87,9 +87,9 @@ struct ResidentBodyRows {
 struct ResidentBreaking {
   int offset;  // ResidentProgram::breakingOffset (-1: none in the kernel)
   int spare, spareFirst;
-  int* spareUsed;            // per world
-  std::int64_t* nextId;      // per world: the case's next own id
-  unsigned char* gone;       // per slot, spare slots included
+  int* spareUsed;        // per world
+  std::int64_t* nextId;  // per world: the case's next own id
+  unsigned char* gone;   // per slot, spare slots included
   ResidentBodyRows rows;
 };
 

@@ -102,14 +102,15 @@ void launchResident(const ResidentArgs& args, int grid, std::size_t shared, cuda
   ResidentArgs copy = args;
   bool staged = shared > 0;
   void* params[] = {&copy, &staged};
-  GEM_CUDA_CHECK(cudaLaunchCooperativeKernel(reinterpret_cast<void*>(resident::residentKernel<BuiltIn, Breaking>), dim3(static_cast<unsigned>(grid)),
-                                             dim3(kResidentBlock), params, shared, stream));
+  GEM_CUDA_CHECK(cudaLaunchCooperativeKernel(reinterpret_cast<void*>(resident::residentKernel<BuiltIn, Breaking>),
+                                             dim3(static_cast<unsigned>(grid)), dim3(kResidentBlock), params, shared, stream));
 }
 
 int residentBlocksPerMultiprocessor(std::size_t shared) {
   allowShared(shared);
   int blocks = 0;
-  GEM_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, resident::residentKernel<BuiltIn, Breaking>, kResidentBlock, shared));
+  GEM_CUDA_CHECK(
+      cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, resident::residentKernel<BuiltIn, Breaking>, kResidentBlock, shared));
   return blocks;
 }
 

@@ -126,12 +126,12 @@ constexpr int kResidentMostBreaks = 32;
 struct BreakScratch {
   int count, unique, piecesKept, floesBroken;
   Real rubbleMass;
-  int row[kResidentMostBreaks];        // the rows of the request stream, in the CPU's order
+  int row[kResidentMostBreaks];  // the rows of the request stream, in the CPU's order
   std::int64_t floeId[kResidentMostBreaks];
-  int place[kResidentMostBreaks];      // the floe's place in the world (-1: not there)
-  int firstPiece[kResidentMostBreaks]; // the request's first new body among the step's
-  int cut[kResidentMostBreaks];        // 1: the floe was cut
-  Real rubble[kResidentMostBreaks][2]; // the mass each of its pieces took away as rubble, kg
+  int place[kResidentMostBreaks];       // the floe's place in the world (-1: not there)
+  int firstPiece[kResidentMostBreaks];  // the request's first new body among the step's
+  int cut[kResidentMostBreaks];         // 1: the floe was cut
+  Real rubble[kResidentMostBreaks][2];  // the mass each of its pieces took away as rubble, kg
 };
 
 struct BlockShared {
@@ -713,8 +713,8 @@ __device__ void breakFloes(const ResidentArgs& a, int w, int s, int parity, Worl
     for (const auto& piece : pieces) {
       if (piece.rubble) continue;
       const int slot = br.spareFirst + w * br.spare + used + k;
-      const BodyMassRow m =
-          bodyMassRow<PortableTrig>(piece.vertices, piece.count, p.thickness[parent], false, out.local + static_cast<size_t>(slot) * kMaxVertices);
+      const BodyMassRow m = bodyMassRow<PortableTrig>(piece.vertices, piece.count, p.thickness[parent], false,
+                                                      out.local + static_cast<size_t>(slot) * kMaxVertices);
       out.id[slot] = idBase + br.nextId[w] + k;
       out.kind[slot] = BodyKind::Floe;
       out.vertexCount[slot] = piece.count;

@@ -186,7 +186,7 @@ TEST(CudaBackend, BusyChannelSummaryMatchesTheCpuOver300Steps) {
   EXPECT_NEAR(broken[1], broken[0], 0.2 * broken[0] + 2);
   EXPECT_NEAR(mean[1], mean[0], 3 * standardError);
   EXPECT_LT(standardError, 0.05 * mean[0]);  // the ensemble is large enough for the test to mean something
-  EXPECT_GT(broken[0], 0);  // breaks happen: the host topology round trip is covered
+  EXPECT_GT(broken[0], 0);                   // breaks happen: the host topology round trip is covered
 }
 
 TEST(CudaBackend, RepeatedRunIsBitIdentical) {
