@@ -62,6 +62,7 @@ struct ResidentControl {
   long long pairCounts[3];  // block 0's first world, over the launch: candidate pairs, overlapping, contacts
   int verticesNeeded;       // the most vertices a world had (the next launch's shared memory for them)
   int floesBroken;          // by the kernel's topology phase, every world (the state is made dense after)
+  int resorted;             // 1: a world re-sorted its members along the curve (the state follows after)
 };
 // The phases' names, in the kernel's order.
 inline constexpr const char* kResidentPhaseNames[kResidentPhases] = {
@@ -107,6 +108,12 @@ struct ResidentArgs {
   int* memberCount;
   int worlds;
   ResidentBreaking breaking;
+  // The re-sort along the curve (docs/model.md 8) in the kernel, every kResortPeriod steps after the
+  // topology phase, as the host's: each world's members ordered by their curve keys (the slots stay;
+  // the host permutes the state to the members' order after the launch). placeScratch: bodySort
+  // ints a world.
+  bool resort;
+  int* placeScratch;
   // Per-world scratch: `capacity` candidate pairs, pow2 of it for the sorts, `bodySort` for the sweep.
   int capacity, capacitySort, bodySort;
   unsigned long long *sweepKeys, *pairKeys, *idKeys, *bKeys, *previous;
