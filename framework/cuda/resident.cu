@@ -175,9 +175,12 @@ void makeDense(DeviceState& d, ResidentState& r, const ResidentControl& control,
   if (control.floesBroken > 0) {
     std::vector<int> used(static_cast<size_t>(worlds));
     r.spareUsed.download(used.data(), used.size());
+    // The spare slots in use: the first mostUsed x worlds (a world's t-th is t x worlds + w).
+    const int mostUsed = *std::max_element(used.begin(), used.end());
+    const size_t usedRows = static_cast<size_t>(mostUsed) * static_cast<size_t>(worlds);
     std::vector<std::int64_t> nextIds(static_cast<size_t>(worlds));
     r.nextId.download(nextIds.data(), nextIds.size());
-    std::vector<unsigned char> gone(first + room);
+    std::vector<unsigned char> gone(first + usedRows);
     r.gone.download(gone.data(), gone.size());
     std::vector<std::int64_t> ids;
     appendDeviceRows(ids, d.id, 0, first);
@@ -194,17 +197,17 @@ void makeDense(DeviceState& d, ResidentState& r, const ResidentControl& control,
     }
     // The new ones that stay: their rows as the kernel made them, and their kinematics now.
     World spareRows;
-    appendDeviceRows(spareRows.id, d.id, first, room), appendDeviceRows(spareRows.kind, d.kind, first, room);
-    appendDeviceRows(spareRows.vertexCount, d.vertexCount, first, room);
-    appendDeviceRows(spareRows.localVertices, d.local, first * kMaxVertices, room * kMaxVertices);
+    appendDeviceRows(spareRows.id, d.id, first, usedRows), appendDeviceRows(spareRows.kind, d.kind, first, usedRows);
+    appendDeviceRows(spareRows.vertexCount, d.vertexCount, first, usedRows);
+    appendDeviceRows(spareRows.localVertices, d.local, first * kMaxVertices, usedRows * kMaxVertices);
     const GraphArray<Real>* arrays[] = {&d.x,          &d.y,          &d.angle,          &d.vx,      &d.vy,         &d.omega,
                                         &d.area,       &d.thickness,  &d.mass,           &d.invMass, &d.invInertia, &d.gyration2,
                                         &d.gyrationX2, &d.gyrationY2, &d.principalAngle, &d.radius};
-    for (size_t a = 0; a < std::size(kRealRows); ++a) appendDeviceRows(spareRows.*kRealRows[a], *arrays[a], first, room);
+    for (size_t a = 0; a < std::size(kRealRows); ++a) appendDeviceRows(spareRows.*kRealRows[a], *arrays[a], first, usedRows);
     World& added = edits.added;
     for (int w = 0; w < worlds; ++w)
       for (int t = 0; t < used[static_cast<size_t>(w)]; ++t) {
-        const size_t k = static_cast<size_t>(w) * static_cast<size_t>(r.spare) + static_cast<size_t>(t);
+        const size_t k = static_cast<size_t>(t) * static_cast<size_t>(worlds) + static_cast<size_t>(w);
         if (gone[first + k]) {  // made and broken again within the launch
           edits.removedIds.push_back(spareRows.id[k]);
           continue;

@@ -80,8 +80,9 @@ struct ResidentBodyRows {
   unsigned char* isLarge;
 };
 
-// Breaks in the kernel: each world may add up to `spare` bodies in a launch, into the slots
-// spareFirst + w x spare + [0, spare) past the state's bodies (spareUsed[w] of them taken); a world
+// Breaks in the kernel: each world may add up to `spare` bodies in a launch, its t-th into the slot
+// spareFirst + t x worlds + w past the state's bodies (spareUsed[w] of them taken: the slots a
+// launch used lie together at the front, and the host reads back only those); a world
 // whose step asks for more stops the launch there, and the host's topology phase does that step.
 // A body that leaves is marked in gone[slot] and dropped from its world's members; its slot keeps
 // its rows until the host makes the state dense again (runResident, DeviceStep::editBodies).

@@ -713,7 +713,7 @@ __device__ bool breakFloes(const ResidentArgs& a, int w, int s, int parity, Worl
     int k = b.firstPiece[j];
     for (const auto& piece : pieces) {
       if (piece.rubble) continue;
-      const int slot = br.spareFirst + w * br.spare + used + k;
+      const int slot = br.spareFirst + (used + k) * a.worlds + w;
       const BodyMassRow m = bodyMassRow<PortableTrig>(piece.vertices, piece.count, p.thickness[parent], false,
                                                       out.local + static_cast<size_t>(slot) * kMaxVertices);
       out.id[slot] = idBase + br.nextId[w] + k;
@@ -750,7 +750,7 @@ __device__ bool breakFloes(const ResidentArgs& a, int w, int s, int parity, Worl
   int* members = a.members + ws.begin;
   const int added = b.piecesKept;
   for (int i = threadIdx.x; i < stay + added; i += blockDim.x)
-    members[i] = i < stay ? survivors[i] : br.spareFirst + w * br.spare + used + (i - stay);
+    members[i] = i < stay ? survivors[i] : br.spareFirst + (used + i - stay) * a.worlds + w;
   __syncthreads();
   if (threadIdx.x == 0) {
     a.memberCount[w] = stay + added;
