@@ -11,11 +11,14 @@
 //   6 topology (flexural_breaking), only in the steps that asked for a break: the events cut the
 //     floes on the host mirror (the few bodies named fetched first) and the device replays the
 //     edit (survivors compacted in order, new floes appended, ids stable): the world stays put.
+//     The resident driver cuts them in its kernel instead (resident_kernel.cuh breakFloes), and
+//     the mirror follows after the batch (followDeviceEdit); the host's way is its fallback for a
+//     world that ran out of room for new floes.
 // The whole step is one captured CUDA graph, the body of a device-side loop: copy_back_every steps
 // run as one launch, and their results (a small record per step, the impacts and logs) are copied
 // off once, through pinned buffers (thesis 5.7). step() then hands them out one step at a time.
 // A batch never runs past a step whose state the host needs: a frame, a re-sort, the run's last
-// step, or a break (the device stops itself there).
+// step, or a break the host makes (the device stops itself there).
 //
 // A device state may hold several cases (CudaStepper::together): a world each, with its own
 // Params, vessel and records, its bodies never paired with another world's (gem sweep, issue 5).

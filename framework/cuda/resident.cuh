@@ -1,9 +1,10 @@
 // Internal to framework/cuda: the resident driver (docs/architecture.md "CUDA drivers"). Each world
 // runs whole steps inside one thread block: prepare, its own pairs, narrowphase, pair events, solo
-// events, gather, motion and write-back, with block barriers between the phases and many steps per
-// launch. A launch of several worlds is cooperative (every block resident at once): a grid barrier
-// per phase boundary keeps the worlds in lockstep, so that a step that overflows a buffer or asks
-// for a break stops every world at the same step, as the device-wide driver's batch does.
+// events, gather, motion, write-back and the topology phase (flexural breaking: ResidentBreaking),
+// with block barriers between the phases and many steps per launch. A launch of several worlds is
+// cooperative (every block resident at once): a grid barrier per phase boundary keeps the worlds in
+// lockstep, so that a step that overflows a buffer, or whose breaks need more room than a world
+// has, stops every world at the same step, as the device-wide driver's batch does.
 //
 // The per-body and per-pair work is body_phases.cuh's, the device-wide driver's own; the events are
 // the built-in evaluators, compiled into the kernel (resident_events.cu), so no physics is written
