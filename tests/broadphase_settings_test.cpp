@@ -58,6 +58,13 @@ TEST(BroadphaseSettings, UnknownStrategiesKeysAndTwiceGivenKeysAreRefused) {
   EXPECT_TRUE(contains(unknown, "uniform_grid")) << unknown;  // the valid names are listed
   const std::string typo = errorOf(kBase + "broadphase = \"uniform_grid\"\n[broadphase.uniform_grid]\ncellsize = 20.0\n");
   EXPECT_TRUE(contains(typo, "broadphase.uniform_grid.cellsize")) << typo;
+  // An unknown key names the strategy's settings as the valid ones, also those the table leaves out.
+  EXPECT_TRUE(contains(typo, "valid keys here: cell_size")) << typo;
+  const std::string kept = errorOf(kBase + "broadphase = \"fixed_radius\"\n[broadphase.fixed_radius]\nskin = 1.0\nfoo = 2\n");
+  EXPECT_TRUE(contains(kept, "fixed_radius, skin")) << kept;
+  const std::string inSimulation = errorOf(kBase + "broadphase = \"variable_radius\"\nfoo = 2\n");
+  EXPECT_TRUE(contains(inSimulation, "simulation.foo")) << inSimulation;
+  EXPECT_TRUE(contains(inSimulation, "skin")) << inSimulation;
   const std::string twice =
       errorOf(kBase + "broadphase = \"uniform_grid\"\ncell_size = 20.0\n[broadphase.uniform_grid]\ncell_size = 30.0\n");
   EXPECT_TRUE(contains(twice, "given twice")) << twice;

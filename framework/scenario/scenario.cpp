@@ -332,6 +332,9 @@ void readPlugins(const toml::array& plugins, TableReader& top, Scenario& s) {
 // keys the strategy declares; any other broadphase key is refused, naming the strategies that do
 // take it. A key set twice (in [simulation] and in [broadphase.NAME]) is refused too.
 void readBroadphaseSettings(TableReader& t, const BroadphaseEntry& strategy, BroadphaseSettings& settings) {
+  // The strategy's settings are this table's keys whether it gives them or not: an unknown key's
+  // message lists them among the valid ones.
+  for (const std::string& key : strategy.settings) t.accept(key);
   for (const std::string& key : broadphaseSettingKeys()) {
     if (!t.has(key)) continue;
     const auto& own = strategy.settings;
