@@ -56,6 +56,10 @@ std::vector<BadCase> badCases() {
        kSim + kDomain + "[field]\nconcentration = 0.3\ngroups = [{ coverage = 0.3, thickness = 5e3 }]\n",
        {"thickness", "from 0.01 to 1000"}},
       {"negative_dt", "[simulation]\ndt = -0.1\n", {"simulation.dt", "from 1e-06 to 3600, got -0.1"}},
+      // A value a hair past a limit is shown with its digits, not rounded onto the limit.
+      {"dt_a_hair_past_its_limit", "[simulation]\ndt = 3600.0000001\n", {"simulation.dt", "got 3600.0000001"}},
+      {"floe_a_hair_too_fast", kSim + "[[floes]]\nvertices = " + kSquare + "\nvelocity = [100.0000001, 0.0]\n",
+       {"floes[0].velocity", "got [100.0000001, 0]"}},
       {"zero_duration", "[simulation]\nduration = 0.0\n", {"simulation.duration", "positive"}},
       {"zero_mass", kSim + "[vessel]\nmass = 0.0\n", {"vessel.mass", "from 1 to 1e+12"}},
       {"overlap",

@@ -243,13 +243,13 @@ std::string TableReader::getPath(const std::string& key, const std::string& fall
 
 Real TableReader::getRealIn(const std::string& key, Real fallback, Real min, Real max) {
   Real v = getReal(key, fallback);
-  if (!(v >= min && v <= max)) report(key, fmt::format("must be from {:g} to {:g}, got {:g}", min, max, v)), v = fallback;
+  if (!(v >= min && v <= max)) report(key, fmt::format("must be from {:g} to {:g}, got {}", min, max, v)), v = fallback;
   return v;
 }
 
 Real TableReader::getPositive(const std::string& key, Real fallback, Real most) {
   Real v = getReal(key, fallback);
-  if (!(v > 0 && v <= most)) report(key, fmt::format("must be positive and at most {:g}, got {:g}", most, v)), v = fallback;
+  if (!(v > 0 && v <= most)) report(key, fmt::format("must be positive and at most {:g}, got {}", most, v)), v = fallback;
   return v;
 }
 

@@ -164,7 +164,7 @@ void readFloes(const toml::array& floes, TableReader& parent, Scenario& s) {
     spec.thickness = t.getRealIn("thickness", Real(0.7), kLeastIceThickness, kMostIceThickness);
     spec.velocity = t.getVec2("velocity", Vec2{0, 0});
     if (!(std::fabs(spec.velocity.x) <= kMostStartSpeed && std::fabs(spec.velocity.y) <= kMostStartSpeed)) {
-      t.report("velocity", fmt::format("each component must be within +-{:g} m/s, got [{:g}, {:g}]", kMostStartSpeed, spec.velocity.x,
+      t.report("velocity", fmt::format("each component must be within +-{:g} m/s, got [{}, {}]", kMostStartSpeed, spec.velocity.x,
                                        spec.velocity.y));
       spec.velocity = Vec2{0, 0};
     }
@@ -207,7 +207,7 @@ void readVessel(TableReader& t, Scenario& s) {
   v.position = t.getVec2("position", v.position);
   if (!(std::fabs(v.position.x) <= kMostDomainCoordinate && std::fabs(v.position.y) <= kMostDomainCoordinate)) {
     t.report("position",
-             fmt::format("each coordinate must be within +-{:g} m, got [{:g}, {:g}]", kMostDomainCoordinate, v.position.x, v.position.y));
+             fmt::format("each coordinate must be within +-{:g} m, got [{}, {}]", kMostDomainCoordinate, v.position.x, v.position.y));
     v.position = VesselSpec{}.position;
   }
   v.headingDeg = t.getRealIn("heading_deg", 0, -360, 360);
@@ -227,7 +227,7 @@ void readVessel(TableReader& t, Scenario& s) {
     for (const Vec2& p : *hull)
       if (!(std::fabs(p.x) <= kMostHullSize && std::fabs(p.y) <= kMostHullSize))
         t.fail("vertices",
-               fmt::format("each coordinate must be within +-{:g} m (the ship frame), got [{:g}, {:g}]", kMostHullSize, p.x, p.y));
+               fmt::format("each coordinate must be within +-{:g} m (the ship frame), got [{}, {}]", kMostHullSize, p.x, p.y));
     if (frames->size() != hull->size())
       t.fail("frame_angle_deg", fmt::format("needs one angle per hull edge: {} vertices, {} angles", hull->size(), frames->size()));
     for (Real b : *frames)

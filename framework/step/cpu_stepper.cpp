@@ -32,24 +32,24 @@ void validateBodySpec(BodySpec& spec, int maxVertices) {
     // Walls are made from the domain's edges, which are checked, and reach a little past them.
     if (spec.kind != BodyKind::Wall && !(std::fabs(v.x) <= kMostCoordinate && std::fabs(v.y) <= kMostCoordinate))
       throw InputError(
-          fmt::format("{}: each vertex coordinate must be within +-{:g} m, got ({:g}, {:g})", spec.origin, kMostCoordinate, v.x, v.y));
+          fmt::format("{}: each vertex coordinate must be within +-{:g} m, got ({}, {})", spec.origin, kMostCoordinate, v.x, v.y));
   }
   if (!std::isfinite(spec.velocity.x) || !std::isfinite(spec.velocity.y) || !std::isfinite(spec.angularVelocity))
     throw InputError(fmt::format("{}: velocity must be finite", spec.origin));
   // A body starts no faster than any ship or floe could (a .ice field's objects too): beyond it
   // the first step overflowed.
   if (!(std::fabs(spec.velocity.x) <= kMostStartSpeed && std::fabs(spec.velocity.y) <= kMostStartSpeed))
-    throw InputError(fmt::format("{}: each velocity component must be within +-{:g} m/s, got ({:g}, {:g})", spec.origin, kMostStartSpeed,
+    throw InputError(fmt::format("{}: each velocity component must be within +-{:g} m/s, got ({}, {})", spec.origin, kMostStartSpeed,
                                  spec.velocity.x, spec.velocity.y));
   if (!(std::fabs(spec.angularVelocity) <= kMostStartAngularSpeed))
-    throw InputError(fmt::format("{}: the angular velocity must be within +-{:g} rad/s, got {:g}", spec.origin, kMostStartAngularSpeed,
+    throw InputError(fmt::format("{}: the angular velocity must be within +-{:g} rad/s, got {}", spec.origin, kMostStartAngularSpeed,
                                  spec.angularVelocity));
   if (!(spec.thickness > 0) || !std::isfinite(spec.thickness))
     throw InputError(fmt::format("{}: thickness must be a positive number, got {}", spec.origin, spec.thickness));
   // A floe (a .ice field's too) from young ice to an iceberg: thinner, its mass was too small for
   // a finite first impulse (the vessel's draft and the walls are checked where they are made).
   if (spec.kind == BodyKind::Floe && !(spec.thickness >= kLeastIceThickness && spec.thickness <= kMostIceThickness))
-    throw InputError(fmt::format("{}: a floe's thickness must be from {:g} to {:g} m, got {:g}", spec.origin, kLeastIceThickness,
+    throw InputError(fmt::format("{}: a floe's thickness must be from {:g} to {:g} m, got {}", spec.origin, kLeastIceThickness,
                                  kMostIceThickness, spec.thickness));
   if (signedArea(spec.vertices.data(), n) < 0) reverseOrder(spec.vertices.data(), n);  // docs/model.md 1
   if (!isStrictlyConvexCCW(spec.vertices.data(), n, Real(1e-9)))
