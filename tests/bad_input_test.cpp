@@ -58,7 +58,8 @@ std::vector<BadCase> badCases() {
       {"negative_dt", "[simulation]\ndt = -0.1\n", {"simulation.dt", "from 1e-06 to 3600, got -0.1"}},
       // A value a hair past a limit is shown with its digits, not rounded onto the limit.
       {"dt_a_hair_past_its_limit", "[simulation]\ndt = 3600.0000001\n", {"simulation.dt", "got 3600.0000001"}},
-      {"floe_a_hair_too_fast", kSim + "[[floes]]\nvertices = " + kSquare + "\nvelocity = [100.0000001, 0.0]\n",
+      {"floe_a_hair_too_fast",
+       kSim + "[[floes]]\nvertices = " + kSquare + "\nvelocity = [100.0000001, 0.0]\n",
        {"floes[0].velocity", "got [100.0000001, 0]"}},
       {"zero_duration", "[simulation]\nduration = 0.0\n", {"simulation.duration", "positive"}},
       {"zero_mass", kSim + "[vessel]\nmass = 0.0\n", {"vessel.mass", "from 1 to 1e+12"}},
@@ -306,6 +307,30 @@ TEST(BadInputCli, LinksThatLeadNowhereAndFilesOfUnknownSizeAreNamedForWhatTheyAr
     const std::string text = gem::test::readFile(log);
     EXPECT_NE(text.find(c.expected), std::string::npos) << c.arguments << ": " << text;
     EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
+  }
+}
+
+// A loop of symbolic links where a run folder or one of its files is read (gem analyze, plot, view,
+// movie) is bad input, exit 2, naming the path; it ended as an internal failure, exit 1, in the
+// library's words ("filesystem error: status: Too many levels of symbolic links").
+TEST(BadInputCli, ALoopOfSymbolicLinksInARunFolderIsBadInput) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  std::filesystem::create_symlink("loop", dir.path() / "loop");
+  const std::filesystem::path run = dir.path() / "run";
+  std::filesystem::create_directories(run);
+  std::filesystem::create_symlink("timeseries.csv", run / "timeseries.csv");
+  std::filesystem::create_symlink("impacts.csv", run / "impacts.csv");
+  std::filesystem::create_symlink("frames.ice", run / "frames.ice");
+  const std::string loop = (dir.path() / "loop").string();
+  for (const std::string& arguments : {"analyze " + loop, "plot " + loop, "view " + loop, "analyze " + run.string(), "plot " + run.string(),
+                                       "view " + run.string() + " --out " + (dir.path() / "v.html").string(),
+                                       "movie " + run.string() + " --still 0 --out " + (dir.path() / "m.png").string()}) {
+    EXPECT_EQ(gem::test::runGem(arguments, log), 2) << arguments << ": " << gem::test::readFile(log);
+    const std::string text = gem::test::readFile(log);
+    EXPECT_EQ(text.find("gem: failed"), std::string::npos) << arguments << ": " << text;
+    EXPECT_TRUE(text.find("symbolic link") != std::string::npos || text.find("Too many levels") != std::string::npos)
+        << arguments << ": " << text;
   }
 }
 

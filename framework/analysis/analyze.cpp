@@ -14,6 +14,7 @@
 
 #include <fmt/format.h>
 
+#include "framework/api/input_size.hpp"
 #include "framework/output/atomic_file.hpp"
 #include "framework/output/csv.hpp"
 #include "framework/api/errors.hpp"
@@ -359,18 +360,18 @@ void printTable(const std::vector<Group>& groups, const std::vector<GroupStatist
 
 int runAnalyze(const AnalyzeOptions& options) {
   const fs::path dir = options.dir;
-  if (!fs::is_directory(dir)) throw InputError(fmt::format("{}: no such folder", dir.string()));
+  requireFolder(dir, "folder");
 
   // The runs: the folder itself, or every case of a sweep that has finished (impacts.csv is
   // written atomically at the end of a run, so its presence means the case is complete).
   std::vector<Run> runs;
-  const bool sweep = !fs::exists(dir / "impacts.csv");
+  const bool sweep = !holdsFile(dir / "impacts.csv", "impacts.csv");
   size_t incomplete = 0;
   if (!sweep) {
     runs.push_back(readRun(dir, dir.filename().string()));
   } else {
     for (const SweepCaseInfo& c : readSweepCases(dir).cases) {
-      if (fs::exists(c.dir / "impacts.csv")) {
+      if (holdsFile(c.dir / "impacts.csv", "impacts.csv")) {
         runs.push_back(readRun(c.dir, c.name));
         runs.back().group = c.group;
         runs.back().folder = c.dir.filename().string();

@@ -130,7 +130,7 @@ MovieResult writeMovie(const MovieOptions& o) {
     throw InputError(fmt::format("--out {}: --still writes a PNG picture: give a name ending in .png", o.out.string()));
   requireFolder(o.runDir, "run folder");
   const fs::path ice = o.runDir / "frames.ice";
-  if (!fs::exists(ice))
+  if (!holdsFile(ice, "frames.ice"))
     throw InputError(
         fmt::format("{}: no frames.ice to draw (run with output.frame_every > 0 and \"ice\" in output.formats)", o.runDir.string()));
   // Two passes over the file: one to fit the view and the colour range, one to draw; a large run's

@@ -81,7 +81,7 @@ void plotTimeSeries(const fs::path& runDir, Writer& write, RunPlots& result) {
 
 void plotImpacts(const fs::path& runDir, Writer& write, RunPlots& result) {
   const fs::path file = runDir / "impacts.csv";
-  if (!fs::exists(file)) {
+  if (!holdsFile(file, "timeseries.csv")) {
     result.notes.push_back("no impacts.csv (no ship_impact event in this run): no impact-load plots");
     return;
   }
@@ -139,7 +139,7 @@ void plotImpacts(const fs::path& runDir, Writer& write, RunPlots& result) {
 
 RunPlots writeRunPlots(const fs::path& runDir) {
   requireFolder(runDir, "run folder");
-  if (!fs::exists(runDir / "timeseries.csv"))
+  if (!holdsFile(runDir / "timeseries.csv", "timeseries.csv"))
     throw InputError(runDir.string() + ": not a run folder (no timeseries.csv; `gem run SCENARIO --out DIR` makes one)");
   RunPlots result;
   Writer write{runDir / "plots", result};

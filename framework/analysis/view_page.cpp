@@ -15,6 +15,7 @@
 #include "framework/output/csv.hpp"
 #include "framework/analysis/sweep_summary.hpp"
 #include "framework/analysis/view_pack.hpp"
+#include "framework/api/input_size.hpp"
 #include "framework/analysis/view_script.hpp"
 #include "framework/api/errors.hpp"
 #include "framework/output/atomic_file.hpp"
@@ -201,8 +202,11 @@ std::string summaryHtml(const std::map<std::string, std::string>& summary) {
 int runView(const ViewOptions& options) {
   const fs::path dir = options.dir;
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw InputError(options.dir + ": not a folder; gem view takes a run folder (gem run ... --out DIR)");
-  if (!fs::exists(dir / "frames.ice", ec))
+  if (!fs::is_directory(dir, ec)) {
+    if (fs::is_symlink(fs::symlink_status(dir, ec))) requireFolder(dir, "run folder");  // a loop, a link to nothing
+    throw InputError(options.dir + ": not a folder; gem view takes a run folder (gem run ... --out DIR)");
+  }
+  if (!holdsFile(dir / "frames.ice", "frames.ice"))
     throw InputError(options.dir +
                      ": no frames.ice in this folder; run the scenario with [output] formats including \"ice\" (the default) and "
                      "frame_every > 0, then gem view the run folder");

@@ -36,12 +36,31 @@ inline void requireRegularFile(const std::filesystem::path& file, const std::str
     throw InputError(fmt::format("{}: not a regular file (a pipe or a device?), not a {}", file.string(), what));
 }
 
-// A folder a command reads (a run folder, a sweep's): refused when it is missing or a file.
+// A folder a command reads (a run folder, a sweep's): refused when it is missing or a file, or a
+// symbolic link that loops or leads nowhere, naming which.
 inline void requireFolder(const std::filesystem::path& dir, const std::string& what) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  if (std::filesystem::is_directory(dir, ec)) return;
-  if (std::filesystem::exists(dir, ec)) throw InputError(fmt::format("{}: a file, not a {}", dir.string(), what));
+  const fs::file_status status = fs::status(dir, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory)
+    throw InputError(fmt::format("{}: cannot be read as a {}: {}", dir.string(), what, ec.message()));
+  if (fs::is_directory(status)) return;
+  if (fs::exists(status)) throw InputError(fmt::format("{}: a file, not a {}", dir.string(), what));
+  std::error_code linkError;
+  if (fs::is_symlink(fs::symlink_status(dir, linkError)))
+    throw InputError(fmt::format("{}: a symbolic link to {}, which does not exist: no such {}", dir.string(),
+                                 fs::read_symlink(dir, linkError).string(), what));
   throw InputError(fmt::format("{}: no such {}", dir.string(), what));
+}
+
+// Whether a run folder holds `file` (one GEM wrote there): false when no entry has its name; an
+// entry that is not a readable regular file (a loop of links, a link to nothing, a folder, a pipe)
+// is refused by requireRegularFile, naming what it is, instead of being taken as missing.
+inline bool holdsFile(const std::filesystem::path& file, const std::string& what) {
+  std::error_code ec;
+  if (!std::filesystem::exists(std::filesystem::symlink_status(file, ec))) return false;
+  requireRegularFile(file, what);
+  return true;
 }
 
 // This machine's memory, bytes: what an input is measured against before it is read or made.

@@ -41,6 +41,20 @@ using namespace gem;
 
 namespace {
 
+// A filesystem fault that only a path the user gave can cause (a loop of symbolic links, a file
+// where a folder must be, a name too long): bad input, exit 2, naming the path; not an internal
+// failure. Any other filesystem error (a full disk, a device error) stays a fault, exit 1.
+std::optional<std::string> pathFaultOf(const std::filesystem::filesystem_error& e) {
+  const std::error_code c = e.code();
+  const char* what = c == std::errc::too_many_symbolic_link_levels ? "a loop of symbolic links"
+                     : c == std::errc::not_a_directory             ? "a part of the path is a file, not a folder"
+                     : c == std::errc::filename_too_long           ? "the path is too long"
+                                                                   : nullptr;
+  if (!what) return std::nullopt;
+  const std::string path = e.path1().empty() ? std::string("a path") : e.path1().string();
+  return path + ": " + what;
+}
+
 struct RunArguments {
   std::string scenario, out, backend, broadphase;
   int threads = -1;  // --threads: simulation.threads (-1: the scenario's)
@@ -211,6 +225,11 @@ int commandRun(const RunArguments& a) {
       log.note(hint);
     }
     log.write(s.output.dir, 128 + e.signal());
+    throw;
+  } catch (const std::filesystem::filesystem_error& e) {
+    const std::optional<std::string> fault = pathFaultOf(e);
+    log.note(fault ? fmt::format("gem: error: {}", *fault) : fmt::format("gem: failed: {}", e.what()));
+    log.write(s.output.dir, fault ? 2 : 1);
     throw;
   } catch (const std::exception& e) {
     log.note(fmt::format("gem: failed: {}", e.what()));
@@ -471,6 +490,13 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::fprintf(stderr, "gem: error: %s\n", e.what());
     return 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    if (const std::optional<std::string> fault = pathFaultOf(e)) {
+      std::fprintf(stderr, "gem: error: %s\n", fault->c_str());
+      return 2;
+    }
+    std::fprintf(stderr, "gem: failed: %s\n", e.what());
+    return 1;
   } catch (const Interrupted& e) {
     if (!args.quiet) std::fprintf(stderr, "\n");  // past the progress line
     std::fprintf(stderr, "gem: %s\n", e.what());
