@@ -164,8 +164,8 @@ void readFloes(const toml::array& floes, TableReader& parent, Scenario& s) {
     spec.thickness = t.getRealIn("thickness", Real(0.7), kLeastIceThickness, kMostIceThickness);
     spec.velocity = t.getVec2("velocity", Vec2{0, 0});
     if (!(std::fabs(spec.velocity.x) <= kMostStartSpeed && std::fabs(spec.velocity.y) <= kMostStartSpeed)) {
-      t.report("velocity", fmt::format("each component must be within +-{:g} m/s, got [{}, {}]", kMostStartSpeed, spec.velocity.x,
-                                       spec.velocity.y));
+      t.report("velocity",
+               fmt::format("each component must be within +-{:g} m/s, got [{}, {}]", kMostStartSpeed, spec.velocity.x, spec.velocity.y));
       spec.velocity = Vec2{0, 0};
     }
     spec.angularVelocity = t.getRealIn("angular_velocity", 0, -kMostStartAngularSpeed, kMostStartAngularSpeed);
@@ -226,8 +226,7 @@ void readVessel(TableReader& t, Scenario& s) {
     if (!frames) t.fail("vertices", "a hull given by vertices also needs frame_angle_deg (one per edge)");
     for (const Vec2& p : *hull)
       if (!(std::fabs(p.x) <= kMostHullSize && std::fabs(p.y) <= kMostHullSize))
-        t.fail("vertices",
-               fmt::format("each coordinate must be within +-{:g} m (the ship frame), got [{}, {}]", kMostHullSize, p.x, p.y));
+        t.fail("vertices", fmt::format("each coordinate must be within +-{:g} m (the ship frame), got [{}, {}]", kMostHullSize, p.x, p.y));
     if (frames->size() != hull->size())
       t.fail("frame_angle_deg", fmt::format("needs one angle per hull edge: {} vertices, {} angles", hull->size(), frames->size()));
     for (Real b : *frames)
