@@ -133,6 +133,11 @@ TEST(Statistics, DegenerateInputsGiveDefinedResults) {
   EXPECT_TRUE(flat.ok);
   EXPECT_DOUBLE_EQ(flat.b, 0.0);
   EXPECT_DOUBLE_EQ(flat.a, 5.0);
+  // x spread too little: ship speeds of 4.887 to 4.9 m/s against forces of 1e5 to 4e5 N (a 50-step
+  // run) gave b = 470 and a = 9e-320, a subnormal number written into statistics.csv as the fit.
+  const PowerLawFit narrow = fitPowerLaw(std::vector<double>{4.887, 4.89, 4.895, 4.9}, std::vector<double>{1e5, 2e5, 3e5, 4e5});
+  EXPECT_FALSE(narrow.ok) << "a = " << narrow.a << ", b = " << narrow.b;
+  EXPECT_EQ(narrow.reason, "x spreads too little for a power law");
 }
 
 TEST(Statistics, NearlyEqualValuesStillConverge) {

@@ -164,6 +164,15 @@ PowerLawFit fitPowerLaw(std::span<const double> x, std::span<const double> y) {
   fit.a = std::exp(my - fit.b * mx);
   // All y equal gives syy = 0 and an exact (flat) fit.
   fit.r2 = syy > 0 ? (sxy * sxy) / (sxx * syy) : 1.0;
+  // x spread too little for a power law: the exponent runs away (ship speeds of 4.887 to 4.9 m/s
+  // gave b = 470 and a = 9e-320, a subnormal number written as the fit). The fit stands only when
+  // a and its curve over the data are ordinary numbers.
+  const auto [least, most] = std::minmax_element(lx.begin(), lx.end());
+  const double atLeast = fit.a * std::exp(fit.b * *least), atMost = fit.a * std::exp(fit.b * *most);
+  if (!std::isnormal(fit.a) || !std::isfinite(fit.b) || !std::isnormal(atLeast) || !std::isnormal(atMost)) {
+    fit.reason = "x spreads too little for a power law";
+    return fit;
+  }
   fit.ok = true;
   return fit;
 }
