@@ -257,6 +257,28 @@ TEST(GemRun, ANonFiniteStateStopsTheRunNamingTheBodyAndStep) {
   EXPECT_EQ(series.find("inf"), std::string::npos) << series;
 }
 
+// A finite state can still make a timeseries.csv column infinite: a 1 kg vessel under 1e8 N of
+// thrust struck by a 1000 m thick floe at 100 m/s (every value within its range) reaches ship
+// speeds whose quadratic net thrust overflows. The
+// run stops at that step, naming the column, before the row is written: no inf in the file.
+TEST(GemRun, AnInfiniteTimeseriesColumnStopsTheRunBeforeItsRow) {
+  test::TempDir dir;
+  const auto scenario = dir.write("light.toml",
+                                  "[simulation]\ndt = 0.1\nsteps = 50\n[[floes]]\n"
+                                  "vertices = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\nthickness = 1000.0\n"
+                                  "velocity = [-100.0, 0.0]\nangular_velocity = 100.0\n[vessel]\nposition = [-60.0, 0.0]\n"
+                                  "speed = 100.0\nopen_water_speed = 100.0\nbollard_thrust = 1e8\nmass = 1.0\n");
+  const auto out = dir.path() / "out";
+  EXPECT_EQ(test::runGem("run " + scenario.string() + " --quiet --out " + out.string(), dir.path() / "log"), 1);
+  const std::string log = test::readFile(dir.path() / "log");
+  EXPECT_NE(log.find("the vessel's net_thrust is no longer finite"), std::string::npos) << log;
+  EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
+  const std::string series = test::readFile(out / "timeseries.csv");
+  EXPECT_EQ(series.rfind("t,", 0), 0u) << series;
+  EXPECT_EQ(series.find("inf"), std::string::npos) << series;
+  EXPECT_EQ(series.find("nan"), std::string::npos) << series;
+}
+
 // gem check takes one CPU step of the world it built: a scenario whose first step is not finite
 // (here a plugin's event, which no range of GEM's can bound) is refused with exit 2 and the words
 // gem run stops with, where it once said "ok" and gem run failed at step 1. It writes nothing.

@@ -272,14 +272,27 @@ class ScenarioRun {
       }
     }
     if ((k + 1) % scenario.output.timeseriesEvery == 0) {
-      if (vessel.present)
-        m_timeseries->stream() << fmt::format("{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n", sim.time(), vessel.position.x,
-                                              vessel.position.y, vessel.heading, surge, Propulsion::netThrust(m_thrust, surge),
-                                              sim.vesselIceForce().x, sim.contactCount());
-      else
+      if (vessel.present) {
+        const double columns[] = {vessel.position.x,     vessel.position.y, vessel.heading, surge, Propulsion::netThrust(m_thrust, surge),
+                                  sim.vesselIceForce().x};
+        requireFiniteRow(k, columns);
+        m_timeseries->stream() << fmt::format("{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n", sim.time(), columns[0], columns[1],
+                                              columns[2], columns[3], columns[4], columns[5], sim.contactCount());
+      } else
         m_timeseries->stream() << fmt::format("{:.6g},,,,,,,{}\n", sim.time(), sim.contactCount());
     }
     if (m_frames && (k + 1) % scenario.output.frameEvery == 0) writeFrames();
+  }
+
+  // A timeseries.csv row whose derived values are not finite (a finite but enormous surge makes
+  // the net thrust infinite) stops the run before the row is written, as a non-finite state does.
+  void requireFiniteRow(long k, const double (&columns)[6]) const {
+    static const char* const names[] = {"ship_x", "ship_y", "ship_heading", "ship_speed", "net_thrust", "ice_force_x"};
+    for (int c = 0; c < 6; ++c)
+      if (!std::isfinite(columns[c]))
+        throw std::runtime_error(
+            fmt::format("step {} (t = {:.6g} s): the vessel's {} is no longer finite (ship speed {} m/s); the run stops here", k + 1,
+                        m_stepper->time(), names[c], columns[3]));
   }
 
   // A non-finite state (a floe at 1e300 m/s, say) stops the run, naming the body and the step,
