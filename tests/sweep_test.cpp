@@ -379,6 +379,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadSweep{"no_such_base",
                  "[sweep]\nbase = \"nope.toml\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n",
                  {"bad_sweep.toml:2:8", "nope.toml"}},
+        // A base that is there but no file is named for what it is ("no such scenario file" once).
+        BadSweep{"base_is_a_folder",
+                 "[sweep]\nbase = \".\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n",
+                 {"bad_sweep.toml:2:8", "a folder, not a scenario file"}},
+        BadSweep{"base_is_a_device",
+                 "[sweep]\nbase = \"/dev/null\"\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n",
+                 {"bad_sweep.toml:2:8", "/dev/null: not a regular file"}},
         BadSweep{"unknown_sweep_key",
                  "[sweep]\nbase = \"base.toml\"\njobs = 3\n[parameters]\n\"vessel.bollard_thrust\" = [1.0]\n",
                  {"bad_sweep.toml:3:", "sweep.jobs"}},

@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include "framework/api/errors.hpp"
+#include "framework/api/input_size.hpp"
 #include "framework/api/table_reader.hpp"
 #include "framework/scenario/toml_limits.hpp"
 
@@ -104,7 +105,12 @@ SweepOverride makeOverride(const Leaf& leaf, bool varied) {
 fs::path resolveBase(TableReader& reader, const std::string& key, const std::string& text, const fs::path& folder) {
   if (text.empty()) reader.fail(key, "expected the path of a scenario file");
   const fs::path path = fs::path(text).is_absolute() ? fs::path(text) : folder / text;
-  if (!fs::is_regular_file(path)) reader.fail(key, fmt::format("no such scenario file: {}", path.string()));
+  // What is there instead, in requireRegularFile's words: a folder, a device, a loop of links.
+  try {
+    requireRegularFile(path, "scenario file");
+  } catch (const InputError& e) {
+    reader.fail(key, e.what());
+  }
   return fs::absolute(path).lexically_normal();
 }
 
