@@ -5,6 +5,8 @@
 // folders without impacts are refused with an InputError naming the folder.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <cmath>
 #include <map>
 #include <random>
@@ -299,7 +301,11 @@ TEST(Analyze, ValuesOutsideTheirColumnsRangeNameFileAndLine) {
                                                         {"1,2,3,4,5,6,7,8,9,10,11,12,13,-1e308,15,0", "fn"},
                                                         {"1,2,3,4,5,6,7,8,9,10,11,12,13,nan,15,0", "fn"},
                                                         {"1,2,3,4,5,6,7,8,9,10,11,12,inf,14,15,0", "vn"},
-                                                        {"1e308,2,3,4,5,6,7,8,9,10,11,12,13,14,15,0", "t"}}) {
+                                                        {"1e308,2,3,4,5,6,7,8,9,10,11,12,13,14,15,0", "t"},
+                                                        // ids are whole numbers from 0, masses positive (hostile-input audit)
+                                                        {"1,4.5,3,4,5,6,7,8,9,10,11,12,13,14,15,0", "floe_id"},
+                                                        {"1,-99999999999999999999,3,4,5,6,7,8,9,10,11,12,13,14,15,0", "floe_id"},
+                                                        {"1,2,0,4,5,6,7,8,9,10,11,12,13,14,15,0", "floe_mass"}}) {
     SCOPED_TRACE(column);
     TempDir tmp;
     writeImpacts(tmp.path(), 3, 1);
@@ -312,6 +318,33 @@ TEST(Analyze, ValuesOutsideTheirColumnsRangeNameFileAndLine) {
       EXPECT_NE(what.find("impacts.csv:5"), std::string::npos) << what;
       EXPECT_NE(what.find(column), std::string::npos) << what;
     }
+  }
+}
+
+// gem view and gem plot read the run's CSVs with the same checks as gem analyze: a NaN force or a
+// broke flag of 7 is refused naming the file, line and column, not drawn (gem view once wrote
+// the NaN into its page with exit 0).
+TEST(Analyze, ViewAndPlotRefuseWhatAnalyzeRefuses) {
+  TempDir tmp;
+  const auto scenario = tmp.write("busy.toml", gem::test::kBusyScene);
+  const auto run = tmp.path() / "run";
+  ASSERT_EQ(gem::test::runGem("run " + scenario.string() + " --steps 20 --quiet --no-plots --out " + run.string(), tmp.path() / "run.log"),
+            0)
+      << gem::test::readFile(tmp.path() / "run.log");
+  const std::string impacts = gem::test::readFile(run / "impacts.csv");
+  for (const auto& [row, column, command] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{{"1,2,3,4,5,6,7,8,9,10,11,12,13,nan,15,0", "fn", "view"},
+                                                                      {"-1e300,2,3,4,5,6,7,8,9,10,11,12,13,14,15,0", "t", "view"},
+                                                                      {"1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,7", "broke", "plot"},
+                                                                      {"1,4.5,3,4,5,6,7,8,9,10,11,12,13,14,15,0", "floe_id", "analyze"}}) {
+    SCOPED_TRACE(command + " " + column);
+    std::ofstream(run / "impacts.csv") << impacts << row << "\n";
+    const auto log = tmp.path() / "log";
+    const std::string out = command == "view" ? " --out " + (tmp.path() / "v.html").string() : "";
+    EXPECT_EQ(gem::test::runGem(command + " " + run.string() + out + " --quiet", log), 2) << gem::test::readFile(log);
+    const std::string text = gem::test::readFile(log);
+    EXPECT_NE(text.find("impacts.csv:"), std::string::npos) << text;
+    EXPECT_NE(text.find("column " + column), std::string::npos) << text;
   }
 }
 

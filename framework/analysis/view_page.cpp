@@ -142,20 +142,22 @@ std::string listsJson(const ViewPack& pack) {
 // timeseries.csv's three columns the page plots; null when the file is absent.
 std::string seriesJson(const fs::path& dir) {
   const fs::path file = dir / "timeseries.csv";
-  if (!fs::exists(file)) return "null";
-  const CsvTable table = readCsvTable(file);
-  std::string out = "{\"t\":" + base64(asFloats(table.numbers("t")));
-  for (const char* column : {"ship_speed", "net_thrust", "ice_force_x"})
-    out += fmt::format(",\"{}\":{}", column, base64(asFloats(table.numbers(column))));
+  if (!holdsFile(file, "timeseries.csv")) return "null";
+  // readColumns refuses values outside what GEM writes (NaN, inf, a negative time), as gem plot
+  // and gem analyze do; empty cells (a run without a vessel) stay NaN.
+  const std::vector<std::vector<double>> c = readColumns(file, {"t", "ship_speed", "net_thrust", "ice_force_x"}, true);
+  std::string out = "{\"t\":" + base64(asFloats(c[0]));
+  const char* names[] = {"ship_speed", "net_thrust", "ice_force_x"};
+  for (int k = 0; k < 3; ++k) out += fmt::format(",\"{}\":{}", names[k], base64(asFloats(c[static_cast<size_t>(k) + 1])));
   return out + "}";
 }
 
 // impacts.csv's times, places and forces, sorted by time (the page searches them by time).
 std::string impactsJson(const fs::path& dir) {
   const fs::path file = dir / "impacts.csv";
-  if (!fs::exists(file)) return "null";
-  const CsvTable table = readCsvTable(file);
-  const std::vector<double> t = table.numbers("t"), x = table.numbers("x"), y = table.numbers("y"), fn = table.numbers("fn");
+  if (!holdsFile(file, "impacts.csv")) return "null";
+  const std::vector<std::vector<double>> c = readColumns(file, {"t", "x", "y", "fn"});
+  const std::vector<double>&t = c[0], &x = c[1], &y = c[2], &fn = c[3];
   std::vector<size_t> order(t.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return t[a] < t[b]; });

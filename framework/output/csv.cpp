@@ -25,16 +25,29 @@ struct ColumnRange {
   const char* column;
   double lo, hi;
   const char* why;
+  bool whole = false;  // a count, an id or a flag: a whole number
 };
+constexpr double kAnyFinite = std::numeric_limits<double>::max();
 constexpr ColumnRange kColumnRanges[] = {
     {"apex_deg", 0, 180, "an apex angle is 0 to 180 degrees"},
     {"y_from_centerline", -1e4, 1e4, "no hull is 20 km wide"},
     {"x_from_stem", -1e5, 1e5, "no hull is 100 km long"},
     // Far past any load GEM computes (MN at most), and small enough that sums of 10^7 rows stay finite.
     {"fn", -1e15, 1e15, "no impact force reaches 1e15 N"},
+    {"flim", 0, 1e15, "a force limit is 0 to 1e15 N"},
     {"vn", -1e6, 1e6, "no impact speed reaches 1000 km/s"},
-    {"floe_mass", 0, 1e15, "no floe weighs 1e15 kg"},
+    {"floe_mass", std::numeric_limits<double>::min(), 1e15, "a floe's mass is positive, and none weighs 1e15 kg"},
+    {"thickness", 0.01, 1000, "a floe is 0.01 to 1000 m thick"},
+    {"floe_id", 0, 9007199254740992.0, "an id is a whole number from 0", true},
+    {"broke", 0, 1, "broke is 0 or 1", true},
+    {"x", -kAnyFinite, kAnyFinite, "a finite number"},
+    {"y", -kAnyFinite, kAnyFinite, "a finite number"},
     {"t", 0, 1e15, "a run's time is 0 to 1e15 s"},
+    // timeseries.csv: any finite number (a run stops before it writes another), counts whole.
+    {"ship_speed", -kAnyFinite, kAnyFinite, "a finite number"},
+    {"net_thrust", -kAnyFinite, kAnyFinite, "a finite number"},
+    {"ice_force_x", -kAnyFinite, kAnyFinite, "a finite number"},
+    {"contacts", 0, 2147483647.0, "a count is a whole number from 0", true},
 };
 
 }  // namespace
@@ -181,7 +194,10 @@ std::vector<std::vector<double>> readColumns(const fs::path& file, const std::ve
         const bool empty = std::isnan(v) && table.rows[k][static_cast<size_t>(c)].find_first_not_of(' ') == std::string::npos;
         if (!empty && !(v >= r.lo && v <= r.hi))
           throw InputError(file.string(), table.lines[k], 0,
-                           fmt::format("column {}: {} is outside {} to {} ({})", r.column, v, r.lo, r.hi, r.why));
+                           r.lo == -kAnyFinite ? fmt::format("column {}: {} is not {}", r.column, v, r.why)
+                                               : fmt::format("column {}: {} is outside {} to {} ({})", r.column, v, r.lo, r.hi, r.why));
+        if (!empty && r.whole && v != std::floor(v))
+          throw InputError(file.string(), table.lines[k], 0, fmt::format("column {}: {} is not a whole number ({})", r.column, v, r.why));
       }
     }
   }
