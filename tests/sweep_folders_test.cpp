@@ -1,6 +1,7 @@
 // Sweep case folders (names safe for shells and tools, unique) and gem analyze on a real sweep,
 // grouping by the varied keys read from each case's scenario.toml.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <map>
 #include <set>
@@ -69,6 +70,30 @@ name = "x=1,y=2"
 
 // gem analyze on a real sweep of 2 concentrations x 2 thrusts: one group per concentration (the
 // thrust does not group), each of its two cases; the inputs come from the cases' scenario.toml.
+// A case folder whose summary.json or case.toml is a folder, a pipe or a link that loops is refused
+// before any case runs (exit 2, naming it), not removed, re-run or failed after the run.
+TEST(Sweep, ACaseFolderHoldingNoFileWhereItsSummaryGoesIsRefusedBeforeAnyCaseRuns) {
+  for (const std::string name : {"summary.json", "case.toml"})
+    for (const std::string kind : {"folder", "fifo", "loop"}) {
+      SCOPED_TRACE(name + " as a " + kind);
+      TempDir dir;
+      dir.write("base.toml", kBase);
+      const fs::path file = dir.write("study.toml", kProduct), out = dir.path() / "out";
+      const fs::path caseDir = out / "cases" / "bollard_thrust-46000_concentration-0.25";
+      fs::create_directories(caseDir);
+      const fs::path place = caseDir / name;
+      if (kind == "folder") fs::create_directories(place / "keep");
+      if (kind == "fifo") ASSERT_EQ(::mkfifo(place.c_str(), 0600), 0);
+      if (kind == "loop") fs::create_symlink(name, place);
+      const auto log = dir.path() / "log";
+      EXPECT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --quiet", log), 2) << test::readFile(log);
+      const std::string text = test::readFile(log);
+      EXPECT_NE(text.find(place.string()), std::string::npos) << text;
+      EXPECT_FALSE(fs::exists(out / "summary.csv"));       // nothing ran
+      EXPECT_TRUE(fs::exists(fs::symlink_status(place)));  // left as it was
+    }
+}
+
 TEST(Sweep, AnalyzeGroupsByTheVariedKeysButNotTheThrust) {
   TempDir dir;
   dir.write("base.toml", kBase);

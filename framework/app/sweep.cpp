@@ -23,6 +23,7 @@
 
 #include "framework/output/atomic_file.hpp"
 #include "framework/api/errors.hpp"
+#include "framework/api/input_size.hpp"
 #include "framework/app/interrupt.hpp"
 #include "framework/app/runner.hpp"
 #include "framework/scenario/scenario.hpp"
@@ -327,6 +328,15 @@ int runSweep(const SweepOptions& options) {
   else
     for (size_t i = 0; i < count; ++i) selected.push_back(i);
   if (options.caseIndex >= 0) std::printf("%s\n", sweep.cases[selected[0]].name.c_str());
+
+  // What a case's folder holds where the sweep reads and writes its summary.json and case.toml
+  // must be a file, or nothing: a folder, a pipe or a device there is refused before any case
+  // runs, naming it (a fifo was removed and the case run again; a folder failed the case, exit 1,
+  // after it ran).
+  for (size_t i : selected) {
+    holdsFile(dirs[i] / "summary.json", "case's summary.json");
+    holdsFile(dirs[i] / "case.toml", "case's case.toml");
+  }
 
   // Resume: complete cases whose scenario has not changed are skipped.
   std::vector<size_t> todo;
