@@ -310,6 +310,17 @@ TEST(BadInputCli, LinksThatLeadNowhereAndFilesOfUnknownSizeAreNamedForWhatTheyAr
   }
 }
 
+// A first word that is no command names itself and the commands (CLI11 said "A subcommand is
+// required", as if none had been given).
+TEST(BadInputCli, AnUnknownCommandIsNamedWithTheCommands) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt";
+  EXPECT_EQ(gem::test::runGem("nosuchcmd", log), 2);
+  const std::string text = gem::test::readFile(log);
+  EXPECT_NE(text.find("unknown command \"nosuchcmd\""), std::string::npos) << text;
+  EXPECT_NE(text.find("run, check"), std::string::npos) << text;
+}
+
 // A loop of symbolic links where a run folder or one of its files is read (gem analyze, plot, view,
 // movie) is bad input, exit 2, naming the path; it ended as an internal failure, exit 1, in the
 // library's words ("filesystem error: status: Too many levels of symbolic links").

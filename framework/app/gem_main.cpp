@@ -452,6 +452,21 @@ int main(int argc, char** argv) {
   sweepCommand->add_option("--set", sweep.set, "override a scenario key in every case: --set simulation.dt=0.05")->take_all();
   sweepCommand->add_option("--backend", sweep.backend, "auto, cpu or cuda, for every case")->check(kName);
 
+  // A first word that names no command: say so, with the commands (CLI11 said only "A subcommand
+  // is required").
+  if (argc > 1 && argv[1][0] != '-') {
+    std::vector<std::string> names;
+    bool known = false;
+    for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
+      names.push_back(command->get_name());
+      known = known || command->get_name() == argv[1];
+    }
+    if (!known) {
+      std::fprintf(stderr, "gem: error: unknown command \"%s\" (the commands: %s; gem --help says what each does)\n",
+                   InputError::shorten(argv[1]).c_str(), fmt::format("{}", fmt::join(names, ", ")).c_str());
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
