@@ -119,6 +119,23 @@ TEST(Checkpoint, AResumeRefusesAFolderWhoseFramesAreGone) {
   EXPECT_EQ(readSummaryJson(part / "summary.json").at("completed"), "false");
 }
 
+// A frame cut short after the stop is refused as a deleted one is (the resume once went on over a
+// 50-byte frame and its frames.pvd still listed it).
+TEST(Checkpoint, AResumeRefusesAFolderWithAFrameCutShort) {
+  TempDir dir;
+  const auto scenario = dir.write("busy.toml", kBusyScene);
+  const auto part = dir.path() / "part";
+  ASSERT_EQ(shell(gemBinary() + " run " + scenario.string() + kRunOptions + " --out " + part.string() + " > /dev/null 2>&1 & p=$!; " +
+                  waitFor(part / "frames/frame_000003.vtp") + "kill -INT $p; wait $p"),
+            130);
+  const auto frame = part / "frames/frame_000001.vtp";
+  std::filesystem::resize_file(frame, 50);
+  EXPECT_EQ(test::runGem("run --resume " + part.string() + " --quiet --no-plots", dir.path() / "log"), 2);
+  const std::string text = readFile(dir.path() / "log");
+  EXPECT_NE(text.find("cannot resume: " + frame.string() + " is cut short"), std::string::npos) << text;
+  EXPECT_EQ(readSummaryJson(part / "summary.json").at("completed"), "false");
+}
+
 // What cannot be resumed is refused with exit 2 and a message naming the file: no checkpoint, a
 // damaged or cut one, a scenario.toml changed since, a folder that is no run's, and options that
 // would make it another run.

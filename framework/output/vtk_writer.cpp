@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <fstream>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -230,6 +231,19 @@ std::string VtkSeriesWriter::frameFile(int index) {
   return name;
 }
 
+// Whether a frame file ends as every frame GEM writes does: "</VTKFile>" then a line break.
+static bool endsAsAWholeFrame(const std::filesystem::path& file) {
+  static const std::string end = "</VTKFile>\n";
+  std::ifstream in(file, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (!in || size < static_cast<std::streamoff>(end.size())) return false;
+  in.seekg(size - static_cast<std::streamoff>(end.size()));
+  std::string tail(end.size(), '\0');
+  in.read(tail.data(), static_cast<std::streamsize>(tail.size()));
+  return in && tail == end;
+}
+
 void VtkSeriesWriter::save(BinaryWriter& out) const {
   std::vector<double> times;
   for (const Entry& e : m_entries) times.push_back(e.time);
@@ -254,6 +268,13 @@ VtkSeriesWriter::VtkSeriesWriter(std::filesystem::path runDir, bool binary, Bina
           fmt::format("cannot resume: {} is missing (the checkpoint's frames.pvd lists {} frames; the run's frames are "
                       "gone: run it again from the start)",
                       (m_runDir / e.file).string(), m_entries.size()));
+    // A frame is written whole under a temporary name: one that does not end as every frame does
+    // was cut after the stop (the resume went on over it, and frames.pvd listed it).
+    if (!endsAsAWholeFrame(m_runDir / e.file))
+      throw InputError(
+          fmt::format("cannot resume: {} is cut short (it does not end with </VTKFile>, as every frame GEM writes "
+                      "does): run it again from the start",
+                      (m_runDir / e.file).string()));
   }
   // Frames the stopped run wrote after its checkpoint go: the resumed run writes them again, and
   // one that stops earlier must not leave frames its series does not list.
