@@ -218,7 +218,7 @@ CudaBatch::CudaBatch(std::vector<CudaStepper*> members, int deviceOrdinal)
     resident = notResident.empty() && worlds() > 1 && (most <= kResidentAutoMostBodies || s.broadphase != "uniform_grid");
   }
   if (resident) {
-    m_device->useResident(program, params, stride);
+    m_device->useResident(program, params, stride, s.mortonSort);
   } else {
     m_device->setBroadphase(deviceBroadphase(s));
   }
@@ -323,8 +323,8 @@ void CudaBatch::runBatch(long step) {
     if (every > 0) end = std::min(end, (step / every + 1) * every);
   };
   if (s.output.frameEvery > 0) stopAtMultipleOf(s.output.frameEvery);
-  if (s.mortonSort) stopAtMultipleOf(kResortPeriod);
-  stopAtMultipleOf(s.output.checkpointEverySteps);  // a checkpoint needs the state on the host
+  if (s.mortonSort && !m_device->resident()) stopAtMultipleOf(kResortPeriod);  // the resident kernel re-sorts itself
+  stopAtMultipleOf(s.output.checkpointEverySteps);                             // a checkpoint needs the state on the host
   if (step < s.steps) end = std::min(end, s.steps);
   Stopwatch clock;
   if (m_device->resident()) {
@@ -335,6 +335,7 @@ void CudaBatch::runBatch(long step) {
   }
   m_device->run(step, s.dt, static_cast<int>(end - step), *m_result);
   if (!m_result->edits.empty()) followDeviceEdits();
+  if (!m_result->order.empty()) followOrder(m_result->order, m_result->worldBefore);
   m_resultFirst = step;
   times.batch += clock.lap();
   ++times.batches;
@@ -412,7 +413,11 @@ void CudaBatch::finishedStep(long step) {
   m_finished = 0;
   m_stepsDone = step + 1;
   applyEdits();
-  if (m_members.front()->scenario().mortonSort && isResortStep(step + 1)) {
+  // The resident kernel re-sorted itself, unless the host's topology phase took this step (then
+  // every world is re-sorted here; the kernel's re-sort of the others gives the same order again).
+  const bool sortedOnDevice =
+      m_device->resident() && !(m_result->hostTopology && step + 1 == m_resultFirst + static_cast<long>(m_result->steps.size()));
+  if (m_members.front()->scenario().mortonSort && isResortStep(step + 1) && !sortedOnDevice) {
     Stopwatch clock;
     reSortAlongCurve();
     times.resort += clock.lap();
@@ -441,6 +446,22 @@ void CudaBatch::applyEdits() {
   times.bookkeeping += clock.lap();
 }
 
+// A permutation of the device state (new slot k holds slot order[k], whose world was
+// worldBefore[order[k]]) in each case's mirror bookkeeping.
+void CudaBatch::followOrder(const std::vector<int>& order, const std::vector<int>& worldBefore) {
+  m_slotsOfWorld.clear();
+  if (worlds() == 1) {
+    m_members.front()->followReorder(order);
+    return;
+  }
+  // Each world's share of the order, in its own slots: the rank of a shared slot among its world's.
+  std::vector<int> localOf(worldBefore.size()), seen(static_cast<size_t>(worlds()), 0);
+  for (size_t k = 0; k < worldBefore.size(); ++k) localOf[k] = seen[static_cast<size_t>(worldBefore[k])]++;
+  std::vector<std::vector<int>> local(static_cast<size_t>(worlds()));
+  for (int old : order) local[static_cast<size_t>(worldBefore[static_cast<size_t>(old)])].push_back(localOf[static_cast<size_t>(old)]);
+  for (int w = 0; w < worlds(); ++w) m_members[static_cast<size_t>(w)]->followReorder(local[static_cast<size_t>(w)]);
+}
+
 // Every kResortPeriod steps (docs/architecture.md "Speed habits": neighbours in space become neighbours in memory).
 void CudaBatch::reSortAlongCurve() {
   // On the device, bit for bit as the host's World::curveOrder + World::permute, world by world;
@@ -450,16 +471,7 @@ void CudaBatch::reSortAlongCurve() {
   bool followed = true;
   const std::vector<int> order = m_device->reorderAlongCurve(&followed);
   m_slotsOfWorld.clear();
-  if (worlds() == 1) {
-    m_members.front()->followReorder(order);
-  } else {
-    // Each world's share of the order, in its own slots: the rank of a shared slot among its world's.
-    std::vector<int> localOf(worldBefore.size()), seen(static_cast<size_t>(worlds()), 0);
-    for (size_t k = 0; k < worldBefore.size(); ++k) localOf[k] = seen[static_cast<size_t>(worldBefore[k])]++;
-    std::vector<std::vector<int>> local(static_cast<size_t>(worlds()));
-    for (int old : order) local[static_cast<size_t>(worldBefore[static_cast<size_t>(old)])].push_back(localOf[static_cast<size_t>(old)]);
-    for (int w = 0; w < worlds(); ++w) m_members[static_cast<size_t>(w)]->followReorder(local[static_cast<size_t>(w)]);
-  }
+  followOrder(order, worldBefore);
   if (!followed) {
     // A device broadphase that keeps per-body storage but cannot permute it (a plugin's, say; one
     // world only) rebuilds from the whole world, in the new order.

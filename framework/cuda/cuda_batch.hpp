@@ -76,6 +76,7 @@ class CudaBatch {
  private:
   void runBatch(long step);
   void followDeviceEdits();  // the mirrors after the resident kernel's breaks (runBatch)
+  void followOrder(const std::vector<int>& order, const std::vector<int>& worldBefore);  // after a re-sort
   void applyEdits();
   void reSortAlongCurve();
 

@@ -204,6 +204,10 @@ void sizeForBodies(DeviceState& d, std::int64_t nextId);
 // after a launch whose breaks added bodies in the kernel.
 bool editDeviceBodies(DeviceState& d, const std::vector<int>& removedSlots, const World& from, int firstAdded,
                       const std::vector<int>& addedWorlds, const std::vector<int>& vesselDofs);
+// The state's rows permuted (new slot k holds old slot order[k]; o: the same order on the device),
+// the host's lists of worlds, large bodies and vessels with them (edits.cu): the re-sort along the
+// curve, on the device-wide driver and after the resident kernel's.
+void permuteDeviceState(DeviceState& d, const int* o, const std::vector<int>& order);
 // Each world's vessel slot, to the device (device_state.cu).
 void uploadVessels(DeviceState& d);
 // The resident driver's contact keys of the last step, (lo << 32) | hi, sorted (world 0), and the

@@ -39,8 +39,9 @@ struct WorldStepRecord {
 };
 
 // What the resident driver's breaks in the kernel changed during a run of steps (the device state
-// is dense again when run() returns: DeviceStep::editBodies made it so). removedIds: device ids
-// of the bodies that left (broken floes, the pieces of a launch among them); added: the new
+// is dense again when run() returns: DeviceStep::editBodies made it so, and a run stops after the
+// launch that changed it). removedIds: device ids of the bodies that left (broken floes; ids made
+// and broken within the launch among them, which no mirror knows); added: the new
 // bodies that remain, as on the device after the run (shapes, mass properties and kinematics),
 // their worlds addedWorlds; nextIds: per world, its next free id (the case's own, not shifted).
 struct DeviceBodyEdits {
@@ -60,6 +61,10 @@ struct DeviceBatchResult {
   std::vector<WorldStepRecord> worldSteps;                // steps.size() x worlds: step s's world w at s * worlds + w
   std::vector<unsigned char> records[kMaxRecordStreams];  // rows (RecordTag + record) of each stream
   DeviceBodyEdits edits;                                  // the resident kernel's breaks (empty: none)
+  // The resident kernel's re-sort along the curve, after the edits (empty: none): new slot k holds
+  // slot order[k] of the state as the edits left it, whose worlds were worldBefore.
+  std::vector<int> order, worldBefore;
+  bool hostTopology = false;  // the last step's topology is the host's (a launch stopped for it)
 };
 
 class DeviceStep {
@@ -122,7 +127,9 @@ class DeviceStep {
   // The resident driver (framework/cuda/resident.cuh) steps from now on: each world's whole step in
   // one thread block. program: the events as the resident kernel holds them; params: worlds rows of
   // paramsStride bytes, the Params of world w's events at the program's offsets.
-  void useResident(const ResidentProgram& program, const std::vector<unsigned char>& params, int paramsStride);
+  // resort: the kernel re-sorts each world along the curve every kResortPeriod steps itself (the
+  // scenario's morton_sort), so that a re-sort ends no launch either.
+  void useResident(const ResidentProgram& program, const std::vector<unsigned char>& params, int paramsStride, bool resort);
   bool resident() const;
   // The resident driver's breaks in the kernel give new bodies the next ids of their world: each
   // world's next free id (the case's own), before each run.
@@ -134,7 +141,9 @@ class DeviceStep {
   void configure(int copyBackEvery, int blockSize);
   // Runs `steps` steps from step index firstStep (time = index x dt) without the host, and then
   // copies their results off. Stops early after a step that asked for a break (the host's topology
-  // phase comes next). A step that overflowed a buffer is redone, bit-identically, with more room.
+  // phase comes next), and on the resident driver after a launch whose kernel broke floes or
+  // re-sorted (result.edits, result.order: the host's mirrors follow). A step that overflowed a buffer is redone, bit-identically, with
+  // more room.
   void run(long firstStep, Real dt, int steps, DeviceBatchResult& result);
   // One world: each body's |sum of its contact impulses| over the last step (N s), by id, ids
   // [0, nextId) (0 for a body without contact, or gone).

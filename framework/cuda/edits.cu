@@ -11,21 +11,12 @@
 #include "framework/api/cuda_check.hpp"
 #include "framework/cuda/device_state.cuh"
 #include "framework/cuda/device_step.hpp"
+#include "framework/cuda/step_phases.cuh"
 #include "framework/step/phases.hpp"
 
 namespace gem::cuda {
 
 namespace {
-
-// A coordinate as an integer of the same order (min and max by integer atomics are then exact, as
-// the host's loop): doubles keep every float and coordinate exactly.
-__device__ inline unsigned long long orderedBits(Real v) {
-  const unsigned long long u = static_cast<unsigned long long>(__double_as_longlong(static_cast<double>(v)));
-  return (u >> 63) ? ~u : u | (1ull << 63);
-}
-__device__ inline Real fromOrderedBits(unsigned long long u) {
-  return static_cast<Real>(__longlong_as_double(static_cast<long long>((u >> 63) ? u & ~(1ull << 63) : ~u)));
-}
 
 // Per world: the box of its bodies' centroids (min x, min y, max x, max y), as ordered bits.
 __global__ void curveBoundsInitKernel(int worlds, unsigned long long* bounds) {
@@ -36,7 +27,7 @@ __global__ void curveBoundsKernel(int n, const Real* x, const Real* y, const int
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   unsigned long long* b = bounds + 4 * world[i];
-  const unsigned long long bx = orderedBits(x[i]), by = orderedBits(y[i]);
+  const unsigned long long bx = orderedRealBits(x[i]), by = orderedRealBits(y[i]);
   atomicMin(b + 0, bx), atomicMin(b + 1, by), atomicMax(b + 2, bx), atomicMax(b + 3, by);
 }
 
@@ -46,8 +37,8 @@ __global__ void curveKeyKernel(int n, const Real* x, const Real* y, const int* w
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   const unsigned long long* b = bounds + 4 * world[i];
-  const Real x0 = fromOrderedBits(b[0]), y0 = fromOrderedBits(b[1]);
-  const Real scale = curveScale(x0, y0, fromOrderedBits(b[2]), fromOrderedBits(b[3]));
+  const Real x0 = fromOrderedRealBits(b[0]), y0 = fromOrderedRealBits(b[1]);
+  const Real scale = curveScale(x0, y0, fromOrderedRealBits(b[2]), fromOrderedRealBits(b[3]));
   key[i] = (static_cast<unsigned long long>(world[i]) << 32) | curveKey(x[i], y[i], x0, y0, scale);
   slot[i] = i;
 }
@@ -118,7 +109,6 @@ std::vector<int> DeviceStep::reorderAlongCurve(bool* broadphaseFollowed) {
     return order;
   }
   cudaStream_t s = d.stream;
-  ReorderScratch& scratch = d.permuteScratch;
   ReorderScratch& sortScratch = d.sortScratch;
   // Each world's centroid box: exact (min and max round nothing), as the host's loop.
   GraphArray<unsigned long long>& bounds = d.resortBounds;
@@ -144,7 +134,16 @@ std::vector<int> DeviceStep::reorderAlongCurve(bool* broadphaseFollowed) {
   void* temp = sortScratch.get();
   GEM_CUDA_CHECK(
       cub::DeviceRadixSort::SortPairs(temp, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, keyBits, s));
-  const int* o = sortedSlots.get();
+  sortedSlots.download(order.data(), static_cast<size_t>(n));
+  permuteDeviceState(d, sortedSlots.get(), order);
+  if (d.broadphase) *broadphaseFollowed = d.broadphase->reorder(sortedSlots.get(), n, s);
+  return order;
+}
+
+void permuteDeviceState(DeviceState& d, const int* o, const std::vector<int>& order) {
+  const int n = d.n;
+  cudaStream_t s = d.stream;
+  ReorderScratch& scratch = d.permuteScratch;
   permuteOnDevice(d.id, n, 1, o, scratch, s), permuteOnDevice(d.kind, n, 1, o, scratch, s);
   permuteOnDevice(d.world, n, 1, o, scratch, s);
   permuteOnDevice(d.vertexCount, n, 1, o, scratch, s), permuteOnDevice(d.dof, n, 1, o, scratch, s);
@@ -152,8 +151,6 @@ std::vector<int> DeviceStep::reorderAlongCurve(bool* broadphaseFollowed) {
   for (GraphArray<Real>* r : {&d.x, &d.y, &d.angle, &d.vx, &d.vy, &d.omega, &d.radius, &d.area, &d.thickness, &d.mass, &d.invMass,
                               &d.invInertia, &d.gyration2, &d.gyrationX2, &d.gyrationY2, &d.principalAngle})
     permuteOnDevice(*r, n, 1, o, scratch, s);
-  if (d.broadphase) *broadphaseFollowed = d.broadphase->reorder(o, n, s);
-  sortedSlots.download(order.data(), static_cast<size_t>(n));
 
   // The large bodies' and the vessels' new slots, the worlds' (their count is unchanged: the graph
   // stays valid).
@@ -170,7 +167,6 @@ std::vector<int> DeviceStep::reorderAlongCurve(bool* broadphaseFollowed) {
     if (v >= 0) v = newSlot[static_cast<size_t>(v)];
   d.large.upload(d.largeHost.data(), d.largeHost.size());
   uploadVessels(d);
-  return order;
 }
 
 void DeviceStep::downloadKinematics(const std::vector<int>& deviceSlots, const std::vector<int>& hostSlots, World& w) const {

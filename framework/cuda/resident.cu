@@ -25,6 +25,7 @@ struct ResidentState {
   std::vector<int> worldOfMembers;
   bool membersBuilt = false;
   DeviceArray<int> members, memberBegin, memberCount, previousCount;
+  std::vector<int> memberBeginHost;
   int mostBodies = 0;
   // Breaks in the kernel (ResidentBreaking): the new bodies a world may add in a launch
   // (GEM_RESIDENT_SPARE, default kSpareBodies; 0: every break ends the launch, as the device-wide
@@ -34,6 +35,8 @@ struct ResidentState {
   DeviceArray<std::int64_t> nextId;
   DeviceArray<int> spareUsed;
   DeviceArray<unsigned char> gone;
+  bool resort = false;            // the re-sort along the curve in the kernel (scenario's morton_sort)
+  DeviceArray<int> placeScratch;  // its scratch: bodySort ints a world
   // Per-world scratch (ResidentArgs).
   int capacity = 0, capacitySort = 0, bodySort = 0;
   int startCapacity = 0;  // GEM_CUDA_CAPACITY (tests force the regrowth path with it); 0: 4 x bodies + 256
@@ -107,6 +110,7 @@ void buildMembers(DeviceState& d, ResidentState& r) {
     members[static_cast<size_t>(at[static_cast<size_t>(d.worldHost[k])]++)] = static_cast<int>(k);
   r.members.upload(members.data(), members.size());
   r.memberBegin.upload(begin.data(), begin.size());
+  r.memberBeginHost = begin;
   r.memberCount.upload(count.data(), count.size());
   r.worldOfMembers = d.worldHost;
   r.membersBuilt = true;
@@ -136,6 +140,12 @@ void makeSpareRoom(DeviceState& d, ResidentState& r) {
   }
 }
 
+// The Real rows of World, in the order makeDense reads the device's arrays.
+std::vector<Real> World::*const kRealRows[] = {&World::x,          &World::y,          &World::angle,          &World::vx,
+                                               &World::vy,         &World::omega,      &World::area,           &World::thickness,
+                                               &World::mass,       &World::invMass,    &World::invInertia,     &World::gyration2,
+                                               &World::gyrationX2, &World::gyrationY2, &World::principalAngle, &World::radius};
+
 // Rows [first, first + count) of a device array into the host vector's end.
 template <class T, class Array>
 void appendDeviceRows(std::vector<T>& to, const Array& from, size_t first, size_t count) {
@@ -144,92 +154,95 @@ void appendDeviceRows(std::vector<T>& to, const Array& from, size_t first, size_
   if (count) GEM_CUDA_CHECK(cudaMemcpy(to.data() + at, from.get() + first, count * sizeof(T), cudaMemcpyDeviceToHost));
 }
 
-// After a launch whose breaks added bodies in the kernel: the state made dense again, as the
-// device-wide driver's edits leave it (the bodies that left compacted out, the others in their
-// order, the new ones after them in the order they were made, world by world), and what changed
-// appended to `edits` for the host's mirrors.
-void makeDense(DeviceState& d, ResidentState& r, DeviceBodyEdits& edits) {
+// After a launch whose kernel broke floes or re-sorted: the state made dense again, as the
+// device-wide driver's edits and re-sort leave it. First the edit: the bodies that left compacted
+// out, the others in their order, the new ones after them in the order they were made, world by
+// world (editDeviceBodies), what changed in result.edits for the host's mirrors. Then, after a
+// re-sort, the rows permuted to the members' order, world after world (permuteDeviceState, as
+// reorderAlongCurve), the order in result.order.
+void makeDense(DeviceState& d, ResidentState& r, const ResidentControl& control, DeviceBatchResult& result) {
   const int worlds = d.worlds, n = d.n;
-  std::vector<int> used(static_cast<size_t>(worlds));
-  r.spareUsed.download(used.data(), used.size());
-  std::vector<std::int64_t> nextIds(static_cast<size_t>(worlds));
-  r.nextId.download(nextIds.data(), nextIds.size());
   const size_t first = static_cast<size_t>(n), room = static_cast<size_t>(worlds) * static_cast<size_t>(r.spare);
-  std::vector<unsigned char> gone(first + room);
-  r.gone.download(gone.data(), gone.size());
-  std::vector<std::int64_t> ids;
-  appendDeviceRows(ids, d.id, 0, first + room);
-
-  // The bodies that left: of the state (compacted out), and new ones broken again in the launch.
-  std::vector<int> removedSlots;
-  for (int k = 0; k < n; ++k)
-    if (gone[static_cast<size_t>(k)]) removedSlots.push_back(k), edits.removedIds.push_back(ids[static_cast<size_t>(k)]);
-  // The new ones that stay: their rows as the kernel made them, and their kinematics now.
-  World added;
-  std::vector<int> addedWorlds;
-  World spareRows;
-  appendDeviceRows(spareRows.id, d.id, first, room), appendDeviceRows(spareRows.kind, d.kind, first, room);
-  appendDeviceRows(spareRows.vertexCount, d.vertexCount, first, room);
-  appendDeviceRows(spareRows.localVertices, d.local, first * kMaxVertices, room * kMaxVertices);
-  std::vector<Real> World::*reals[] = {&World::x,          &World::y,          &World::angle,          &World::vx,
-                                       &World::vy,         &World::omega,      &World::area,           &World::thickness,
-                                       &World::mass,       &World::invMass,    &World::invInertia,     &World::gyration2,
-                                       &World::gyrationX2, &World::gyrationY2, &World::principalAngle, &World::radius};
-  const GraphArray<Real>* arrays[] = {&d.x,          &d.y,          &d.angle,          &d.vx,      &d.vy,         &d.omega,
-                                      &d.area,       &d.thickness,  &d.mass,           &d.invMass, &d.invInertia, &d.gyration2,
-                                      &d.gyrationX2, &d.gyrationY2, &d.principalAngle, &d.radius};
-  for (size_t a = 0; a < std::size(reals); ++a) appendDeviceRows(spareRows.*reals[a], *arrays[a], first, room);
-  for (int w = 0; w < worlds; ++w)
-    for (int t = 0; t < used[static_cast<size_t>(w)]; ++t) {
-      const size_t k = static_cast<size_t>(w) * static_cast<size_t>(r.spare) + static_cast<size_t>(t);
-      if (gone[first + k]) {
-        edits.removedIds.push_back(spareRows.id[k]);
-        continue;
+  // The members name slots of the state as the launch left it: read before the edit moves them.
+  std::vector<int> members, count(static_cast<size_t>(worlds));
+  if (control.resorted) {
+    members.resize(static_cast<size_t>(r.memberBeginHost.back()));
+    r.members.download(members.data(), members.size());
+    r.memberCount.download(count.data(), count.size());
+  }
+  std::vector<int> denseSlot(first + room, -1);  // each slot's after the edit (-1: gone)
+  for (int k = 0; k < n; ++k) denseSlot[static_cast<size_t>(k)] = k;
+  if (control.floesBroken > 0) {
+    std::vector<int> used(static_cast<size_t>(worlds));
+    r.spareUsed.download(used.data(), used.size());
+    // The spare slots in use: the first mostUsed x worlds (a world's t-th is t x worlds + w).
+    const int mostUsed = *std::max_element(used.begin(), used.end());
+    const size_t usedRows = static_cast<size_t>(mostUsed) * static_cast<size_t>(worlds);
+    std::vector<std::int64_t> nextIds(static_cast<size_t>(worlds));
+    r.nextId.download(nextIds.data(), nextIds.size());
+    std::vector<unsigned char> gone(first + usedRows);
+    r.gone.download(gone.data(), gone.size());
+    std::vector<std::int64_t> ids;
+    appendDeviceRows(ids, d.id, 0, first);
+    DeviceBodyEdits& edits = result.edits;
+    std::vector<int> removedSlots;
+    int kept = 0;
+    for (int k = 0; k < n; ++k) {
+      if (gone[static_cast<size_t>(k)]) {
+        removedSlots.push_back(k), edits.removedIds.push_back(ids[static_cast<size_t>(k)]);
+        denseSlot[static_cast<size_t>(k)] = -1;
+      } else {
+        denseSlot[static_cast<size_t>(k)] = kept++;
       }
-      added.id.push_back(spareRows.id[k]), added.kind.push_back(spareRows.kind[k]), added.vertexCount.push_back(spareRows.vertexCount[k]);
-      added.localVertices.insert(added.localVertices.end(), spareRows.localVertices.begin() + static_cast<std::ptrdiff_t>(k * kMaxVertices),
-                                 spareRows.localVertices.begin() + static_cast<std::ptrdiff_t>((k + 1) * kMaxVertices));
-      for (auto real : reals) (added.*real).push_back((spareRows.*real)[k]);
-      addedWorlds.push_back(w);
     }
-  // The ids the dense state has room for: the world's own next id alone, or every world's stride.
-  added.nextId = worlds == 1 ? nextIds[0] : static_cast<std::int64_t>(worlds) * d.idStride;
-  editDeviceBodies(d, removedSlots, added, 0, worlds == 1 ? std::vector<int>{} : addedWorlds,
-                   std::vector<int>(static_cast<size_t>(worlds), 3));
+    // The new ones that stay: their rows as the kernel made them, and their kinematics now.
+    World spareRows;
+    appendDeviceRows(spareRows.id, d.id, first, usedRows), appendDeviceRows(spareRows.kind, d.kind, first, usedRows);
+    appendDeviceRows(spareRows.vertexCount, d.vertexCount, first, usedRows);
+    appendDeviceRows(spareRows.localVertices, d.local, first * kMaxVertices, usedRows * kMaxVertices);
+    const GraphArray<Real>* arrays[] = {&d.x,          &d.y,          &d.angle,          &d.vx,      &d.vy,         &d.omega,
+                                        &d.area,       &d.thickness,  &d.mass,           &d.invMass, &d.invInertia, &d.gyration2,
+                                        &d.gyrationX2, &d.gyrationY2, &d.principalAngle, &d.radius};
+    for (size_t a = 0; a < std::size(kRealRows); ++a) appendDeviceRows(spareRows.*kRealRows[a], *arrays[a], first, usedRows);
+    World& added = edits.added;
+    for (int w = 0; w < worlds; ++w)
+      for (int t = 0; t < used[static_cast<size_t>(w)]; ++t) {
+        const size_t k = static_cast<size_t>(t) * static_cast<size_t>(worlds) + static_cast<size_t>(w);
+        if (gone[first + k]) {  // made and broken again within the launch
+          edits.removedIds.push_back(spareRows.id[k]);
+          continue;
+        }
+        denseSlot[first + k] = kept + added.size();
+        added.id.push_back(spareRows.id[k]), added.kind.push_back(spareRows.kind[k]), added.vertexCount.push_back(spareRows.vertexCount[k]);
+        added.localVertices.insert(added.localVertices.end(),
+                                   spareRows.localVertices.begin() + static_cast<std::ptrdiff_t>(k * kMaxVertices),
+                                   spareRows.localVertices.begin() + static_cast<std::ptrdiff_t>((k + 1) * kMaxVertices));
+        for (auto real : kRealRows) (added.*real).push_back((spareRows.*real)[k]);
+        edits.addedWorlds.push_back(w);
+      }
+    // The ids the dense state has room for: the world's own next id alone, or every world's stride.
+    added.nextId = worlds == 1 ? nextIds[0] : static_cast<std::int64_t>(worlds) * d.idStride;
+    editDeviceBodies(d, removedSlots, added, 0, worlds == 1 ? std::vector<int>{} : edits.addedWorlds,
+                     std::vector<int>(static_cast<size_t>(worlds), 3));
+    edits.nextIds = nextIds;
+    r.nextIds = nextIds;
+  }
+  if (control.resorted) {
+    // The members' order, world after world, in the slots the edit left.
+    std::vector<int>& order = result.order;
+    for (int w = 0; w < worlds; ++w)
+      for (int i = 0; i < count[static_cast<size_t>(w)]; ++i)
+        order.push_back(denseSlot[static_cast<size_t>(members[static_cast<size_t>(r.memberBeginHost[static_cast<size_t>(w)] + i)])]);
+    if (order.size() != static_cast<size_t>(d.n) || std::find(order.begin(), order.end(), -1) != order.end())
+      throw std::logic_error("runResident: the worlds' members after the launch are not the state's bodies");
+    result.worldBefore = d.worldHost;
+    GraphArray<int>& onDevice = d.resortSlotsSorted;
+    onDevice.upload(order.data(), order.size());
+    awaitHostCopies();  // the order: read by the permutation's kernels
+    permuteDeviceState(d, onDevice.get(), order);
+  }
   r.membersBuilt = false;
-
-  // For the host: a body made and gone within the run was never in a mirror; made in an earlier
-  // launch of the run and gone in this one, it leaves the run's added rows instead.
-  std::vector<char> dropped(edits.added.id.size(), 0);
-  bool anyDropped = false;
-  std::vector<std::int64_t> removed;
-  for (std::int64_t id : edits.removedIds) {
-    const auto it = std::find(edits.added.id.begin(), edits.added.id.end(), id);
-    if (it == edits.added.id.end()) {
-      removed.push_back(id);
-    } else {
-      dropped[static_cast<size_t>(it - edits.added.id.begin())] = 1, anyDropped = true;
-    }
-  }
-  edits.removedIds.swap(removed);
-  if (anyDropped) {
-    std::vector<int> keptWorlds;
-    for (size_t k = 0; k < dropped.size(); ++k)
-      if (!dropped[k]) keptWorlds.push_back(edits.addedWorlds[k]);
-    edits.added.removeBodies(dropped);
-    edits.addedWorlds.swap(keptWorlds);
-  }
-  for (int k = 0; k < added.size(); ++k) {
-    edits.added.id.push_back(added.id[static_cast<size_t>(k)]), edits.added.kind.push_back(added.kind[static_cast<size_t>(k)]);
-    edits.added.vertexCount.push_back(added.vertexCount[static_cast<size_t>(k)]);
-    for (auto real : reals) (edits.added.*real).push_back((added.*real)[static_cast<size_t>(k)]);
-  }
-  edits.added.localVertices.insert(edits.added.localVertices.end(), added.localVertices.begin(), added.localVertices.end());
-  edits.addedWorlds.insert(edits.addedWorlds.end(), addedWorlds.begin(), addedWorlds.end());
-  edits.nextIds = nextIds;
-  r.nextIds = nextIds;
 }
-
 // Room for `capacity` candidate pairs in every world; the previous step's pairs are kept.
 void sizeScratch(DeviceState& d, ResidentState& r, int capacity) {
   const size_t worlds = static_cast<size_t>(d.worlds);
@@ -261,10 +274,11 @@ void sizeScratch(DeviceState& d, ResidentState& r, int capacity) {
 
 }  // namespace
 
-void DeviceStep::useResident(const ResidentProgram& program, const std::vector<unsigned char>& params, int paramsStride) {
+void DeviceStep::useResident(const ResidentProgram& program, const std::vector<unsigned char>& params, int paramsStride, bool resort) {
   DeviceState& d = *m_state;
   d.resident.reset(new ResidentState);
   ResidentState& r = *d.resident;
+  r.resort = resort;
   r.program = program;
   r.paramsStride = paramsStride;
   r.params.upload(params.data(), std::max<size_t>(params.size(), 1));
@@ -344,6 +358,7 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
       r.spareUsed.ensure(static_cast<size_t>(d.worlds));
       GEM_CUDA_CHECK(cudaMemset(r.spareUsed.get(), 0, sizeof(int) * static_cast<size_t>(d.worlds)));
     }
+    if (r.resort) r.placeScratch.ensure(static_cast<size_t>(d.worlds) * static_cast<size_t>(r.bodySort));
     // The largest world, its spare bodies included, sets the launch's shared memory.
     const std::size_t shared = residentSharedBytes(r.mostBodies + r.spare, r.vertexRoom);
     const int grid = std::max(1, std::min(d.worlds, multiprocessors * std::max(1, residentBlocksPerMultiprocessor(shared))));
@@ -367,6 +382,7 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
         ResidentBodyRows{d.id.get(), d.kind.get(), d.vertexCount.get(), d.dof.get(), d.world.get(), d.local.get(), d.area.get(),
                          d.thickness.get(), d.mass.get(), d.invMass.get(), d.invInertia.get(), d.gyration2.get(), d.gyrationX2.get(),
                          d.gyrationY2.get(), d.principalAngle.get(), d.radius.get(), d.isLarge.get()}};
+    a.resort = r.resort, a.placeScratch = r.placeScratch.get();
     a.capacity = r.capacity, a.capacitySort = r.capacitySort, a.bodySort = r.bodySort;
     a.sweepKeys = r.sweepKeys.get(), a.pairKeys = r.pairKeys.get(), a.idKeys = r.idKeys.get(), a.bKeys = r.bKeys.get();
     a.previous = r.previous.get(), a.previousCount = r.previousCount.get();
@@ -422,7 +438,12 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
                              d.h_worldRing + static_cast<size_t>(done) * static_cast<size_t>(d.worlds));
     next += done;
     remaining -= done;
-    if (control.floesBroken > 0) makeDense(d, r, result.edits);
+    result.hostTopology = control.haltReason == kHaltBreak;
+    // A launch that changed the worlds' bodies or their order ends the run: the host follows first.
+    if (control.floesBroken > 0 || control.resorted) {
+      makeDense(d, r, control, result);
+      break;
+    }
     if (control.haltReason == kHaltBreak) break;
     if (control.haltReason != kHaltOverflow) continue;
     // A step overflowed and left every world alone: grow what it passed, run it again.

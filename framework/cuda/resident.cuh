@@ -63,6 +63,7 @@ struct ResidentControl {
   long long pairCounts[3];  // block 0's first world, over the launch: candidate pairs, overlapping, contacts
   int verticesNeeded;       // the most vertices a world had (the next launch's shared memory for them)
   int floesBroken;          // by the kernel's topology phase, every world (the state is made dense after)
+  int resorted;             // 1: a world re-sorted its members along the curve (the state follows after)
 };
 // The phases' names, in the kernel's order.
 inline constexpr const char* kResidentPhaseNames[kResidentPhases] = {
@@ -80,8 +81,9 @@ struct ResidentBodyRows {
   unsigned char* isLarge;
 };
 
-// Breaks in the kernel: each world may add up to `spare` bodies in a launch, into the slots
-// spareFirst + w x spare + [0, spare) past the state's bodies (spareUsed[w] of them taken); a world
+// Breaks in the kernel: each world may add up to `spare` bodies in a launch, its t-th into the slot
+// spareFirst + t x worlds + w past the state's bodies (spareUsed[w] of them taken: the slots a
+// launch used lie together at the front, and the host reads back only those); a world
 // whose step asks for more stops the launch there, and the host's topology phase does that step.
 // A body that leaves is marked in gone[slot] and dropped from its world's members; its slot keeps
 // its rows until the host makes the state dense again (runResident, DeviceStep::editBodies).
@@ -108,6 +110,12 @@ struct ResidentArgs {
   int* memberCount;
   int worlds;
   ResidentBreaking breaking;
+  // The re-sort along the curve (docs/model.md 8) in the kernel, every kResortPeriod steps after the
+  // topology phase, as the host's: each world's members ordered by their curve keys (the slots stay;
+  // the host permutes the state to the members' order after the launch). placeScratch: bodySort
+  // ints a world.
+  bool resort;
+  int* placeScratch;
   // Per-world scratch: `capacity` candidate pairs, pow2 of it for the sorts, `bodySort` for the sweep.
   int capacity, capacitySort, bodySort;
   unsigned long long *sweepKeys, *pairKeys, *idKeys, *bKeys, *previous;

@@ -136,6 +136,7 @@ struct BreakScratch {
 
 struct BlockShared {
   BreakScratch breaks;
+  unsigned long long bounds[4];  // the re-sort's box of centroids (resortWorld)
   int scan[33];
   int count;
   long long cycles[kResidentPhases], stamp;  // block 0's time by phase (ResidentControl::phaseCycles)
@@ -605,12 +606,12 @@ __device__ void secondHalf(const ResidentArgs& a, int w, int contacts, const Ste
 // requests than its room stops the launch after this step instead (halt), and leaves the step to
 // the host. Returns nothing; the world's record of the step says what it did.
 template <class Breaking>
-__device__ void breakFloes(const ResidentArgs& a, int w, int s, int parity, WorldStepRecord& record, BlockShared& sh) {
+__device__ bool breakFloes(const ResidentArgs& a, int w, int s, int parity, WorldStepRecord& record, BlockShared& sh) {
   const ResidentBreaking& br = a.breaking;
   const PrepareArgs& p = a.prepare;
   const unsigned char* row = a.params + static_cast<size_t>(w) * static_cast<size_t>(a.paramsStride);
   const int q = Breaking::stream(row, br.offset);
-  if (q < 0 || q >= kMaxRecordStreams || !a.sink.streams[q].count) return;
+  if (q < 0 || q >= kMaxRecordStreams || !a.sink.streams[q].count) return false;
   const RecordBuffer& buffer = a.sink.streams[q];
   // This step's rows: nothing is pushed after the first barrier, and the step before ended its rows.
   const int begin = s > 0 ? a.ring[s - 1].recordEnd[q] : 0;
@@ -635,7 +636,7 @@ __device__ void breakFloes(const ResidentArgs& a, int w, int s, int parity, Worl
     }
   __syncthreads();
   const int count = b.count;
-  if (count == 0) return;
+  if (count == 0) return false;
   const int room = br.spare - br.spareUsed[w];
   if (threadIdx.x == 0) {
     // The CPU's order of the rows (by event, then contact), then the first request of each floe.
@@ -665,7 +666,7 @@ __device__ void breakFloes(const ResidentArgs& a, int w, int s, int parity, Worl
   }
   __syncthreads();
   const int unique = b.unique;
-  if (unique < 0) return;
+  if (unique < 0) return true;
   const std::int64_t idBase = static_cast<std::int64_t>(w) * p.idStride;
   WorldScratch ws = scratchOf(a, w);
   for (int i = threadIdx.x; i < ws.n; i += blockDim.x) {
@@ -712,7 +713,7 @@ __device__ void breakFloes(const ResidentArgs& a, int w, int s, int parity, Worl
     int k = b.firstPiece[j];
     for (const auto& piece : pieces) {
       if (piece.rubble) continue;
-      const int slot = br.spareFirst + w * br.spare + used + k;
+      const int slot = br.spareFirst + (used + k) * a.worlds + w;
       const BodyMassRow m = bodyMassRow<PortableTrig>(piece.vertices, piece.count, p.thickness[parent], false,
                                                       out.local + static_cast<size_t>(slot) * kMaxVertices);
       out.id[slot] = idBase + br.nextId[w] + k;
@@ -749,7 +750,7 @@ __device__ void breakFloes(const ResidentArgs& a, int w, int s, int parity, Worl
   int* members = a.members + ws.begin;
   const int added = b.piecesKept;
   for (int i = threadIdx.x; i < stay + added; i += blockDim.x)
-    members[i] = i < stay ? survivors[i] : br.spareFirst + w * br.spare + used + (i - stay);
+    members[i] = i < stay ? survivors[i] : br.spareFirst + (used + i - stay) * a.worlds + w;
   __syncthreads();
   if (threadIdx.x == 0) {
     a.memberCount[w] = stay + added;
@@ -760,6 +761,42 @@ __device__ void breakFloes(const ResidentArgs& a, int w, int s, int parity, Worl
     record.floesBroken = b.floesBroken;
     record.rubbleMass = b.rubbleMass;
   }
+  __syncthreads();
+  return false;
+}
+
+// The re-sort of world w after step `step`'s topology phase, as World::curveOrder orders the host's
+// bodies (and the device-wide driver's reorderAlongCurve its slots): the box of the world's
+// centroids (exact: min and max round nothing), each body's Morton key in it, a stable sort by key
+// (ties keep their place). Only the members move: the next step pairs and sums in the new order,
+// and the host permutes the state's rows to it after the launch (runResident).
+__device__ inline void resortWorld(const ResidentArgs& a, int w, BlockShared& sh) {
+  WorldScratch ws = scratchOf(a, w);
+  const int n = ws.n;
+  if (n < 2) return;
+  if (threadIdx.x == 0) sh.bounds[0] = sh.bounds[1] = ~0ull, sh.bounds[2] = sh.bounds[3] = 0ull;
+  __syncthreads();
+  for (int i = threadIdx.x; i < n; i += blockDim.x) {
+    const int slot = ws.members[i];
+    const unsigned long long bx = orderedRealBits(a.x[slot]), by = orderedRealBits(a.y[slot]);
+    atomicMin(&sh.bounds[0], bx), atomicMin(&sh.bounds[1], by), atomicMax(&sh.bounds[2], bx), atomicMax(&sh.bounds[3], by);
+  }
+  __syncthreads();
+  const Real x0 = fromOrderedRealBits(sh.bounds[0]), y0 = fromOrderedRealBits(sh.bounds[1]);
+  const Real scale = curveScale(x0, y0, fromOrderedRealBits(sh.bounds[2]), fromOrderedRealBits(sh.bounds[3]));
+  unsigned long long* keys = ws.sweep;  // the world's sweep keys in global memory: bodySort of them
+  for (int i = threadIdx.x; i < n; i += blockDim.x) {
+    const int slot = ws.members[i];
+    keys[i] = (static_cast<unsigned long long>(curveKey(a.x[slot], a.y[slot], x0, y0, scale)) << 32) | static_cast<unsigned>(i);
+  }
+  __syncthreads();
+  blockSort(keys, n, sh);
+  int* scratch = a.placeScratch + static_cast<size_t>(w) * static_cast<size_t>(a.bodySort);
+  for (int k = threadIdx.x; k < n; k += blockDim.x) scratch[k] = ws.members[keys[k] & 0xffffffffu];
+  __syncthreads();
+  int* members = a.members + ws.begin;
+  for (int k = threadIdx.x; k < n; k += blockDim.x) members[k] = scratch[k];
+  if (threadIdx.x == 0) a.control->resorted = 1;
   __syncthreads();
 }
 
@@ -822,13 +859,21 @@ __global__ void __launch_bounds__(kResidentBlock) residentKernel(ResidentArgs a,
       }
     }
     if (!overflow) {
+      // Does a topology stream the kernel leaves to the host have rows this step (the leader halts
+      // then)? Every block reads the same counters, as for the overflow.
+      bool hostTopology = false;
+      for (int q = 0; q < kMaxRecordStreams; ++q)
+        if (((a.haltStreams >> q) & 1u) && a.sink.streams[q].count)
+          hostTopology = hostTopology || readShared(a.sink.streams[q].count) > (s > 0 ? a.ring[s - 1].recordEnd[q] : 0);
       __syncthreads();
       for (int w = blockIdx.x; w < a.worlds; w += gridDim.x) {
         WorldStepRecord& record = a.worldRing[static_cast<size_t>(s) * a.worlds + w];
         const int contacts = record.contacts;
         __syncthreads();
         secondHalf<Events>(a, w, contacts, ctx, record);
-        if (a.breaking.offset >= 0) breakFloes<Breaking>(a, w, s, parity, record, sh);
+        const bool halted = a.breaking.offset >= 0 && breakFloes<Breaking>(a, w, s, parity, record, sh);
+        // A step whose topology the host takes (a halt) re-sorts on the host after it, every world.
+        if (a.resort && isResortStep(step + 1) && !hostTopology && !halted) resortWorld(a, w, sh);
       }
     }
     mark(sh, 11);

@@ -367,6 +367,8 @@ void DeviceStep::run(long firstStep, Real dt, int steps, DeviceBatchResult& resu
   result.steps.clear(), result.worldSteps.clear();
   for (auto& rows : result.records) rows.clear();
   result.edits = DeviceBodyEdits{};
+  result.order.clear(), result.worldBefore.clear();
+  result.hostTopology = false;
   result.worlds = d.worlds;
   if (d.n == 0) {
     result.steps.assign(static_cast<size_t>(steps), StepRecord{});

@@ -55,6 +55,17 @@ constexpr int kLargeChunk = 256;
 inline int largeChunks(int n) { return (n + kLargeChunk - 1) / kLargeChunk; }
 
 #if defined(__CUDACC__)
+// A coordinate as an integer of the same order (min and max by integer atomics are then exact, as
+// the host's loop): doubles keep every float and coordinate exactly. The re-sort along the curve's
+// box of centroids, on the device-wide driver (edits.cu) and in the resident kernel.
+__device__ inline unsigned long long orderedRealBits(Real v) {
+  const unsigned long long u = static_cast<unsigned long long>(__double_as_longlong(static_cast<double>(v)));
+  return (u >> 63) ? ~u : u | (1ull << 63);
+}
+__device__ inline Real fromOrderedRealBits(unsigned long long u) {
+  return static_cast<Real>(__longlong_as_double(static_cast<long long>((u >> 63) ? u & ~(1ull << 63) : ~u)));
+}
+
 __device__ inline long long cellCoord(Real v, Real cell) { return static_cast<long long>(floor(v / cell)); }
 
 // A cell of one world: the worlds of a batch share the table (world 0 hashes as a lone run did).

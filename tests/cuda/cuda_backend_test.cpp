@@ -247,16 +247,16 @@ TEST(CudaBackend, BreaksOnTheDeviceMatchTheWholeWorldRoundTrip) {
   }
 }
 
-// The resident driver breaks floes inside its kernel: a break no longer ends a launch (it did, for
-// the host's topology phase), and the run is bit for bit the device-wide driver's, whose breaks the
-// host makes: the same breaks, pieces, ids and trajectories, since both cut with the same
+// The resident driver breaks floes and re-sorts along the curve inside its kernel: neither ends a
+// launch any more (they did, for the host's topology phase and re-sort), and the run is bit for bit
+// the device-wide driver's, whose breaks the host makes: the same breaks, pieces, ids and trajectories, since both cut with the same
 // arithmetic (events/flexural_cut.hpp). With room for two pieces a launch, the launches end at the
 // breaks that pass it, the host's topology phase takes those, and the run stays the same.
 TEST(CudaBackend, ResidentBreaksInItsKernelWithoutEndingTheLaunch) {
   GEM_SKIP_WITHOUT_CUDA();
   TempDir dir;
   const std::vector<std::string> thin = {"domain.x=[0.0, 240.0]", "field.thickness=0.25", "simulation.steps=400",
-                                         "simulation.copy_back_every=64", "output.frame_every=0"};
+                                         "simulation.copy_back_every=128", "output.frame_every=0"};
   std::vector<std::string> resident = thin;
   resident.push_back("simulation.cuda_driver=\"resident\"");
   std::vector<std::string> device = thin;
@@ -283,9 +283,9 @@ TEST(CudaBackend, ResidentBreaksInItsKernelWithoutEndingTheLaunch) {
   // Floes broke all along (about 190 on the CPU), pieces among them left as rubble.
   EXPECT_GT(kernel.state.broken, 40);
   EXPECT_GT(kernel.rubble, 0);
-  // A launch per 64 steps, ending at the re-sort (step 200) too: 8, and at most two more for a
-  // step that passed a buffer and was run again with more room; not one per break.
-  EXPECT_LE(kernel.launches, 10) << kernel.state.broken << " floes broken";
+  // Four launches, of 128, 128, 128 and 16 steps: neither a break nor the re-sort along the curve
+  // at step 200 (the kernel's too) ends one.
+  EXPECT_EQ(kernel.launches, 4) << kernel.state.broken << " floes broken";
   EXPECT_GT(cramped.launches, kernel.launches + 10);
   for (const Outcome* other : {&wide, &cramped}) {
     EXPECT_EQ(other->state.broken, kernel.state.broken);
@@ -369,8 +369,8 @@ TEST_P(EveryScenario, CudaSummaryAgreesWithTheCpu) {
   EXPECT_NEAR(gpu.thrust, cpu.thrust, 0.2 * cpu.thrust);
   EXPECT_NEAR(gpu.broken, cpu.broken, 0.25 * cpu.broken + 2);
   // The CUDA runs above take the device-wide driver (auto, one world). The resident driver (the
-  // world in one thread block, its breaks in the kernel) runs the whole transit to the same
-  // summary, number for number, so it agrees with the CPU as the device-wide driver does.
+  // world in one thread block, its breaks and re-sorts in the kernel) runs the whole transit to the
+  // same summary, number for number, so it agrees with the CPU as the device-wide driver does.
   const std::string resident = runOnce("--backend cuda --set simulation.cuda_driver='\"resident\"'", 0, dir.path() / "resident");
   EXPECT_NE(deviceWide.find("\"driver\": \"device\""), std::string::npos);
   EXPECT_NE(resident.find("\"driver\": \"resident\""), std::string::npos);
