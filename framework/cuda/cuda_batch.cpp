@@ -309,8 +309,10 @@ void CudaBatch::ensureStep(long step) {
   runBatch(step);
 }
 
-// Up to copy_back_every steps, ending where the host needs the state: the next frame, the next
-// re-sort along the curve (every kResortPeriod steps), the next checkpoint, the scenario's last step.
+// Up to the next multiple of copy_back_every steps (after a batch that a break ended early too, so
+// that batches end at steps a caller can know: every copy_back_every-th), and before that where the
+// host needs the state: the next frame, the next re-sort along the curve (every kResortPeriod steps;
+// the resident kernel re-sorts itself), the next checkpoint, the scenario's last step.
 void CudaBatch::runBatch(long step) {
   const Scenario& s = m_members.front()->scenario();
   // Alone on its device, a batch is copy_back_every steps in one launch. Sharing it (a sweep's
@@ -322,6 +324,7 @@ void CudaBatch::runBatch(long step) {
   auto stopAtMultipleOf = [&](long every) {
     if (every > 0) end = std::min(end, (step / every + 1) * every);
   };
+  stopAtMultipleOf(every);
   if (s.output.frameEvery > 0) stopAtMultipleOf(s.output.frameEvery);
   if (s.mortonSort && !m_device->resident()) stopAtMultipleOf(kResortPeriod);  // the resident kernel re-sorts itself
   stopAtMultipleOf(s.output.checkpointEverySteps);                             // a checkpoint needs the state on the host

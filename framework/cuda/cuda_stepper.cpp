@@ -92,6 +92,7 @@ long CudaStepper::broadphaseRebuilds() const {
 }
 
 long CudaStepper::residentLaunches() const { return m_batch->device().residentLaunches(); }
+long CudaStepper::residentResortLaunches() const { return m_batch->device().residentResortLaunches(); }
 
 std::string CudaStepper::driver() const { return m_batch->device().resident() ? "resident" : "device"; }
 

@@ -76,6 +76,8 @@ class CudaStepper final : public Stepper {
   long broadphaseRebuilds() const;
   // Launches of the resident kernel so far (0 on the device-wide driver): breaks no longer end one.
   long residentLaunches() const;
+  // Those of them that re-sorted along the curve in the kernel (nor does a re-sort end one).
+  long residentResortLaunches() const;
   // Tests, alone only: run the topology phase through a whole-world round trip (download, edit,
   // upload), the reference that the device edit must match bit for bit.
   void setTopologyThroughHost(bool on) { m_topologyThroughHost = on; }

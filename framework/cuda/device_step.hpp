@@ -136,6 +136,8 @@ class DeviceStep {
   void setNextIds(const std::vector<std::int64_t>& nextIds);
   // Launches of the resident kernel so far (a break in the kernel no longer ends one).
   long residentLaunches() const;
+  // Those of them whose kernel re-sorted a world along the curve (a re-sort no longer ends one).
+  long residentResortLaunches() const;
   // Steps kept on the device between two copies to the host (the ring's length), and threads per
   // block of the per-body and per-contact kernels. Before the first run.
   void configure(int copyBackEvery, int blockSize);

@@ -134,6 +134,9 @@ std::vector<int> DeviceStep::reorderAlongCurve(bool* broadphaseFollowed) {
   void* temp = sortScratch.get();
   GEM_CUDA_CHECK(
       cub::DeviceRadixSort::SortPairs(temp, bytes, keys.get(), sortedKeys.get(), slots.get(), sortedSlots.get(), n, 0, keyBits, s));
+  // The download goes on the legacy stream, which does not wait for the sort on the state's
+  // non-blocking stream: wait here, or the order read back may be the sort's half-written output.
+  GEM_CUDA_CHECK(cudaStreamSynchronize(s));
   sortedSlots.download(order.data(), static_cast<size_t>(n));
   permuteDeviceState(d, sortedSlots.get(), order);
   if (d.broadphase) *broadphaseFollowed = d.broadphase->reorder(sortedSlots.get(), n, s);

@@ -58,6 +58,7 @@ struct ResidentState {
   // global memory (for side-by-side timings; the results are the same).
   int vertexRoom = -1;
   long launches = 0, steps = 0;
+  long resortLaunches = 0;  // launches whose kernel re-sorted a world along the curve
   ResidentState() { GEM_CUDA_CHECK(cudaMallocHost(&h_control, sizeof(ResidentControl))); }
   ~ResidentState() {
     if (h_control) cudaFreeHost(h_control);
@@ -296,6 +297,7 @@ void DeviceStep::setNextIds(const std::vector<std::int64_t>& nextIds) {
 }
 
 long DeviceStep::residentLaunches() const { return m_state->resident ? m_state->resident->launches : 0; }
+long DeviceStep::residentResortLaunches() const { return m_state->resident ? m_state->resident->resortLaunches : 0; }
 
 std::vector<unsigned long long> residentPreviousKeys(const DeviceState& d) {
   const ResidentState& r = *d.resident;
@@ -414,6 +416,7 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     const ResidentControl control = *r.h_control;
     const int done = control.stepsDone;
     ++r.launches;
+    if (control.resorted) ++r.resortLaunches;
     r.steps += done;
     for (int k = 0; k < kResidentPhases; ++k) r.phaseCycles[k] += control.phaseCycles[k];
     for (int k = 0; k < 3; ++k) r.pairCounts[k] += control.pairCounts[k];
@@ -439,26 +442,28 @@ void runResident(DeviceState& d, long firstStep, Real dt, int steps, DeviceBatch
     next += done;
     remaining -= done;
     result.hostTopology = control.haltReason == kHaltBreak;
+    // A step overflowed and left every world alone: grow what it passed; it runs again next launch.
+    // (Before the early end below, so that the next run does not first overflow at that step again.)
+    if (control.haltReason == kHaltOverflow) {
+      if (control.candidatesNeeded > r.capacity) {
+        sizeScratch(d, r, control.candidatesNeeded + control.candidatesNeeded / 2 + 256);
+        d.recordCapacity = std::max(d.recordCapacity, r.capacity);
+        for (int q = 0; q < d.recordStreams; ++q)
+          d.records[q].ensure(static_cast<size_t>(d.recordCapacity) * static_cast<size_t>(d.recordStride[q]));
+      } else if (done == 0 || (done < batch / 2 && d.recordCapacity < (1 << 24))) {
+        // One step's records alone passed the buffers (4x), or a launch filled them in less than half
+        // its steps (2x; many worlds log many rows a step): more room, so launches keep their length.
+        d.recordCapacity *= done == 0 ? 4 : 2;
+        for (int q = 0; q < d.recordStreams; ++q)
+          d.records[q].ensure(static_cast<size_t>(d.recordCapacity) * static_cast<size_t>(d.recordStride[q]));
+      }
+    }
     // A launch that changed the worlds' bodies or their order ends the run: the host follows first.
     if (control.floesBroken > 0 || control.resorted) {
       makeDense(d, r, control, result);
       break;
     }
     if (control.haltReason == kHaltBreak) break;
-    if (control.haltReason != kHaltOverflow) continue;
-    // A step overflowed and left every world alone: grow what it passed, run it again.
-    if (control.candidatesNeeded > r.capacity) {
-      sizeScratch(d, r, control.candidatesNeeded + control.candidatesNeeded / 2 + 256);
-      d.recordCapacity = std::max(d.recordCapacity, r.capacity);
-      for (int q = 0; q < d.recordStreams; ++q)
-        d.records[q].ensure(static_cast<size_t>(d.recordCapacity) * static_cast<size_t>(d.recordStride[q]));
-    } else if (done == 0 || (done < batch / 2 && d.recordCapacity < (1 << 24))) {
-      // One step's records alone passed the buffers (4x), or a launch filled them in less than half
-      // its steps (2x; many worlds log many rows a step): more room, so launches keep their length.
-      d.recordCapacity *= done == 0 ? 4 : 2;
-      for (int q = 0; q < d.recordStreams; ++q)
-        d.records[q].ensure(static_cast<size_t>(d.recordCapacity) * static_cast<size_t>(d.recordStride[q]));
-    }
   }
 }
 

@@ -103,8 +103,9 @@ struct ResidentArgs {
   MotionBody* motion;
   Real* impulseOfId;  // one world: |its contact impulses| by body id (the frames' contact_force); else null
   // Worlds: world w's bodies are members[memberBegin[w] .. memberBegin[w] + memberCount[w]), in the
-  // order of its own run (ascending slots; the bodies a break adds after the others), with room for
-  // the spare bodies a launch may add.
+  // order of its own run (ascending slots at a launch's start; the bodies a break adds after the
+  // others; a re-sort in the kernel reorders them, and the host permutes the rows to match after the
+  // launch), with room for the spare bodies a launch may add.
   int* members;
   const int* memberBegin;
   int* memberCount;

@@ -8,7 +8,8 @@
 // blockIdx.x + gridDim.x, ... Per step and world:
 //   1. prepare every body (body_phases.cuh), and key it by its box's left edge;
 //   2. its pairs: a sort and sweep along x over the world's bodies, then the prefilter (mayTouch):
-//      exactly the pairs the device-wide driver's narrowphase tests, sorted by (a, b) slots;
+//      exactly the pairs the device-wide driver's narrowphase tests, sorted by (a, b) places among
+//      the world's members (its slots' order but after a re-sort in the launch: resortWorld);
 //   3. narrowphase (contactOfPair), compaction in order, onset against the previous step's pairs;
 //   4. the pair events, contact by contact, each contact's events in the declared order; the solo
 //      events, body by body;
@@ -300,6 +301,10 @@ struct WorldScratch {
   Contact* candidates;
   int *flag, *touching, *survivors;
   int *contactA, *contactB;
+  // Contact c's first body by its place among the world's members (the gather's search): the
+  // contacts ascend by it, not by contactA's slots once the kernel has re-sorted the members
+  // (resortWorld). It lives in flag's room, which is free once the survivors are placed.
+  int* placeA;
   PairContact* contacts;
   PairSlot* slots;
 };
@@ -318,6 +323,7 @@ __device__ inline WorldScratch scratchOf(const ResidentArgs& a, int w) {
   s.candidates = a.candContact + ww * cap;
   s.flag = a.flag + ww * 2 * (cap + 1);
   s.touching = s.flag + (cap + 1);
+  s.placeA = s.flag;
   s.survivors = a.survivors + ww * cap;
   s.contactA = a.contactA + ww * cap;
   s.contactB = a.contactB + ww * cap;
@@ -524,6 +530,7 @@ __device__ int firstHalf(const ResidentArgs& a, int w, const StepContext& ctx, i
                              idb = static_cast<unsigned long long>(p.pairBodies[sb].id);
     const unsigned long long idKey = ida < idb ? (ida << 32) | idb : (idb << 32) | ida;
     s.contactA[c] = sa;
+    s.placeA[c] = static_cast<int>(key >> 32);
     s.contactB[c] = sb;
     const int seen = lowerBoundOf(s.previous, previous, idKey);
     s.contacts[c] = PairContact{s.candidates[j], seen == previous || s.previous[seen] != idKey};
@@ -580,9 +587,9 @@ __device__ void secondHalf(const ResidentArgs& a, int w, int contacts, const Ste
     const int firstB = lowerBoundOf(s.bs, contacts, static_cast<unsigned long long>(i) << 32);
     int endB = firstB;
     while (endB < contacts && (s.bs[endB] >> 32) == static_cast<unsigned long long>(i)) ++endB;
-    const int firstA = lowerBoundOf(s.contactA, contacts, slot);
+    const int firstA = lowerBoundOf(s.placeA, contacts, i);
     int endA = firstA;
-    while (endA < contacts && s.contactA[endA] == slot) ++endA;
+    while (endA < contacts && s.placeA[endA] == i) ++endA;
     Vec2 onBody;
     MotionBody body = gatherBody(
         p.pairBodies[slot], p.changes[slot], [&](int q) { return static_cast<int>(s.bs[firstB + q] & 0xffffffffu); }, endB - firstB, firstA,
@@ -643,7 +650,10 @@ __device__ bool breakFloes(const ResidentArgs& a, int w, int s, int parity, Worl
     for (int i = 1; i < min(count, kResidentMostBreaks); ++i)
       for (int j = i; j > 0; --j) {
         const RecordTag x = tagOf(b.row[j - 1]), y = tagOf(b.row[j]);
-        if (x.event < y.event || (x.event == y.event && x.contact <= y.contact)) break;
+        // Ties by the row itself: the rows came in by atomics, in no fixed order, while the host
+        // keeps a stream's push order.
+        if (x.event < y.event || (x.event == y.event && (x.contact < y.contact || (x.contact == y.contact && b.row[j - 1] < b.row[j]))))
+          break;
         const int t = b.row[j - 1];
         b.row[j - 1] = b.row[j], b.row[j] = t;
       }
