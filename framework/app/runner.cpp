@@ -527,6 +527,14 @@ RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const s
       }
       if (stop) {
         reason = stop;
+        // A device backend has its state on the host only between copy-back batches: the steps it
+        // has already run past the rule's (copy_back_every at most) are recorded too, as after
+        // Ctrl-C, so that every file and the summary stop at one step.
+        while (!sim.stateOnHost() && stepsRun < scenario.steps) {
+          sim.step();
+          run.record(stepsRun);
+          ++stepsRun;
+        }
         break;
       }
     }
@@ -609,8 +617,11 @@ std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>
   const auto start = std::chrono::steady_clock::now();
   auto wallSeconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   // A case whose stop rule fired is finished there (its files and summary written) and is still
-  // stepped with the others, its outputs no longer recorded.
+  // stepped with the others, its outputs no longer recorded. On a device backend that is at the end
+  // of the copy-back batch the rule fired in (the state is on the host only there): the case
+  // records the steps up to it, as a run alone does (runSteps).
   std::vector<char> done(count, 0);
+  std::vector<const char*> stopping(count, nullptr);
   auto finishCase = [&](size_t i, long stepsRun, const std::string& reason, bool completed) {
     try {
       runs[i]->summary().casesOnDevice = static_cast<int>(count);
@@ -632,7 +643,8 @@ std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>
         if (!running(i)) continue;
         try {
           runs[i]->record(k);
-          if (const char* stop = runs[i]->stopRuleReached()) finishCase(i, k + 1, stop, true);
+          if (!stopping[i]) stopping[i] = runs[i]->stopRuleReached();
+          if (stopping[i] && steppers[i]->stateOnHost()) finishCase(i, k + 1, stopping[i], true);
         } catch (const std::exception& e) {
           failures[i] = e.what();
           runs[i]->abandon();
@@ -657,7 +669,7 @@ std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>
     return failures;
   }
   for (size_t i = 0; i < count; ++i)
-    if (running(i)) finishCase(i, steps, "duration", true);
+    if (running(i)) finishCase(i, steps, stopping[i] ? stopping[i] : "duration", true);
   return failures;
 }
 

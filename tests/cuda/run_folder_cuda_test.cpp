@@ -3,6 +3,7 @@
 // the very files of the run that was never stopped.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 
 #include "cuda_test_support.hpp"
@@ -61,6 +62,68 @@ TEST_P(CudaRunFolder, FramesCarryEachBodysContactForce) {
             0)
       << readFile(dir.path() / "log");
   expectContactForcesInFrames(out);
+}
+
+}  // namespace
+
+namespace {
+
+long summaryNumber(const std::string& summary, const std::string& key) {
+  const size_t at = summary.find("\"" + key + "\": ");
+  return at == std::string::npos ? -1 : std::stol(summary.substr(at + key.size() + 4));
+}
+
+// A stop rule that fires inside a copy-back batch (simulation.stop_when) ends a CUDA run at that
+// batch's end, the first step whose state is on the host: the steps the device already ran are
+// recorded, as after Ctrl-C, and the run exits 0 with the rule's reason. It used to fail there
+// asking for the world in the middle of the batch, alone and in a sweep's cases run together.
+TEST_P(CudaRunFolder, AStopRuleInsideABatchEndsTheRunAtTheBatchsEnd) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  const auto scenario = dir.write("busy.toml", kBusyScene);
+  const std::string stop = " --quiet --no-plots --steps 2000 --set output.frame_every=0 --set simulation.stop_when=\\\"distance\\\"";
+  const std::string cuda =
+      std::string(" --backend cuda --set simulation.copy_back_every=16 --set simulation.cuda_driver=\\\"") + GetParam() + "\\\"";
+  ASSERT_EQ(runGem("run " + scenario.string() + stop + " --set simulation.stop_distance=20.0 --out " + (dir.path() / "cpu").string(),
+                   dir.path() / "log"),
+            0)
+      << readFile(dir.path() / "log");
+  const long cpuSteps = summaryNumber(readFile(dir.path() / "cpu" / "summary.json"), "steps");
+  ASSERT_GT(cpuSteps, 16);
+  ASSERT_NE(cpuSteps % 16, 0) << "the rule fires at a batch's end on the CPU already: it tests nothing";
+  ASSERT_EQ(runGem("run " + scenario.string() + stop + cuda + " --set simulation.stop_distance=20.0 --out " + (dir.path() / "gpu").string(),
+                   dir.path() / "log"),
+            0)
+      << readFile(dir.path() / "log");
+  const std::string summary = readFile(dir.path() / "gpu" / "summary.json");
+  EXPECT_NE(summary.find("\"stop_reason\": \"distance\""), std::string::npos) << summary;
+  // Batches end at every 16th step, and earlier at a step the host's topology phase takes (the
+  // device-wide driver's breaks): at the latest the 16th step the rule fired before.
+  const long steps = summaryNumber(summary, "steps");
+  EXPECT_GE(steps, cpuSteps);
+  EXPECT_LE(steps, (cpuSteps + 15) / 16 * 16) << "past the end of the batch the rule fired in (the CPU stopped at " << cpuSteps << ")";
+  // Every file stops at that step: timeseries.csv has a row a step.
+  const std::string series = readFile(dir.path() / "gpu" / "timeseries.csv");
+  EXPECT_EQ(static_cast<long>(std::count(series.begin(), series.end(), '\n')), steps + 1);
+
+  // Two cases run together on the device, their rules firing in different batches.
+  dir.write("stop.toml",
+            "[sweep]\nname = \"stop\"\nbase = \"busy.toml\"\n[[cases]]\nname = \"near\"\nset = { \"simulation.stop_distance\" = 20.0 }\n"
+            "[[cases]]\nname = \"far\"\nset = { \"simulation.stop_distance\" = 60.0 }\n");
+  ASSERT_EQ(runGem("sweep " + (dir.path() / "stop.toml").string() + " --quiet --out " + (dir.path() / "sweep").string() + " --set " +
+                       "simulation.steps=2000 --set output.frame_every=0 --set simulation.stop_when=\\\"distance\\\" --set " +
+                       "simulation.backend=\\\"cuda\\\" --set simulation.copy_back_every=16 --set simulation.cuda_driver=\\\"" +
+                       GetParam() + "\\\"",
+                   dir.path() / "log"),
+            0)
+      << readFile(dir.path() / "log");
+  const std::string near = readFile(dir.path() / "sweep" / "cases" / "near" / "summary.json"),
+                    far = readFile(dir.path() / "sweep" / "cases" / "far" / "summary.json");
+  EXPECT_NE(near.find("\"stop_reason\": \"distance\""), std::string::npos) << near;
+  EXPECT_NE(far.find("\"stop_reason\": \"distance\""), std::string::npos) << far;
+  EXPECT_GE(summaryNumber(near, "steps"), cpuSteps);
+  EXPECT_LE(summaryNumber(near, "steps"), (cpuSteps + 15) / 16 * 16);
+  EXPECT_LT(summaryNumber(near, "steps"), summaryNumber(far, "steps"));
 }
 
 }  // namespace
