@@ -655,9 +655,25 @@ std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>
       if (!anyRunning) break;
     }
   } catch (const Interrupted& e) {
-    // Every case still running keeps its whole files and a summary saying it did not complete.
+    // Every case still running keeps its whole files and a summary saying it did not complete. A
+    // device backend has its cases' state on the host only between copy-back batches: the steps
+    // the device has already run are recorded first, as a run alone does (runSteps).
+    auto onHost = [&] {
+      for (const auto& s : steppers)
+        if (!s->stateOnHost()) return false;
+      return true;
+    };
+    try {
+      for (; k < steps && !onHost(); ++k) {
+        for (size_t i = 0; i < count; ++i) steppers[i]->step();
+        for (size_t i = 0; i < count; ++i)
+          if (running(i)) runs[i]->record(k);
+      }
+    } catch (const std::exception&) {
+      // A failure here leaves the cases' summaries to say where they stopped, as below.
+    }
     for (size_t i = 0; i < count; ++i)
-      if (running(i)) finishCase(i, k, signalName(e.signal()), false);
+      if (running(i)) finishCase(i, k, stopping[i] ? stopping[i] : signalName(e.signal()), stopping[i] != nullptr);
     throw;
   } catch (const std::exception& e) {
     // The shared device state failed: every case that was still running fails with it.

@@ -127,3 +127,45 @@ TEST_P(CudaRunFolder, AStopRuleInsideABatchEndsTheRunAtTheBatchsEnd) {
 }
 
 }  // namespace
+
+namespace {
+
+// Ctrl-C stops a sweep whose cases run together on the device: each running case records the steps
+// the device has already run (to the batch's end) and keeps whole files and a summary that says it
+// did not complete, as a run alone does. It used to fail each case asking for the world in the
+// middle of a batch, leaving no summary.
+TEST_P(CudaRunFolder, CtrlCInsideABatchStopsCasesRunTogetherWhole) {
+  GEM_SKIP_WITHOUT_CUDA();
+  TempDir dir;
+  dir.write("busy.toml", kBusyScene);
+  const auto file = dir.write("long.toml",
+                              "[sweep]\nname = \"long\"\nbase = \"busy.toml\"\n[[cases]]\nname = \"a\"\n"
+                              "[[cases]]\nname = \"b\"\nset = { \"vessel.bollard_thrust\" = 500e3 }\n");
+  const auto out = dir.path() / "out";
+  // Both cases have started once the second's scenario.toml is written (its outputs appear only
+  // at their end, through temporaries). Both drivers run them together on the grid.
+  const std::string started = (out / "cases" / "b" / "scenario.toml").string();
+  const int status =
+      shell(gemBinary() + " sweep " + file.string() + " --out " + out.string() +
+            " --set simulation.steps=2000000 --set output.frame_every=0 --set simulation.backend=\\\"cuda\\\"" +
+            " --set simulation.broadphase=\\\"uniform_grid\\\"" + " --set simulation.copy_back_every=64 --set simulation.cuda_driver=\\\"" +
+            GetParam() + "\\\" > " + (dir.path() / "log").string() + " 2>&1 & p=$!; for i in $(seq 600); do [ -s " + started +
+            " ] && break; sleep 0.1; done; sleep 2; kill -INT $p; wait $p");
+  ASSERT_EQ(status, 130) << readFile(dir.path() / "log");
+  ASSERT_NE(readFile(dir.path() / "log").find("in 1 device run of several cases"), std::string::npos) << readFile(dir.path() / "log");
+  long stepsOfA = -1;
+  for (const char* name : {"a", "b"}) {
+    SCOPED_TRACE(name);
+    const std::string summary = readFile(out / "cases" / name / "summary.json");
+    ASSERT_NE(summary.find("\"stop_reason\": \"SIGINT\""), std::string::npos) << summary << readFile(dir.path() / "log");
+    EXPECT_NE(summary.find("\"completed\": false"), std::string::npos);
+    const long steps = summaryNumber(summary, "steps");
+    EXPECT_GT(steps, 0);
+    const std::string series = readFile(out / "cases" / name / "timeseries.csv");
+    EXPECT_EQ(static_cast<long>(std::count(series.begin(), series.end(), '\n')), steps + 1);  // a row a step, whole
+    if (stepsOfA >= 0) EXPECT_EQ(steps, stepsOfA);                                            // the cases stepped together stop at one step
+    stepsOfA = steps;
+  }
+}
+
+}  // namespace
