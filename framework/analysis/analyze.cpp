@@ -389,6 +389,13 @@ int runAnalyze(const AnalyzeOptions& options) {
                     "case",
                     dir.string()));
 
+  // A run folder is one group: a --groups naming another (a typo, a sweep's label) analysed the
+  // whole run under "all" with exit 0.
+  for (const std::string& wanted : options.groups)
+    if (!sweep && wanted != "all" && wanted != runs.front().name)
+      throw InputError(
+          fmt::format("--groups {}: {} is a run folder, one group: \"all\" (groups are a sweep folder's)", wanted, dir.string()));
+
   // Groups: a run folder is one group "all"; a sweep groups its cases by the values of its varied
   // keys other than thrust and seed (sweep_cases.hpp; thesis Figure 6.38 groups by ice mix), plus
   // "all" of the chosen ones. --groups names a group by its label or by one of its cases' names.

@@ -58,14 +58,14 @@ const std::vector<std::pair<std::string, std::string>>& columnKeys() {
 
 }  // namespace
 
-std::map<std::string, std::string> readSummaryJson(const fs::path& file) {
+std::map<std::string, std::string> readSummaryJson(const fs::path& file, const std::string& remedy) {
   requireRegularFile(file, "summary.json");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError("cannot read " + file.string());
   const std::string text(std::istreambuf_iterator<char>(in), {});
   // Bad input like any other (exit 2): a damaged file in a sweep's folder, not an internal error.
   auto malformed = [&](const std::string& what) {
-    return InputError(fmt::format("{}: malformed JSON: {} (delete it, and the sweep runs that case again)", file.string(), what));
+    return InputError(fmt::format("{}: malformed JSON: {} ({})", file.string(), what, remedy));
   };
   constexpr int kMostDepth = 64;  // GEM writes 2 levels; a hostile file must not exhaust the stack
   nlohmann::json root;
@@ -94,6 +94,10 @@ std::map<std::string, std::string> readSummaryJson(const fs::path& file) {
   std::map<std::string, std::string> out;
   flatten(root, "", out);
   return out;
+}
+
+std::map<std::string, std::string> readSummaryJson(const fs::path& file) {
+  return readSummaryJson(file, "delete it, and the sweep runs that case again");
 }
 
 const std::vector<std::string>& sweepSummaryColumns() {

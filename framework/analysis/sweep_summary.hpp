@@ -12,7 +12,10 @@ namespace gem {
 // The flat numbers and strings of a summary.json (the subset of JSON GEM writes: objects, numbers,
 // strings, true/false/null; arrays are skipped), nested objects flattened to "ship_speed.mean".
 // Numbers are written back in their shortest exact form ("1e3" reads as "1000.0"); null is "". Throws InputError (the file and the offset)
-// if malformed or nested more than 64 deep.
+// if malformed or nested more than 64 deep; its message ends with `remedy`, what the reader who
+// met the file can do (a sweep runs the case again; `gem view` once gave a sweep's advice too).
+std::map<std::string, std::string> readSummaryJson(const std::filesystem::path& file, const std::string& remedy);
+// The same with a sweep's advice: "delete it, and the sweep runs that case again".
 std::map<std::string, std::string> readSummaryJson(const std::filesystem::path& file);
 
 // The summary quantities of summary.csv, after name and the varied keys.

@@ -169,7 +169,8 @@ std::string impactsJson(const fs::path& dir) {
 // The summary facts the header shows; an empty map when summary.json is absent (a run that failed).
 std::map<std::string, std::string> readSummary(const fs::path& dir) {
   const fs::path file = dir / "summary.json";
-  return fs::exists(file) ? readSummaryJson(file) : std::map<std::string, std::string>{};
+  return fs::exists(file) ? readSummaryJson(file, "run the scenario again, or delete it and the page shows the run without its summary")
+                          : std::map<std::string, std::string>{};
 }
 
 std::string summaryHtml(const std::map<std::string, std::string>& summary) {

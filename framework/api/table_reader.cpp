@@ -119,22 +119,33 @@ thread_local const std::vector<std::string>* t_overrides = nullptr;
 OverrideScope::OverrideScope(const std::vector<std::string>& assignments) : m_previous(t_overrides) { t_overrides = &assignments; }
 OverrideScope::~OverrideScope() { t_overrides = m_previous; }
 
+std::string overrideNamedIn(const std::string& message, const std::vector<std::string>& assignments) {
+  // The message's own key path, when it starts with one ("broadphase.x: unknown broadphase"): a
+  // --set of a key below it (broadphase.x.skin=1) made the table it is about.
+  const std::string about = message.substr(0, std::min(message.find(':'), message.find(' ')));
+  // The key an "unknown key" message quotes: a --set below it (a.b.c=1, unknown key "a") made it.
+  std::string unknown;
+  if (const size_t at = message.find("unknown key \""); at != std::string::npos) {
+    const size_t from = at + 13, to = message.find('"', from);
+    if (to != std::string::npos) unknown = message.substr(from, to - from);
+  }
+  for (auto a = assignments.rbegin(); a != assignments.rend(); ++a) {
+    const std::string key = a->substr(0, a->find('='));
+    const bool named = message.rfind(key + ":", 0) == 0 || message.rfind(key + "[", 0) == 0 || message.rfind(key + ".", 0) == 0 ||
+                       message.find("\"" + key + "\"") != std::string::npos || message.find("\"" + key + ".") != std::string::npos ||
+                       (!about.empty() && key.rfind(about + ".", 0) == 0) || (!unknown.empty() && key.rfind(unknown + ".", 0) == 0);
+    if (named) return *a;
+  }
+  return "";
+}
+
 InputError TableReader::errorAt(const toml::node& n, const std::string& message) const {
   const auto& src = n.source();
-  // A value from --set (no source): the message starts with its key path ("a.b: ...", "a.b[0]...")
-  // or quotes it ("unknown key \"a.b\""); the last assignment of that key is the one in force.
-  if (!src.path && t_overrides) {
-    // The message's own key path, when it starts with one ("broadphase.x: unknown broadphase"): a
-    // --set of a key below it (broadphase.x.skin=1) made the table it is about.
-    const std::string about = message.substr(0, std::min(message.find(':'), message.find(' ')));
-    for (auto a = t_overrides->rbegin(); a != t_overrides->rend(); ++a) {
-      const std::string key = a->substr(0, a->find('='));
-      const bool named = message.rfind(key + ":", 0) == 0 || message.rfind(key + "[", 0) == 0 || message.rfind(key + ".", 0) == 0 ||
-                         message.find("\"" + key + "\"") != std::string::npos || message.find("\"" + key + ".") != std::string::npos ||
-                         (!about.empty() && key.rfind(about + ".", 0) == 0);
-      if (named) return InputError(fmt::format("--set {}: {}", *a, message));
-    }
-  }
+  // A value from --set (no source): the last assignment of the key the message is about is the
+  // one in force.
+  if (!src.path && t_overrides)
+    if (const std::string set = overrideNamedIn(message, *t_overrides); !set.empty())
+      return InputError(fmt::format("--set {}: {}", set, message));
   return InputError(m_file, static_cast<int>(src.begin.line), static_cast<int>(src.begin.column), message);
 }
 

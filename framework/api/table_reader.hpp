@@ -32,6 +32,12 @@ class OverrideScope {
   const std::vector<std::string>* m_previous;
 };
 
+// The `--set KEY=VALUE` among `assignments` that an error message is about: the last one whose
+// key the message names, starts with (a key path, "a.b: ..."), quotes (unknown key "a.b"), or lies
+// below (unknown key "a" of --set a.b.c=1); "" when none. Errors found after the tables are read
+// (a field generator's "field.size_max: expected >= field.size_min = 50 m") use it too.
+std::string overrideNamedIn(const std::string& message, const std::vector<std::string>& assignments);
+
 // While one is alive on this thread, a TableReader records a bad value or an unknown key and goes
 // on with the key's default, so that one pass over a file reports all of its errors at once, each
 // with its line and column (loadScenario holds one). Without one, the first error throws.

@@ -111,7 +111,12 @@ Scenario load(const RunArguments& a) {
     s.steps = static_cast<long>(*steps);
     s.duration = static_cast<Real>(*steps) * s.dt;
   }
-  if (!a.out.empty()) s.output.dir = fs::absolute(a.out);
+  if (!a.out.empty()) {
+    s.output.dir = fs::absolute(a.out);
+    // Checked here, so that its message names the option (the run folder's lock once said only
+    // "cannot open the run folder's lock" for `--out /proc`).
+    requireOutputFolder(s.output.dir, "gem run --out");
+  }
   return s;
 }
 
@@ -410,7 +415,7 @@ int main(int argc, char** argv) {
       ->add_option("--groups", analyze.groups,
                    "groups to analyse, each by its label (concentration=0.4) or a case's name (121_46); several: repeat "
                    "--groups or separate with ';'")
-      ->delimiter(';');
+      ->check(kName);  // `--groups ''` once meant every group; split on ';' below
   analyzeCommand->add_flag("--quiet", analyze.quiet, "print nothing but errors");
 
   std::string plotDir;
@@ -447,7 +452,7 @@ int main(int argc, char** argv) {
   sweepCommand
       ->add_option("--batch", sweep.batch,
                    "on a GPU, the most cases run together in one device state (default 0: automatic; 1: one case at a time)")
-      ->check(CLI::Range(0, 100000));
+      ->check(CLI::Range(0, 1024));  // a device state holds at most 1024 cases (sweep.cpp, kMostTogether)
   sweepCommand->add_flag("--quiet", sweep.quiet, "no progress");
   sweepCommand->add_option("--set", sweep.set, "override a scenario key in every case: --set simulation.dt=0.05")->take_all();
   sweepCommand->add_option("--backend", sweep.backend, "auto, cpu or cuda, for every case")->check(kName);
@@ -490,7 +495,22 @@ int main(int argc, char** argv) {
     if (*viewCommand && !view.out.empty()) requireOutputFile(view.out, "gem view --out");
     if (*benchCommand) return runBench(bench);
     if (*sweepCommand) return runSweep(sweep);
-    if (*analyzeCommand) return runAnalyze(analyze);
+    if (*analyzeCommand) {
+      // Split here, not by CLI11, which dropped the empty names of 'a;;b' and took 'a;;b' for a;b.
+      std::vector<std::string> groups;
+      for (const std::string& given : analyze.groups)
+        for (size_t at = 0;;) {
+          const size_t end = std::min(given.find(';', at), given.size());
+          if (end == at)
+            throw InputError(
+                fmt::format("--groups {}: an empty group name; name each group, separated by ';'", InputError::shorten(given)));
+          groups.push_back(given.substr(at, end - at));
+          if (end == given.size()) break;
+          at = end + 1;
+        }
+      analyze.groups = groups;
+      return runAnalyze(analyze);
+    }
     if (*plotCommand) return commandPlot(plotDir, plotQuiet);
     if (*movieCommand) {
       movie.out = movieOut;

@@ -167,6 +167,13 @@ IceObject parseObject(pugi::xml_node node, bool firstFrame, const SourceMap& src
   object.index = parseIndex(node, "index", src, "object");
   if (firstFrame) object.place = src.place(node);
   const std::string what = "object " + std::to_string(object.index);
+  // An element GEM reads, given twice, is a hand edit whose intent is unknown: the first was taken
+  // silently (two <coordinates>, a second <thickness>). Other elements stay a reader's to ignore.
+  for (const char* name : {"coordinates", "velocity", "thickness", "removed"}) {
+    const pugi::xml_node first = node.child(name);
+    if (const pugi::xml_node second = first ? first.next_sibling(name) : pugi::xml_node())
+      throw src.error(second, what + ": a second <" + name + ">; an object gives each element once");
+  }
   if (node.attribute("kind")) {
     object.kind = parseKind(node, src, what);
     object.hasKind = true;
@@ -182,6 +189,10 @@ IceObject parseObject(pugi::xml_node node, bool firstFrame, const SourceMap& src
     throw src.error(node, what + " in frame 0 has no <coordinates>");
   }
   if (const pugi::xml_node v = node.child("velocity")) {
+    // Its attributes are x, y and a: another (vx="1", a typo) left the velocity zero, silently.
+    for (const pugi::xml_attribute a : v.attributes())
+      if (std::string_view(a.name()) != "x" && std::string_view(a.name()) != "y" && std::string_view(a.name()) != "a")
+        throw src.error(v, what + ": velocity " + a.name() + "=" + quoted(a.value()) + ": the velocity's attributes are x, y and a");
     // A missing component reads as zero: the thesis files always write all three, others may not.
     const auto component = [&](const char* name) {
       const pugi::xml_attribute a = v.attribute(name);

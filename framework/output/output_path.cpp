@@ -1,6 +1,10 @@
 #include "framework/output/output_path.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <fmt/format.h>
 
@@ -24,6 +28,17 @@ void makeWritableFolder(const fs::path& folder, const std::string& what) {
   fs::create_directories(folder, ec);
   if (ec) throw InputError(fmt::format("{}: cannot make the folder {}: {}", what, folder.string(), ec.message()));
   if (::access(folder.c_str(), W_OK | X_OK) != 0) throw InputError(fmt::format("{}: cannot write in the folder {}", what, folder.string()));
+  // access() answers yes to root for any folder on a writable filesystem, also for one that can
+  // hold no new file (/proc, /sys): a file made and removed again is the only sure test. Without it
+  // `--out /proc` failed later, on the run folder's lock, in words that named no option.
+  const fs::path probe = folder / fmt::format(".gem-probe-{}", ::getpid());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    if (errno == EEXIST) return;  // a probe of this pid left by a killed run: the folder holds files
+    throw InputError(fmt::format("{}: cannot make a file in the folder {}: {}", what, folder.string(), std::strerror(errno)));
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 }  // namespace

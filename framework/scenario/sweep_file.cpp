@@ -89,11 +89,18 @@ std::string sanitize(const std::string& text) {
   return out;
 }
 
-bool validName(const std::string& name) {
-  if (name.empty() || name.size() > 200 || name[0] == '.' || name[0] == '-') return false;
-  return std::all_of(name.begin(), name.end(), [](char c) {
+// What is wrong with a sweep's or a case's name (`what`: "a sweep name"), "" when nothing: each
+// rule its own words (a 300-letter name was refused as if it held a bad character).
+std::string nameProblem(const std::string& name, const std::string& what) {
+  constexpr size_t kMostCharacters = 200;  // a folder's name, with room for the sweep's suffixes
+  if (name.empty()) return what + " is empty";
+  if (name.size() > kMostCharacters)
+    return fmt::format("{} of {} characters; at most {} (it names a folder)", what, name.size(), kMostCharacters);
+  if (name[0] == '.' || name[0] == '-') return what + " may not start with '.' or '-' (it names a folder)";
+  const bool allValid = std::all_of(name.begin(), name.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || std::string_view("._-+=,@#").find(c) != std::string_view::npos;
   });
+  return allValid ? std::string() : what + " may hold letters, digits and . _ - + = , @ # (it names a folder)";
 }
 
 SweepOverride makeOverride(const Leaf& leaf, bool varied) {
@@ -223,7 +230,7 @@ SweepDefinition readSweepFile(const fs::path& file) {
   TableReader top(&root, "", def.fileName);
   TableReader sweep(top.findTable("sweep"), "sweep", def.fileName);
   def.name = sweep.getString("name", def.file.stem().string());
-  if (!validName(def.name)) sweep.fail("name", "a sweep name may hold letters, digits and . _ - + = , @ # (it names a folder)");
+  if (const std::string problem = nameProblem(def.name, "a sweep name"); !problem.empty()) sweep.fail("name", problem);
   fs::path base;
   sweep.accept("base");
   if (sweep.has("base")) base = resolveBase(sweep, "base", sweep.getString("base", ""), folder);
@@ -266,7 +273,7 @@ SweepDefinition readSweepFile(const fs::path& file) {
       e.line = static_cast<int>(t->source().begin.line), e.column = static_cast<int>(t->source().begin.column);
       if (!reader.has("name")) reader.fail("name", "each case needs a name = \"...\"");
       e.name = reader.getString("name", "");
-      if (!validName(e.name)) reader.fail("name", "a case name may hold letters, digits and . _ - + = , @ # (it names a folder)");
+      if (const std::string problem = nameProblem(e.name, "a case name"); !problem.empty()) reader.fail("name", problem);
       reader.accept("base");
       e.base = reader.has("base") ? resolveBase(reader, "base", reader.getString("base", ""), folder) : base;
       if (e.base.empty()) reader.fail("name", "no base scenario: give base = \"...\" here or in [sweep]");

@@ -86,15 +86,26 @@ static void addWalls(const Scenario& s, std::vector<BodySpec>& bodies) {
   }
 }
 
-// The generators report bad specs by key; this adds where the [field] table is.
+// The generators report bad specs by key; this adds where the value came from: the --set that the
+// message names, else the key's line in the file (s.document keeps the places; s.root, a copy, has
+// none, so the message once named the file alone), else the [field] table's.
 static std::vector<BodySpec> generateField(const Scenario& s) {
   try {
     if (s.fieldKind == "random_convex") return generateRandomConvexField(s.randomField);
     return generateHexagonField(s.hexagonField);
   } catch (const InputError& e) {
-    const toml::node* field = s.root.get("field");
-    const auto line = field ? field->source().begin.line : 0, column = field ? field->source().begin.column : 0;
-    throw InputError(s.fileName, static_cast<int>(line), static_cast<int>(column), e.what());
+    const std::string message = e.what();
+    if (const std::string set = overrideNamedIn(message, s.overrides); !set.empty())
+      throw InputError(fmt::format("--set {}: {}", set, message));
+    // A bound set by another key ("field.size_max: expected >= field.size_min = 50 m").
+    for (auto a = s.overrides.rbegin(); a != s.overrides.rend(); ++a)
+      if (message.find(" " + a->substr(0, a->find('=')) + " ") != std::string::npos)
+        throw InputError(fmt::format("--set {}: {}", *a, message));
+    const toml::table& document = s.document ? *s.document : s.root;
+    const toml::node* at = document.at_path(message.substr(0, message.find(':'))).node();
+    if (!at || !at->source().begin) at = document.get("field");
+    const auto line = at ? at->source().begin.line : 0, column = at ? at->source().begin.column : 0;
+    throw InputError(s.fileName, static_cast<int>(line), static_cast<int>(column), message);
   }
 }
 
