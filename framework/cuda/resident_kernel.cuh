@@ -611,7 +611,8 @@ __device__ void secondHalf(const ResidentArgs& a, int w, int contacts, const Ste
 // moved state, the pieces added into the world's spare slots with World::addPiece's rows
 // (bodyMassRow with the portable trigonometry) and new ids, the floe and rubble out of the world's members. A world with more
 // requests than its room stops the launch after this step instead (halt), and leaves the step to
-// the host. Returns nothing; the world's record of the step says what it did.
+// the host. Returns whether it halted so (no re-sort in the kernel then: the host re-sorts after its
+// topology phase); the world's record of the step says what it did.
 template <class Breaking>
 __device__ bool breakFloes(const ResidentArgs& a, int w, int s, int parity, WorldStepRecord& record, BlockShared& sh) {
   const ResidentBreaking& br = a.breaking;
