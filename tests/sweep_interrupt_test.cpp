@@ -58,6 +58,8 @@ set = { "simulation.steps" = 5 }
   const auto stopped = readSummaryJson(out / "cases" / "long" / "summary.json");
   EXPECT_EQ(stopped.at("completed"), "false");
   EXPECT_EQ(stopped.at("stop_reason"), "SIGINT");
+  // No checkpoint in the stopped case: the sweep runs it again from its start (one was left there).
+  EXPECT_FALSE(fs::exists(out / "cases" / "long" / "checkpoint.gem"));
   EXPECT_FALSE(fs::exists(out / "cases" / "never" / "summary.json"));
   for (const auto& entry : fs::recursive_directory_iterator(out))
     EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();

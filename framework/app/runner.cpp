@@ -578,7 +578,7 @@ RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const s
         run.record(stepsRun);
         ++stepsRun;
       }
-      run.saveCheckpoint(wallSeconds());
+      if (options.checkpointOnInterrupt) run.saveCheckpoint(wallSeconds());
     } catch (const std::exception& failed) {
       std::fprintf(stderr, "gem: no checkpoint written: %s\n", failed.what());
     }

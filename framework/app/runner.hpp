@@ -20,6 +20,10 @@ struct RunOptions {
   // refused before any line of a run that never starts. It gets the stepper, whose backend is the
   // one that runs (auto may have fallen back to the cpu).
   std::function<void(Stepper&)> started;
+  // A sweep's case (false): a stopped sweep runs its incomplete cases again from their start, so
+  // Ctrl-C writes no checkpoint.gem into the case's folder (it was left there until the case ran
+  // again whole).
+  bool checkpointOnInterrupt = true;
 };
 
 struct Stats {

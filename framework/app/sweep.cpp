@@ -448,6 +448,7 @@ int runSweep(const SweepOptions& options) {
         const std::string failure = message([&] {
           RunOptions runOptions;
           runOptions.quiet = true;
+          runOptions.checkpointOnInterrupt = false;
           runScenario(prepareCase(unit[0]), runOptions);
         });
         finished(unit[0], failure, std::chrono::duration<double>(std::chrono::steady_clock::now() - unitStart).count(), 1);
@@ -481,6 +482,7 @@ int runSweep(const SweepOptions& options) {
           if (!options.quiet) std::fprintf(stderr, "gem sweep: %s; running those %zu cases one at a time\n", e.what(), unit.size());
           RunOptions runOptions;
           runOptions.quiet = true;
+          runOptions.checkpointOnInterrupt = false;
           for (size_t j = 0; j < unit.size(); ++j) failures[j] = message([&] { runScenario(scenarios[j], runOptions); });
           return;
         } catch (const std::exception&) {
