@@ -101,6 +101,7 @@ std::vector<BadCase> badCases() {
       // 1e-308 m once made walls too thin to be convex, refused naming no key.
       {"walls_too_thin", kSim + kDomain + "walls = true\nwall_thickness = 1e-308\n", {"domain.wall_thickness", "from 0.01"}},
       {"huge_duration", "[simulation]\nduration = 1e300\n", {"simulation.duration", "more than the 2e9"}},
+      {"a_frame_format_twice", kSim + "[output]\nformats = [\"vtk\", \"ice\", \"vtk\"]\n", {"output.formats", "\"vtk\" is listed twice"}},
       {"non_convex_hull",
        kSim + "[vessel]\nvertices = [[-50.0, -10.0], [50.0, -10.0], [0.0, 0.0], [50.0, 10.0], [-50.0, 10.0]]\n"
               "frame_angle_deg = [80.0, 30.0, 30.0, 80.0, 80.0]\n",

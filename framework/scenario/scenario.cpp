@@ -280,6 +280,9 @@ void readOutput(TableReader& t, Scenario& s) {
     for (const toml::node& f : *formats) {
       auto name = f.value_exact<std::string>();
       if (!name || (*name != "vtk" && *name != "ice")) t.failAt(f, "output.formats: valid formats are \"vtk\" and \"ice\"");
+      // Twice would write one set of frames (it was taken as once): say so rather than guess.
+      if (name && std::find(o.formats.begin(), o.formats.end(), *name) != o.formats.end())
+        t.failAt(f, fmt::format("output.formats: \"{}\" is listed twice", *name));
       o.formats.push_back(*name);
     }
   } else {
