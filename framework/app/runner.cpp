@@ -542,7 +542,8 @@ RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const s
       run.record(k);
       stepsRun = k + 1;
       const char* stop = run.stopRuleReached();
-      if (!stop && sim.stateOnHost() && run.checkpointDue(stepsRun, wallSeconds())) run.saveCheckpoint(wallSeconds());
+      if (!stop && options.checkpoints && sim.stateOnHost() && run.checkpointDue(stepsRun, wallSeconds()))
+        run.saveCheckpoint(wallSeconds());
       if (options.progress && !options.quiet) {
         const auto now = std::chrono::steady_clock::now();
         if (now - lastProgress > std::chrono::milliseconds(250) || k + 1 == scenario.steps || stop) {
@@ -578,7 +579,7 @@ RunSummary runSteps(const Scenario& scenario, const RunOptions& options, const s
         run.record(stepsRun);
         ++stepsRun;
       }
-      if (options.checkpointOnInterrupt) run.saveCheckpoint(wallSeconds());
+      if (options.checkpoints) run.saveCheckpoint(wallSeconds());
     } catch (const std::exception& failed) {
       std::fprintf(stderr, "gem: no checkpoint written: %s\n", failed.what());
     }
@@ -695,11 +696,23 @@ std::vector<std::string> runScenariosTogether(const std::vector<const Scenario*>
     try {
       for (; k < steps && !onHost(); ++k) {
         for (size_t i = 0; i < count; ++i) steppers[i]->step();
-        for (size_t i = 0; i < count; ++i)
-          if (running(i)) runs[i]->record(k);
+        for (size_t i = 0; i < count; ++i) {
+          if (!running(i)) continue;
+          try {
+            runs[i]->record(k);
+          } catch (const std::exception& failed) {  // this case's own fault (a state no longer finite)
+            failures[i] = failed.what();
+            runs[i]->abandon();
+          }
+        }
       }
-    } catch (const std::exception&) {
-      // A failure here leaves the cases' summaries to say where they stopped, as below.
+    } catch (const std::exception& failed) {
+      // The shared device state failed: the cases still running fail with it, as below.
+      for (size_t i = 0; i < count; ++i)
+        if (running(i)) {
+          failures[i] = fmt::format("step {} of cases run together on one device: {}", k, failed.what());
+          runs[i]->abandon();
+        }
     }
     for (size_t i = 0; i < count; ++i)
       if (running(i)) finishCase(i, k, stopping[i] ? stopping[i] : signalName(e.signal()), stopping[i] != nullptr);

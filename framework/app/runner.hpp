@@ -21,9 +21,9 @@ struct RunOptions {
   // one that runs (auto may have fallen back to the cpu).
   std::function<void(Stepper&)> started;
   // A sweep's case (false): a stopped sweep runs its incomplete cases again from their start, so
-  // Ctrl-C writes no checkpoint.gem into the case's folder (it was left there until the case ran
-  // again whole).
-  bool checkpointOnInterrupt = true;
+  // the case writes no checkpoint.gem, neither every output.checkpoint_every nor at Ctrl-C (one was
+  // left in its folder until the case ran again whole).
+  bool checkpoints = true;
 };
 
 struct Stats {

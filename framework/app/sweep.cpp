@@ -448,7 +448,7 @@ int runSweep(const SweepOptions& options) {
         const std::string failure = message([&] {
           RunOptions runOptions;
           runOptions.quiet = true;
-          runOptions.checkpointOnInterrupt = false;
+          runOptions.checkpoints = false;
           runScenario(prepareCase(unit[0]), runOptions);
         });
         finished(unit[0], failure, std::chrono::duration<double>(std::chrono::steady_clock::now() - unitStart).count(), 1);
@@ -482,7 +482,7 @@ int runSweep(const SweepOptions& options) {
           if (!options.quiet) std::fprintf(stderr, "gem sweep: %s; running those %zu cases one at a time\n", e.what(), unit.size());
           RunOptions runOptions;
           runOptions.quiet = true;
-          runOptions.checkpointOnInterrupt = false;
+          runOptions.checkpoints = false;
           for (size_t j = 0; j < unit.size(); ++j) failures[j] = message([&] { runScenario(scenarios[j], runOptions); });
           return;
         } catch (const std::exception&) {
