@@ -34,8 +34,9 @@ void makeWritableFolder(const fs::path& folder, const std::string& what) {
   const fs::path probe = folder / fmt::format(".gem-probe-{}", ::getpid());
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) {
-    if (errno == EEXIST) return;  // a probe of this pid left by a killed run: the folder holds files
-    throw InputError(fmt::format("{}: cannot make a file in the folder {}: {}", what, folder.string(), std::strerror(errno)));
+    const int error = errno;      // before anything else can change it
+    if (error == EEXIST) return;  // a probe of this pid left by a killed run: the folder holds files
+    throw InputError(fmt::format("{}: cannot make a file in the folder {}: {}", what, folder.string(), std::strerror(error)));
   }
   ::close(fd);
   ::unlink(probe.c_str());

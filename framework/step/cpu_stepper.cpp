@@ -8,6 +8,7 @@
 #include <optional>
 #include <cmath>
 #include <map>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -98,9 +99,18 @@ static std::vector<BodySpec> generateField(const Scenario& s) {
     if (const std::string set = overrideNamedIn(message, s.overrides); !set.empty())
       throw InputError(fmt::format("--set {}: {}", set, message));
     // A bound set by another key ("field.size_max: expected >= field.size_min = 50 m").
+    // The key as a whole word of the message ("... >= field.size_min = 50 m", "[field.size_min, ...]").
+    const auto namesKey = [&message](const std::string& key) {
+      for (size_t at = message.find(key); at != std::string::npos; at = message.find(key, at + 1)) {
+        const char before = at ? message[at - 1] : ' ', after = at + key.size() < message.size() ? message[at + key.size()] : ' ';
+        if (std::string_view(" [(,").find(before) != std::string_view::npos &&
+            std::string_view(" ],)=:").find(after) != std::string_view::npos)
+          return true;
+      }
+      return false;
+    };
     for (auto a = s.overrides.rbegin(); a != s.overrides.rend(); ++a)
-      if (message.find(" " + a->substr(0, a->find('=')) + " ") != std::string::npos)
-        throw InputError(fmt::format("--set {}: {}", *a, message));
+      if (namesKey(a->substr(0, a->find('=')))) throw InputError(fmt::format("--set {}: {}", *a, message));
     const toml::table& document = s.document ? *s.document : s.root;
     const toml::node* at = document.at_path(message.substr(0, message.find(':'))).node();
     if (!at || !at->source().begin) at = document.get("field");
