@@ -115,13 +115,8 @@ Scenario load(const RunArguments& a) {
     s.output.dir = fs::absolute(a.out);
     // Checked here, so that its message names the option (the run folder's lock once said only
     // "cannot open the run folder's lock" for `--out /proc`), but without making the folder: a run
-    // refused for its input leaves nothing behind. A folder that exists is tried with a file; a
-    // path through a file is refused before anything is made.
-    std::error_code ec;
-    bool throughFile = false;
-    for (fs::path p = s.output.dir; !p.empty() && p != p.root_path(); p = p.parent_path())
-      throughFile = throughFile || (fs::exists(p, ec) && !fs::is_directory(p, ec));
-    if (throughFile || fs::exists(s.output.dir, ec)) requireOutputFolder(s.output.dir, "gem run --out");
+    // refused for its input leaves nothing behind.
+    requireOutputFolderIfThere(s.output.dir, "gem run --out");
   }
   return s;
 }

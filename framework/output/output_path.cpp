@@ -15,8 +15,8 @@ namespace fs = std::filesystem;
 namespace gem {
 namespace {
 
-// `folder` made and writable, for `what` ("gem sweep --out runs/x"), which it holds or is.
-void makeWritableFolder(const fs::path& folder, const std::string& what) {
+// No file and no dangling link on the way to `folder`, for `what`: the folder could not be made.
+void refuseBlockedPath(const fs::path& folder, const std::string& what) {
   std::error_code ec;
   for (fs::path p = folder; !p.empty() && p != p.root_path(); p = p.parent_path())
     if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw InputError(fmt::format("{}: {} is a file, not a folder", what, p.string()));
@@ -25,6 +25,12 @@ void makeWritableFolder(const fs::path& folder, const std::string& what) {
     if (fs::is_symlink(fs::symlink_status(p, ec)) && !fs::exists(p, ec))
       throw InputError(
           fmt::format("{}: {} is a symbolic link to {}, which does not exist", what, p.string(), fs::read_symlink(p, ec).string()));
+}
+
+// `folder` made and writable, for `what` ("gem sweep --out runs/x"), which it holds or is.
+void makeWritableFolder(const fs::path& folder, const std::string& what) {
+  refuseBlockedPath(folder, what);
+  std::error_code ec;
   fs::create_directories(folder, ec);
   if (ec) throw InputError(fmt::format("{}: cannot make the folder {}: {}", what, folder.string(), ec.message()));
   if (::access(folder.c_str(), W_OK | X_OK) != 0) throw InputError(fmt::format("{}: cannot write in the folder {}", what, folder.string()));
@@ -45,6 +51,12 @@ void makeWritableFolder(const fs::path& folder, const std::string& what) {
 }  // namespace
 
 void requireOutputFolder(const fs::path& dir, const std::string& option) { makeWritableFolder(dir, option + " " + dir.string()); }
+
+void requireOutputFolderIfThere(const fs::path& dir, const std::string& option) {
+  refuseBlockedPath(dir, option + " " + dir.string());
+  std::error_code ec;
+  if (fs::exists(dir, ec)) makeWritableFolder(dir, option + " " + dir.string());
+}
 
 void requireOutputFile(const fs::path& file, const std::string& option) {
   const std::string what = option + " " + file.string();

@@ -12,6 +12,11 @@ namespace gem {
 // from ("gem sweep --out"). InputError otherwise.
 void requireOutputFolder(const std::filesystem::path& dir, const std::string& option);
 
+// As requireOutputFolder, but nothing is made: a path through a file is refused, and a folder that
+// exists already is checked whole; one that does not is left to be made by the run (gem run checks
+// --out while it loads, and a run refused for its input leaves no folder behind).
+void requireOutputFolderIfThere(const std::filesystem::path& dir, const std::string& option);
+
 // `file` can be written: its folder is made as requireOutputFolder does, and it is not a folder.
 void requireOutputFile(const std::filesystem::path& file, const std::string& option);
 
