@@ -171,3 +171,141 @@ TEST(HostileCli, AFieldGeneratorsErrorNamesTheSetOrTheLine) {
   text = refused(dir, "check " + scenario.string() + " --set bogus.b.c=1");
   EXPECT_TRUE(holds(text, "--set bogus.b.c=1: unknown key \"bogus\"")) << text;
 }
+
+// The hostile audit of 2026-12-04's open classes, closed afterwards.
+
+// A vessel the [domain] says can never reach the field (`vessel.position = [1e6, 0]` beside x = [0,
+// 500]) was taken. The vessel sails forward along its heading (a 3-DOF one along the autopilot's set
+// heading), so that line must come within the hull's reach of the domain, and with walls the vessel
+// starts between them. Refused by gem run and gem check alike, naming the file, the key's line and
+// column, the value and the domain; the legitimate starts are still taken.
+TEST(HostileCli, AVesselThatCanNeverReachTheDomainIsRefused) {
+  TempDir dir;
+  const std::string head = "[simulation]\ndt = 0.1\nsteps = 3\n[domain]\nx = [0.0, 500.0]\ny = [-100.0, 100.0]\n";
+  const std::string out = " --quiet --no-plots --out " + (dir.path() / "run").string();
+  const struct {
+    std::string vessel, expected;
+  } refusedCases[] = {
+      {"position = [1e6, 0.0]", "vessel.position: [1000000, 0], sailing at heading 0 deg"},        // past the field
+      {"position = [-300.0, 0.0]\nheading_deg = 180.0", "[-300, 0], sailing at heading 180 deg"},  // facing away
+      {"position = [100.0, 400.0]", "[100, 400], sailing at heading 0 deg"},                       // beside it
+      {"position = [-60.0, 0.0]\nheading_deg = 90.0", "[-60, 0], sailing at heading 90 deg"},      // across, before it
+      {"position = [1e6, 0.0]\ndof = 3\n[events.autopilot]\nheading_deg = 90.0", "heading 0 deg or the autopilot's 90 deg"},
+  };
+  for (const auto& c : refusedCases) {
+    const auto scenario = dir.write("case.toml", head + "[vessel]\n" + c.vessel + "\n");
+    for (const std::string command : {"run ", "check "}) {
+      const std::string text = refused(dir, command + scenario.string() + (command == "run " ? out : ""));
+      EXPECT_TRUE(holds(text, scenario.string() + ":8:12: vessel.position: ")) << text;
+      EXPECT_TRUE(holds(text, c.expected)) << text;
+      EXPECT_TRUE(holds(text, "[domain] x = [0, 500], y = [-100, 100]")) << text;
+      EXPECT_TRUE(holds(text, "can never reach the field")) << text;
+      EXPECT_FALSE(std::filesystem::exists(dir.path() / "run" / "summary.json")) << text;
+    }
+  }
+  // With walls the vessel cannot cross one: outside the channel it is refused, even heading along it.
+  auto scenario = dir.write("case.toml", head + "walls = true\n[vessel]\nposition = [-60.0, 140.0]\n");
+  std::string text = refused(dir, "check " + scenario.string());
+  EXPECT_TRUE(holds(text, "case.toml:9:12: vessel.position: [-60, 140] lies outside the channel between the walls")) << text;
+  // A --set that moves it is named, and so is a sweep's case.
+  scenario = dir.write("case.toml", head + "[vessel]\n");
+  text = refused(dir, "check " + scenario.string() + " --set 'vessel.position=[2e3, 0.0]'");
+  EXPECT_TRUE(holds(text, "--set vessel.position=[2e3, 0.0]: vessel.position: [2000, 0]")) << text;
+  const auto sweep =
+      dir.write("study.toml", "[sweep]\nbase = \"case.toml\"\n[parameters]\n\"vessel.position\" = [[-60.0, 0.0], [2e3, 0.0]]\n");
+  text = refused(dir, "check " + sweep.string(), false);
+  EXPECT_TRUE(holds(text, "study.toml:4:")) << text;
+  EXPECT_TRUE(holds(text, "case 1")) << text;
+  EXPECT_TRUE(holds(text, "[2000, 0], sailing at heading 0 deg")) << text;
+
+  // Taken: before the field facing it (the thesis's start), in it, past it facing back, a 3-DOF
+  // vessel whose autopilot turns it towards the field, no [domain] at all, and explicit floes
+  // outside the domain (it bounds the generated field and the statistics, not the bodies).
+  const std::string takenCases[] = {
+      head + "[vessel]\n",
+      head + "[vessel]\nposition = [250.0, 50.0]\nheading_deg = 135.0\n",
+      head + "[vessel]\nposition = [1e6, 0.0]\nheading_deg = 180.0\n",
+      head + "[vessel]\nposition = [-60.0, 0.0]\nheading_deg = 180.0\ndof = 3\n[events.autopilot]\nheading_deg = 0.0\n",
+      head + "walls = true\n[vessel]\nposition = [-60.0, 90.0]\nbeam = 10.0\n",
+      "[simulation]\ndt = 0.1\nsteps = 3\n[vessel]\nposition = [1e6, 0.0]\n",
+      head + "[vessel]\n[[floes]]\nvertices = [[1e4, 1e4], [1.001e4, 1e4], [1.001e4, 1.001e4]]\n",
+  };
+  for (const std::string& toml : takenCases) {
+    scenario = dir.write("case.toml", toml);
+    EXPECT_EQ(gem::test::runGem("check --quiet " + scenario.string(), dir.path() / "log.txt"), 0)
+        << toml << gem::test::readFile(dir.path() / "log.txt");
+  }
+}
+
+// A .ice file holding more than its one document: a second root element after </iceFloeSim> (two
+// files joined), text, CDATA, a second XML declaration or a doctype after it, or text before it,
+// was taken (pugixml reads the first root and drops the rest, or keeps a second root beside it).
+// Each is refused naming the file and the line and column where it starts; comments and processing
+// instructions around the root are still taken, and a missing root or one of another name is refused.
+TEST(HostileCli, AnIceFileWithContentOutsideItsRootIsRefused) {
+  TempDir dir;
+  const auto scenario = dir.write("s.toml", "[simulation]\ndt = 0.1\nsteps = 3\n[field]\nkind = \"file\"\nfile = \"f.ice\"\n");
+  const std::string document =
+      "<?xml version=\"1.0\"?>\n<iceFloeSim numFrames=\"1\"><frame index=\"0\">\n<object index=\"4\"><coordinates>80 0 82 0 82 2 80 2"
+      "</coordinates><thickness>0.5</thickness></object></frame></iceFloeSim>\n";
+  const struct {
+    std::string before, after, place, expected;
+  } cases[] = {
+      {"", document, ":4:1:", "an XML declaration <?xml ...?> after the root element </iceFloeSim>"},  // two files joined
+      {"", "<iceFloeSim/>\n", ":4:1:", "a second root element <iceFloeSim> after the root element </iceFloeSim>"},
+      {"", "\n  <extra/>\n", ":5:3:", "a second root element <extra>"},
+      {"", "junk\n", ":4:1:", "text 'junk' after the root element"},
+      {"", "<!-- fine -->\n<![CDATA[x]]>\n", ":5:1:", "a CDATA section 'x' after the root element"},
+      {"", "<!DOCTYPE iceFloeSim>\n", ":4:1:", "a <!DOCTYPE> after the root element"},
+      {"lead\n", "", ":1:1:", "text 'lead' before the root element <iceFloeSim>"},
+  };
+  for (const auto& c : cases) {
+    const auto ice = dir.write("f.ice", c.before + document + c.after);
+    for (const std::string command : {"check ", "run "}) {
+      const std::string text =
+          refused(dir, command + scenario.string() + (command == "run " ? " --quiet --out " + (dir.path() / "run").string() : ""));
+      EXPECT_TRUE(holds(text, ice.string() + c.place + " " + c.expected)) << text;
+    }
+  }
+  // No root, or a root of another name.
+  for (const std::string& text : {std::string(""), std::string("<!-- nothing -->\n"), std::string("<?xml version=\"1.0\"?>\n")}) {
+    dir.write("f.ice", text);
+    EXPECT_TRUE(holds(refused(dir, "check " + scenario.string()), "expected the root element <iceFloeSim>, found no element")) << text;
+  }
+  dir.write("f.ice", "<floes><frame index=\"0\"/></floes>\n");
+  EXPECT_TRUE(holds(refused(dir, "check " + scenario.string()), "expected the root element <iceFloeSim>, found <floes>"));
+  // Comments and processing instructions may stand around the root, as XML allows.
+  dir.write("f.ice", "<!-- a -->\n" + document + "<!-- written by hand -->\n<?editor saved?>\n\n");
+  EXPECT_EQ(gem::test::runGem("check --quiet " + scenario.string(), dir.path() / "log.txt"), 0)
+      << gem::test::readFile(dir.path() / "log.txt");
+}
+
+// `--set simulation={dt=1}` replaced the whole [simulation] table (TOML's meaning of an inline
+// table), dropping its other keys silently: here steps = 5 went, and the run took 600 s of steps. A
+// table value now merges into the table there, key by key (as a sweep's set table does); an array,
+// or any other value, still replaces the key's value whole.
+TEST(HostileCli, ASetOfATableMergesIntoTheTableThere) {
+  TempDir dir;
+  const auto scenario = dir.write("s.toml",
+                                  "[simulation]\ndt = 0.1\nsteps = 5\nseed = 7\n[events.drag]\ncd = 0.2\n[events.wind]\nforce = 1.0\n"
+                                  "[[floes]]\nvertices = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]\n[output]\nframe_every = 0\n");
+  const auto run = dir.path() / "run";
+  const auto log = dir.path() / "log.txt";
+  ASSERT_EQ(gem::test::runGem("run " + scenario.string() +
+                                  " --quiet --no-plots --set 'simulation={dt=0.2}' --set 'events={drag={linear=0.5}}' --set "
+                                  "'floes=[{vertices=[[5.0, 0.0], [7.0, 0.0], [7.0, 2.0]]}]' --out " +
+                                  run.string(),
+                              log),
+            0)
+      << gem::test::readFile(log);
+  const std::string recorded = gem::test::readFile(run / "scenario.toml");
+  for (const char* kept : {"steps = 5", "seed = 7", "dt = 0.2", "cd = 0.2", "linear = 0.5", "force = 1.0", "[ 5.0, 0.0 ]"})
+    EXPECT_TRUE(holds(recorded, kept)) << kept << " in\n" << recorded;
+  EXPECT_FALSE(holds(recorded, "[ 2.0, 2.0 ]")) << "the array is replaced whole:\n" << recorded;
+  EXPECT_TRUE(holds(gem::test::readFile(run / "summary.json"), "\"steps\": 5")) << gem::test::readFile(run / "summary.json");
+  // A bad key or value inside the table is blamed on the --set.
+  std::string text = refused(dir, "check " + scenario.string() + " --set 'simulation={dtt=1}'");
+  EXPECT_TRUE(holds(text, "--set simulation={dtt=1}: unknown key \"simulation.dtt\"")) << text;
+  text = refused(dir, "check " + scenario.string() + " --set 'simulation={dt=1e9}'");
+  EXPECT_TRUE(holds(text, "--set simulation={dt=1e9}: simulation.dt: must be from 1e-06 to 3600")) << text;
+}

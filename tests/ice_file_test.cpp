@@ -318,6 +318,12 @@ TEST(IceFile, ErrorsNameFileLineAndProblem) {
        1, "numFrames=2 but the file holds 1 frames"},
       {"duplicate frame", "<iceFloeSim>\n<frame index=\"0\"/>\n<frame index=\"0\"/>\n</iceFloeSim>\n", 3, "duplicate frame index 0"},
       {"removed in frame 0", object0(std::string(kGood) + "<removed/>\n"), 6, "frame 0"},
+      // One document: nothing but comments and processing instructions outside the root element.
+      {"second root", object0(kGood) + "<iceFloeSim>\n<frame index=\"0\"/>\n</iceFloeSim>\n", 9, "a second root element <iceFloeSim>"},
+      {"second document", object0(kGood) + "<?xml version=\"1.0\"?>\n" + object0(kGood), 9, "an XML declaration"},
+      {"text after the root", object0(kGood) + "<!-- c -->\n  trailing words\n", 10, "text 'trailing words' after the root"},
+      {"text before the root", "stray\n" + object0(kGood), 1, "text 'stray' before the root"},
+      {"no root", "<!-- only a comment -->\n", 1, "found no element"},
   };
   TempDir dir;
   for (const BadCase& c : cases) {

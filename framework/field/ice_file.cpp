@@ -215,6 +215,50 @@ IceObject parseObject(pugi::xml_node node, bool firstFrame, const SourceMap& src
   return object;
 }
 
+// One document: the root element, with only comments and processing instructions around it (and
+// an XML declaration and a doctype before it). Anything else outside the root (a second root
+// element, a second document's declaration, text, CDATA) is refused where it starts: it was taken
+// silently, the first root read and the rest dropped.
+void requireOneDocument(const pugi::xml_document& doc, pugi::xml_node root, const SourceMap& src, const std::string& content) {
+  bool afterRoot = false;
+  for (const pugi::xml_node n : doc.children()) {
+    // Where the node starts: pugixml points into it (an element's name, a text's first byte).
+    std::ptrdiff_t at = std::max<std::ptrdiff_t>(n.offset_debug(), 0);
+    if (n.type() == pugi::node_pcdata) {
+      while (at < std::ssize(content) && isXmlSpace(content[static_cast<size_t>(at)])) ++at;
+    } else {
+      while (at > 0 && content[static_cast<size_t>(at)] != '<') --at;
+    }
+    const std::string where = afterRoot ? "after the root element </" + std::string(root.name()) + ">"
+                                        : "before the root element <" + std::string(root.name()) + ">";
+    switch (n.type()) {
+      case pugi::node_element:
+        if (n == root) {
+          afterRoot = true;
+          break;
+        }
+        throw src.error(at, "a second root element <" + std::string(n.name()) + "> " + where +
+                                ": a .ice file holds one <iceFloeSim> (two files joined together?)");
+      case pugi::node_declaration:
+        if (n == doc.first_child()) break;
+        throw src.error(at,
+                        "an XML declaration <?xml ...?> " + where + ": it may only open the file (a second document joined to the first?)");
+      case pugi::node_doctype:
+        if (!afterRoot) break;
+        throw src.error(at, "a <!DOCTYPE> " + where + ": it may only come before the root");
+      case pugi::node_pcdata:
+      case pugi::node_cdata: {
+        const std::string_view text = trim(n.value());
+        throw src.error(at, std::string(n.type() == pugi::node_cdata ? "a CDATA section " : "text ") + quoted(text.substr(0, 40)) +
+                                (text.size() > 40 ? "..." : "") + " " + where +
+                                ": only comments and processing instructions may stand outside the root element");
+      }
+      default:  // comments and processing instructions may stand anywhere (XML 1.0, Misc)
+        break;
+    }
+  }
+}
+
 std::string readWholeFile(const std::filesystem::path& path) {
   requireRegularFile(path, ".ice file");
   requireFitsInMemory(path, 4);  // the text, and pugixml's tree of it
@@ -247,16 +291,20 @@ std::vector<IceFrame> parseIceFile(const std::filesystem::path& path, bool frame
 
   pugi::xml_document doc;
   // No end-of-line normalisation: it would shift text offsets of Windows files and so the columns.
-  const unsigned flags = pugi::parse_default & ~pugi::parse_eol;
+  // pugixml takes a second root element, and drops text, a doctype or an XML declaration outside
+  // the root without a word: the fragment, declaration and doctype flags keep them as nodes, so
+  // that requireOneDocument below can refuse them.
+  const unsigned flags = (pugi::parse_default & ~pugi::parse_eol) | pugi::parse_fragment | pugi::parse_declaration | pugi::parse_doctype;
   const pugi::xml_parse_result parsed = doc.load_buffer(content.data(), content.size(), flags);
   if (!parsed) throw src.error(parsed.offset, std::string("malformed XML: ") + parsed.description());
 
-  const pugi::xml_node root = doc.document_element();
+  const pugi::xml_node root = doc.document_element();  // the first element
   std::string rootName = root ? root.name() : "";
   std::string lower = rootName;
   std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
   if (lower != "icefloesim")
     throw src.error(root, "expected the root element <iceFloeSim>, found " + (root ? "<" + rootName + ">" : std::string("no element")));
+  requireOneDocument(doc, root, src, content);
 
   std::vector<IceFrame> frames;
   std::unordered_set<std::int64_t> seenFrames;

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -22,7 +23,22 @@ namespace gem {
 
 namespace {
 
+// A table value given to a table merges into it, key by key and table by table below, as dotted
+// --set's would: `--set simulation={dt=1}` sets simulation.dt and keeps the table's other keys
+// (TOML's own meaning, the whole table replaced, dropped them silently). Any other value, an
+// array included, replaces what is there.
+void mergeValue(toml::table& into, std::string_view key, const toml::node& value) {
+  toml::node* there = into.get(key);
+  const toml::table* given = value.as_table();
+  if (!given || !there || !there->is_table()) {
+    into.insert_or_assign(key, value);
+    return;
+  }
+  for (const auto& [k, v] : *given) mergeValue(*there->as_table(), k.str(), v);
+}
+
 // "a.b.c=VALUE": VALUE in TOML syntax (1.5, true, "x", [1, 2]); a bare word is taken as a string.
+// An inline table ({dt = 1}) merges into the table already there (mergeValue).
 void applyOverride(toml::table& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
@@ -56,7 +72,7 @@ void applyOverride(toml::table& root, const std::string& assignment) {
     if (!next->is_table()) throw InputError(fmt::format("--set {}: {} is not a table", assignment, parts[i]));
     table = next->as_table();
   }
-  table->insert_or_assign(parts.back(), *parsed.get("value"));
+  mergeValue(*table, parts.back(), *parsed.get("value"));
 }
 
 // The largest |coordinate| of a domain's edge, m: far past any ice field (10,000 km), and small enough
@@ -237,6 +253,73 @@ void readVessel(TableReader& t, Scenario& s) {
     t.fail("frame_angle_deg", "only with vertices = [...] (the default hull has its own)");
   }
   t.finish();
+}
+
+// Whether the ray from p along the unit vector d (t >= 0) meets the rectangle [lo, hi].
+bool rayMeetsBox(Vec2 p, Vec2 d, Vec2 lo, Vec2 hi) {
+  double near = 0, far = std::numeric_limits<double>::infinity();
+  const double from[2] = {p.x, p.y}, along[2] = {d.x, d.y}, low[2] = {lo.x, lo.y}, high[2] = {hi.x, hi.y};
+  for (int axis = 0; axis < 2; ++axis) {
+    if (std::fabs(along[axis]) < 1e-12) {  // along the other axis (cos 90 deg is 6e-17, not 0)
+      if (from[axis] < low[axis] || from[axis] > high[axis]) return false;
+      continue;
+    }
+    double a = (low[axis] - from[axis]) / along[axis], b = (high[axis] - from[axis]) / along[axis];
+    if (a > b) std::swap(a, b);
+    near = std::max(near, a), far = std::min(far, b);
+    if (near > far) return false;
+  }
+  return true;
+}
+
+// A vessel the [domain] says can never reach the field (docs/scenario.md 2.5, `position`): the
+// vessel sails forward along its heading (a 3-DOF vessel along the autopilot's set track, through
+// its start along the set heading), so the line it sails from `position` must come within the
+// hull's reach of the domain's rectangle; with walls it starts between them, since it cannot cross
+// one. The domain's ends are open: a vessel before the field, facing it, is the usual start. With
+// no [domain] nothing is checked (the field is then where the floes are). Explicit floes and a
+// .ice field's objects may lie anywhere: the domain bounds the generated field and the statistics,
+// not the bodies, and floes leave it through its open ends in any run.
+void checkVesselCanReachDomain(Scenario& s) {
+  const VesselSpec& v = s.vessel;
+  if (!v.present || !s.hasDomain) return;
+  // An error already reported about one of these keys took the key's default: what follows from
+  // that default is no new error.
+  if (const ErrorCollector* errors = ErrorCollector::active())
+    for (const char* key : {"vessel.position", "vessel.heading_deg", "vessel.dof", "vessel.length", "vessel.beam", "vessel.vertices"})
+      if (errors->followsFrom(fmt::format(" {}:", key))) return;
+  TableReader t(s.root["vessel"].as_table(), "vessel", s.fileName);
+  const Domain& d = s.domain;
+  const std::string domain = fmt::format("[domain] x = [{}, {}], y = [{}, {}]", d.x0, d.x1, d.y0, d.y1);
+  const std::string value = fmt::format("[{}, {}]", v.position.x, v.position.y);
+  if (s.walls && !(v.position.y >= d.y0 && v.position.y <= d.y1))
+    return t.report("position", fmt::format("{} lies outside the channel between the walls of the {}: the vessel can never reach "
+                                            "the field; start it between y = {} and y = {}",
+                                            value, domain, d.y0, d.y1));
+  // The hull's reach from its centroid (its farthest vertex, m), as the stop rule vessel_left_field
+  // takes it; a hull of no area (refused when the world is built) takes its span instead.
+  Real reach = 0, span = 0;
+  const HullGeometry hull = hullGeometry(v);
+  for (const Vec2& a : hull.vertices) {
+    reach = std::max(reach, norm(a));
+    for (const Vec2& b : hull.vertices) span = std::max(span, norm(a - b));
+  }
+  if (!(std::isfinite(reach) && reach > 0)) reach = span;
+  const Vec2 lo{d.x0 - reach, d.y0 - reach}, hi{d.x1 + reach, d.y1 + reach};
+  std::vector<Real> headings{v.headingDeg};
+  // A 3-DOF vessel turns to the autopilot's set heading (its event checks the value later).
+  if (v.dof == 3)
+    if (const auto set = s.root["events"]["autopilot"]["heading_deg"].value<double>(); set && std::fabs(*set) <= 360)
+      headings.push_back(static_cast<Real>(*set));
+  for (const Real h : headings)
+    if (rayMeetsBox(v.position, Vec2{std::cos(h * kPi / 180), std::sin(h * kPi / 180)}, lo, hi)) return;
+  const std::string course = headings.size() == 1 || headings[0] == headings[1]
+                                 ? fmt::format("heading {} deg", v.headingDeg)
+                                 : fmt::format("heading {} deg or the autopilot's {} deg", headings[0], headings[1]);
+  t.report("position",
+           fmt::format("{}, sailing at {}, never comes within the hull's reach ({:.3g} m from its centroid) of the {}: the vessel "
+                       "can never reach the field; place it before the field, facing it",
+                       value, course, reach, domain));
 }
 
 // output.checkpoint_every: a whole number of steps (1000), or a wall-clock interval as a string
@@ -522,6 +605,7 @@ void readScenarioTables(Scenario& s) {
   if (s.stopWhen != "duration" && !s.vessel.present)
     TableReader(top.findTable("simulation"), "simulation", s.fileName)
         .fail("stop_when", fmt::format("stop_when = \"{}\" follows the vessel, and this scenario has no [vessel]", s.stopWhen));
+  checkVesselCanReachDomain(s);
   if (s.fieldKind != "none" && s.fieldKind != "file" && !s.hasDomain)
     throw InputError(fmt::format("{}: a generated [field] needs a [domain] with x = [x0, x1] and y = [y0, y1]", s.fileName));
   // The field was read before [domain] may have been: bind the generators to the final domain.
