@@ -18,7 +18,9 @@ std::string refused(const TempDir& dir, const std::string& arguments, bool oneLi
   const auto log = dir.path() / "log.txt";
   EXPECT_EQ(gem::test::runGem(arguments, log), 2) << arguments << ": " << gem::test::readFile(log);
   const std::string text = gem::test::readFile(log);
-  if (oneLine) EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
+  if (oneLine) {
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << "one message: " << text;
+  }
   return text;
 }
 
