@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Issue "Trust" item 5, 2026-12-04 evening: does the memcheck report of the graph path on a shared
 # GPU go away when no device or pinned address is ever handed out twice in the process
-# (GEM_CUDA_KEEP_FREED=1, framework/api/cuda_check.hpp)? A public report against another CUDA
+# (GEM_CUDA_KEEP_FREED=1: an experiment-only patch to framework/api/cuda_check.hpp, not on main;
+# README.md says what it did)? A public report against another CUDA
 # project's WHILE-loop graphs has compute-sanitizer fault on memory allocated shortly before the
 # capture. Run in the folder scripts/stage-gpu.sh stages, with memcheck-loop.sh copied beside it.
 #   CONTROL=N   runs of the default (one at a time, beside an unsanitized loop of the test)
