@@ -375,73 +375,106 @@ TEST(PluginBroadphase, PairsInAnyOrderGiveTheBuiltInsTrajectoriesBitForBit) {
   EXPECT_EQ(reference, scrambled);
 }
 
-// The SDK from the build, as a user does it: install, build each example out of tree, run it.
-TEST(PluginSdk, InstallBuildEachExampleOutOfTreeRunItAndSeeItInGemInfo) {
-  TempDir dir;
-  const fs::path prefix = dir.path() / "prefix", log = dir.path() / "log.txt";
-  const std::string cmake = std::string("\"") + GEM_CMAKE_COMMAND + "\"";
-  ASSERT_EQ(run(cmake + " --install " GEM_BINARY_DIR " --prefix " + prefix.string(), log), 0) << readFile(log);
-  const std::string gem = (prefix / "bin" / "gem").string();
-  // The installed gem runs gem bench from its own share/gem/scenarios, not the source tree.
-  ASSERT_EQ(run(gem + " bench --backend cpu --cases 456 --steps 3", log), 0) << readFile(log);
-  EXPECT_NE(readFile(log).find("scenes from " + fs::weakly_canonical(prefix / "share" / "gem" / "scenarios").string()), std::string::npos)
-      << readFile(log);
-  ASSERT_TRUE(fs::exists(prefix / "lib" / "cmake" / "gem" / "gemConfig.cmake"));
-  ASSERT_TRUE(fs::exists(prefix / "include" / "gem" / "framework" / "plugin_api.hpp"));
+// The SDK from the build, as a user does it: install, build each example out of tree, run it. One
+// test per example, so that each stays under a minute in the sanitizer pass (each builds its own).
 
-  std::string makeProgram = GEM_MAKE_PROGRAM;
-  const std::string configure =
-      cmake + " -G \"" GEM_CMAKE_GENERATOR "\"" + (makeProgram.empty() ? "" : " -DCMAKE_MAKE_PROGRAM=\"" + makeProgram + "\"") +
-      " -DCMAKE_CXX_COMPILER=\"" GEM_CXX_COMPILER "\" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=" + prefix.string();
-  for (const std::string name : {"shear_current", "rafting_onset", "sweep_and_prune"}) {
-    SCOPED_TRACE(name);
-    const fs::path build = dir.path() / name;
-    ASSERT_EQ(run(configure + " -S " GEM_SOURCE_DIR "/plugins/" + name + " -B " + build.string(), log), 0) << readFile(log);
-    ASSERT_EQ(run(cmake + " --build " + build.string(), log), 0) << readFile(log);
-    const fs::path library = build / ("lib" + name + ".so");
-    ASSERT_TRUE(fs::exists(library));
+namespace {
 
-    // gem info --plugin and GEM_PLUGIN_PATH both list it with its path and version.
-    ASSERT_EQ(run(gem + " info --plugin " + library.string(), log), 0) << readFile(log);
-    EXPECT_TRUE(contains(readFile(log), "from " + fs::canonical(library).string() + " (" + name + " 1.0.0)")) << readFile(log);
-    ASSERT_EQ(run("GEM_PLUGIN_PATH=" + build.string() + " " + gem + " info", log), 0) << readFile(log);
-    EXPECT_TRUE(contains(readFile(log), fs::canonical(library).string())) << readFile(log);
-
-    const fs::path out = dir.path() / ("run_" + name);
-    ASSERT_EQ(run(gem + " run " + (build / "scenario.toml").string() + " --quiet --out " + out.string(), log), 0) << readFile(log);
-    ASSERT_TRUE(fs::exists(out / "summary.json"));
+// GEM installed to DIR/prefix by `cmake --install` of the build; `gem` is the installed binary.
+struct InstalledGem {
+  fs::path prefix, gem, log;
+  std::string cmake;
+  explicit InstalledGem(const TempDir& dir)
+      : prefix(dir.path() / "prefix"),
+        gem(prefix / "bin" / "gem"),
+        log(dir.path() / "log.txt"),
+        cmake(std::string("\"") + GEM_CMAKE_COMMAND + "\"") {}
+  // Returns the install's exit status (its output in log).
+  int install() const { return run(cmake + " --install " GEM_BINARY_DIR " --prefix " + prefix.string(), log); }
+  // Configures and builds the example plugins/NAME out of tree against the install, in DIR/NAME.
+  int buildExample(const std::string& name, const fs::path& build) const {
+    const std::string makeProgram = GEM_MAKE_PROGRAM;
+    const std::string configure =
+        cmake + " -G \"" GEM_CMAKE_GENERATOR "\"" + (makeProgram.empty() ? "" : " -DCMAKE_MAKE_PROGRAM=\"" + makeProgram + "\"") +
+        " -DCMAKE_CXX_COMPILER=\"" GEM_CXX_COMPILER "\" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=" + prefix.string();
+    const int status = run(configure + " -S " GEM_SOURCE_DIR "/plugins/" + name + " -B " + build.string(), log);
+    return status != 0 ? status : run(cmake + " --build " + build.string(), log);
   }
+};
 
-  // shear_current: U = 0.2 + 0.01 y, floes at y = -40, 0, 40 (state.csv rows in id order): the
-  // first drifts back (U < 0), the last fastest.
-  {
-    std::vector<double> vx = gem::readCsvTable(dir.path() / "run_shear_current" / "state.csv").numbers("vx");
+}  // namespace
+
+// The install holds the CMake package and the plugin API, and the installed gem runs gem bench
+// from its own share/gem/scenarios, not the source tree.
+TEST(PluginSdk, TheInstalledGemHasItsPackageHeadersAndScenarios) {
+  TempDir dir;
+  const InstalledGem installed(dir);
+  ASSERT_EQ(installed.install(), 0) << readFile(installed.log);
+  ASSERT_EQ(run(installed.gem.string() + " bench --backend cpu --cases 456 --steps 3", installed.log), 0) << readFile(installed.log);
+  EXPECT_NE(readFile(installed.log).find("scenes from " + fs::weakly_canonical(installed.prefix / "share" / "gem" / "scenarios").string()),
+            std::string::npos)
+      << readFile(installed.log);
+  EXPECT_TRUE(fs::exists(installed.prefix / "lib" / "cmake" / "gem" / "gemConfig.cmake"));
+  EXPECT_TRUE(fs::exists(installed.prefix / "include" / "gem" / "framework" / "plugin_api.hpp"));
+}
+
+class PluginSdkExample : public ::testing::TestWithParam<std::string> {};
+
+// Each example under plugins/ builds out of tree against the install, gem info lists it (by
+// --plugin and by GEM_PLUGIN_PATH) with its path and version, its scenario runs, and it does what
+// it is for.
+TEST_P(PluginSdkExample, BuildsOutOfTreeRunsAndShowsInGemInfo) {
+  const std::string name = GetParam();
+  TempDir dir;
+  const InstalledGem installed(dir);
+  const fs::path& log = installed.log;
+  const std::string gem = installed.gem.string();
+  ASSERT_EQ(installed.install(), 0) << readFile(log);
+  const fs::path build = dir.path() / name;
+  ASSERT_EQ(installed.buildExample(name, build), 0) << readFile(log);
+  const fs::path library = build / ("lib" + name + ".so");
+  ASSERT_TRUE(fs::exists(library));
+
+  ASSERT_EQ(run(gem + " info --plugin " + library.string(), log), 0) << readFile(log);
+  EXPECT_TRUE(contains(readFile(log), "from " + fs::canonical(library).string() + " (" + name + " 1.0.0)")) << readFile(log);
+  ASSERT_EQ(run("GEM_PLUGIN_PATH=" + build.string() + " " + gem + " info", log), 0) << readFile(log);
+  EXPECT_TRUE(contains(readFile(log), fs::canonical(library).string())) << readFile(log);
+
+  const fs::path out = dir.path() / "run";
+  ASSERT_EQ(run(gem + " run " + (build / "scenario.toml").string() + " --quiet --out " + out.string(), log), 0) << readFile(log);
+  ASSERT_TRUE(fs::exists(out / "summary.json"));
+
+  if (name == "shear_current") {
+    // U = 0.2 + 0.01 y, floes at y = -40, 0, 40 (state.csv rows in id order): the first drifts
+    // back (U < 0), the last fastest.
+    std::vector<double> vx = gem::readCsvTable(out / "state.csv").numbers("vx");
     ASSERT_EQ(vx.size(), 3u);
     EXPECT_LT(vx[0], 0);
     EXPECT_GT(vx[1], 0);
     EXPECT_GT(vx[2], 2 * vx[1]);
-  }
-  // rafting_onset: the thin pair's onset is logged (floes 0 and 1), the thick pair's is not.
-  {
-    const std::string text = readFile(dir.path() / "run_rafting_onset" / "rafting.csv");
+  } else if (name == "rafting_onset") {
+    // The thin pair's onset is logged (floes 0 and 1), the thick pair's is not.
+    const std::string text = readFile(out / "rafting.csv");
     EXPECT_TRUE(contains(text, "t,floe_a,floe_b,x,y,vc,thickness\n")) << text;
     EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2) << text;
     EXPECT_TRUE(contains(text, ",0,1,")) << text;
-  }
-  // sweep_and_prune: the same contacts as all_pairs, so the same final state bit for bit.
-  {
-    const fs::path out = dir.path() / "run_all_pairs";
-    ASSERT_EQ(run(gem + " run " + (dir.path() / "sweep_and_prune" / "scenario.toml").string() + " --broadphase all_pairs --quiet --out " +
-                      out.string(),
-                  log),
+  } else if (name == "sweep_and_prune") {
+    // The same contacts as all_pairs, so the same final state bit for bit.
+    const fs::path allPairs = dir.path() / "run_all_pairs";
+    ASSERT_EQ(run(gem + " run " + (build / "scenario.toml").string() + " --broadphase all_pairs --quiet --out " + allPairs.string(), log),
               0)
         << readFile(log);
-    const std::string sap = readFile(dir.path() / "run_sweep_and_prune" / "state.csv");
+    const std::string sap = readFile(out / "state.csv");
     EXPECT_GT(std::count(sap.begin(), sap.end(), '\n'), 20);
-    EXPECT_EQ(sap, readFile(out / "state.csv"));
-    EXPECT_TRUE(contains(readFile(dir.path() / "run_sweep_and_prune" / "summary.json"), "sweep_and_prune"));
+    EXPECT_EQ(sap, readFile(allPairs / "state.csv"));
+    EXPECT_TRUE(contains(readFile(out / "summary.json"), "sweep_and_prune"));
+  } else {
+    FAIL() << "no check written for the example " << name;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Examples, PluginSdkExample, ::testing::Values("shear_current", "rafting_onset", "sweep_and_prune"),
+                         [](const auto& info) { return info.param; });
 
 // Nothing lost when a run fails: an event that fails mid-run (exit 1) leaves the whole rows
 // written so far under their final names, and no summary.json (a run that failed is not complete).
