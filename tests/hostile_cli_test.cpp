@@ -237,6 +237,16 @@ TEST(HostileCli, AVesselThatCanNeverReachTheDomainIsRefused) {
     EXPECT_EQ(gem::test::runGem("check --quiet " + scenario.string(), dir.path() / "log.txt"), 0)
         << toml << gem::test::readFile(dir.path() / "log.txt");
   }
+
+  // A plugin's event may steer the vessel in ways the check cannot foresee: beside the field, the
+  // vessel is taken while a plugin's event is enabled, and refused again once it is disabled.
+  const std::string plugin = std::string("[[plugins]]\npath = \"") + GEM_TEST_PLUGIN_DIR + "/libold_layout.so\"\n";
+  scenario = dir.write("case.toml", head + plugin + "[events.sideways_push]\naccel = 1.0\n[vessel]\nposition = [100.0, 400.0]\n");
+  EXPECT_EQ(gem::test::runGem("check --quiet " + scenario.string(), dir.path() / "log.txt"), 0)
+      << gem::test::readFile(dir.path() / "log.txt");
+  scenario = dir.write("case.toml", head + plugin + "[events.sideways_push]\nenabled = false\n[vessel]\nposition = [100.0, 400.0]\n");
+  text = refused(dir, "check " + scenario.string());
+  EXPECT_TRUE(holds(text, "[100, 400], sailing at heading 0 deg")) << text;
 }
 
 // A .ice file holding more than its one document: a second root element after </iceFloeSim> (two

@@ -277,12 +277,20 @@ bool rayMeetsBox(Vec2 p, Vec2 d, Vec2 lo, Vec2 hi) {
 // its start along the set heading), so the line it sails from `position` must come within the
 // hull's reach of the domain's rectangle; with walls it starts between them, since it cannot cross
 // one. The domain's ends are open: a vessel before the field, facing it, is the usual start. With
-// no [domain] nothing is checked (the field is then where the floes are). Explicit floes and a
-// .ice field's objects may lie anywhere: the domain bounds the generated field and the statistics,
-// not the bodies, and floes leave it through its open ends in any run.
+// no [domain] nothing is checked (the field is then where the floes are), nor with a plugin's event
+// enabled (see below). Explicit floes and a .ice field's objects may lie anywhere: the domain
+// bounds the generated field and the statistics, not the bodies, and floes leave it through its
+// open ends in any run.
 void checkVesselCanReachDomain(Scenario& s) {
   const VesselSpec& v = s.vessel;
   if (!v.present || !s.hasDomain) return;
+  // An event from a plugin may steer or carry the vessel in ways the check cannot foresee (its own
+  // autopilot, a towline): with one enabled, the start is taken as given.
+  for (const EventEntry* e : Registry::global().events()) {
+    if (e->origin == "built-in") continue;
+    const auto setting = s.events.find(e->name);
+    if (setting != s.events.end() ? setting->second.enabled : e->enabledByDefault) return;
+  }
   // An error already reported about one of these keys took the key's default: what follows from
   // that default is no new error.
   if (const ErrorCollector* errors = ErrorCollector::active())
