@@ -251,7 +251,7 @@ TEST(CpuTiming, OneLineOfPhasesThatAddUpToTheStep) {
   const double total = std::stod(line.substr(line.rfind(' ', at - 1) + 1));
   double sum = 0;
   for (const char* phase :
-       {"broadphase", "narrowphase tests", "narrowphase join", "pair views and events", "solo events", "gather and motion", "topology"}) {
+       {"broadphase", "narrowphase tests", "narrowphase join", "pair views and events", "body updates", "topology"}) {
     const size_t p = line.find(std::string(phase) + " ", at);
     ASSERT_NE(p, std::string::npos) << phase << " missing in: " << line;
     sum += std::stod(line.substr(p + std::string(phase).size() + 1));

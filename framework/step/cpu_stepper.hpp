@@ -90,9 +90,9 @@ class CpuStepper final : public Stepper {
   // GEM_CPU_TIMING=1: the wall time of each phase of the steps taken, printed as one line on
   // stderr when the stepper goes (docs/performance.md 1.4). Off, a lap is one test of a flag.
   struct PhaseClock {
-    enum Phase { Broadphase, Tests, Join, PairEvents, Solo, GatherMotion, Topology, kPhases };
+    enum Phase { Broadphase, Tests, Join, PairEvents, BodyUpdates, Topology, kPhases };
     static constexpr std::array<const char*, kPhases> kNames{
-        "broadphase", "narrowphase tests", "narrowphase join", "pair views and events", "solo events", "gather and motion", "topology"};
+        "broadphase", "narrowphase tests", "narrowphase join", "pair views and events", "body updates", "topology"};
     bool on = false;
     long steps = 0;
     std::array<double, kPhases> seconds{};
@@ -110,7 +110,7 @@ class CpuStepper final : public Stepper {
 
   void setUp();
   void narrowphase();
-  void gatherAndMove();
+  void bodyUpdates(const StepContext& ctx);
   void reorderAlongCurve();
 
   Scenario m_scenario;
@@ -131,17 +131,15 @@ class CpuStepper final : public Stepper {
     Real x, y, angle;
     bool operator==(const Pose&) const = default;
   };
-  std::vector<Pose> m_vertexPose;  // the pose m_worldVertices and m_boxes were computed for, by slot
-  std::vector<char> m_moved;       // this step: the body's pose differs from the last step's
-  std::vector<char> m_active;      // this step: moved, or in a contact at the last step
+  World::PermuteRoom m_permuteRoom;  // the re-sort's arrays, kept from one re-sort to the next
+  std::vector<Pose> m_vertexPose;    // the pose m_worldVertices and m_boxes were computed for, by slot
+  std::vector<char> m_moved;         // this step: the body's pose differs from the last step's
+  std::vector<char> m_active;        // this step: moved, or in a contact at the last step
   std::vector<CandidatePair> m_pairs;
   std::vector<int> m_contactA, m_contactB;
   std::vector<PairContact> m_contacts;
   std::vector<PairSlot> m_slots;
   std::vector<PairBody> m_pairBodies;  // set for the bodies of this step's contacts only
-  std::vector<SoloBody> m_soloBodies;
-  std::vector<VelocityChange> m_changes;
-  std::vector<MotionBody> m_motionBodies;
   std::vector<std::pair<std::int64_t, std::int64_t>> m_previousContacts, m_currentContacts;
   bool m_previousSorted = true;  // m_previousContacts is sorted (it is kept in contact order until searched)
   // The contacts of the narrowphase, body by body, built in O(contacts) (no pass over every slot,

@@ -115,34 +115,40 @@ static void gatherOrder(std::vector<T>& out, const std::vector<T>& v, const std:
     for (size_t s = 0; s < stride; ++s) out[k * stride + s] = v[static_cast<size_t>(order[k]) * stride + s];
 }
 
-void World::permute(const std::vector<int>& order, const TaskRunner& forEachTask) {
+void World::permute(const std::vector<int>& order, const TaskRunner& forEachTask, PermuteRoom* room) {
   // With a runner (a threaded CPU step) an array a task, and the vertices (60 % of the bytes) in
   // ranges of bodies besides: at 10^5 floes the re-sort every 200 steps (docs/model.md 8) took
   // 30 to 40 ms on one thread, as long as 40 steps on 16. Every element lands at its own place,
   // so any thread count gives the same world.
   const size_t n = order.size();
+  PermuteRoom local;
+  PermuteRoom& into = room ? *room : local;
+  // Each array is gathered into its room, which then holds it, and the room the old array: with
+  // a caller's room both keep their memory from one permute to the next.
+  auto prepare = [](auto& out, const auto& v) {
+    out.reserve(v.capacity());  // room kept: else the next break's addBody regrows every array
+    out.resize(v.size());
+  };
   std::vector<std::function<void()>> tasks;
-  auto whole = [&](auto& v) {
-    tasks.push_back([&v, &order, n] {
-      std::remove_reference_t<decltype(v)> out;
-      out.reserve(v.capacity());  // room kept: else the next break's addBody regrows every array
-      out.resize(v.size());
+  auto whole = [&](auto& v, auto& out) {
+    tasks.push_back([&v, &out, &order, &prepare, n] {
+      prepare(out, v);
       gatherOrder(out, v, order, 1, 0, n);
       v.swap(out);
     });
   };
-  whole(id), whole(kind), whole(vertexCount);
-  for (std::vector<Real>* v : {&x, &y, &angle, &vx, &vy, &omega, &area, &thickness, &mass, &invMass, &invInertia, &gyration2, &gyrationX2,
-                               &gyrationY2, &principalAngle, &radius})
-    whole(*v);
-  std::vector<Vec2> vertices;
-  vertices.reserve(localVertices.capacity());
-  vertices.resize(localVertices.size());
+  whole(id, into.id), whole(kind, into.kind), whole(vertexCount, into.vertexCount);
+  const std::array realArrays{&x,    &y,       &angle,      &vx,        &vy,         &omega,      &area,           &thickness,
+                              &mass, &invMass, &invInertia, &gyration2, &gyrationX2, &gyrationY2, &principalAngle, &radius};
+  static_assert(realArrays.size() == std::tuple_size_v<decltype(PermuteRoom::reals)>, "a room for every Real array");
+  for (size_t r = 0; r < realArrays.size(); ++r) whole(*realArrays[r], into.reals[r]);
+  std::vector<Vec2>& vertices = into.vertices;
+  prepare(vertices, localVertices);
   const int ranges = forEachTask && n >= 16384 ? 16 : 1;
-  for (int r = 0; r < ranges; ++r)
-    tasks.push_back([&, r] {
-      gatherOrder(vertices, localVertices, order, kMaxVertices, n * static_cast<size_t>(r) / static_cast<size_t>(ranges),
-                  n * static_cast<size_t>(r + 1) / static_cast<size_t>(ranges));
+  for (int range = 0; range < ranges; ++range)
+    tasks.push_back([&, range] {
+      gatherOrder(vertices, localVertices, order, kMaxVertices, n * static_cast<size_t>(range) / static_cast<size_t>(ranges),
+                  n * static_cast<size_t>(range + 1) / static_cast<size_t>(ranges));
     });
   const auto run = [&](int t) { tasks[static_cast<size_t>(t)](); };
   if (forEachTask)

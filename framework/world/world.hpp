@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 #include <functional>
+#include <array>
 #include <vector>
 
 #include "framework/world/body_kind.hpp"
@@ -95,9 +96,21 @@ struct World {
   // array is then compacted by a task of its own. The result is the same either way.
   using TaskRunner = std::function<void(int count, const std::function<void(int)>& task)>;
   void removeBodies(const std::vector<char>& remove, const TaskRunner& forEachTask = nullptr);
+  // The arrays a permute() leaves behind, kept by a caller that permutes again and again (the CPU
+  // stepper re-sorts every 200 steps) and passed back in: the next permute() writes into them
+  // instead of fresh arrays. At 10^5 floes fresh arrays were 50 MB to zero and page in on one
+  // thread, most of a re-sort's 100 ms on the development machine.
+  struct PermuteRoom {
+    std::vector<std::int64_t> id;
+    std::vector<BodyKind> kind;
+    std::vector<int> vertexCount;
+    std::array<std::vector<Real>, 16> reals;  // in permute()'s order of the Real arrays
+    std::vector<Vec2> vertices;
+  };
   // Reorders all arrays by the permutation (new slot k holds old slot order[k]); forEachTask as for
-  // removeBodies (then the arrays, and ranges of the vertices, are tasks). The same either way.
-  void permute(const std::vector<int>& order, const TaskRunner& forEachTask = nullptr);
+  // removeBodies (then the arrays, and ranges of the vertices, are tasks). The same either way, and
+  // with or without room.
+  void permute(const std::vector<int>& order, const TaskRunner& forEachTask = nullptr, PermuteRoom* room = nullptr);
   // The order of the bodies along a Morton (Z-order) curve through their centroids: neighbours in
   // space become neighbours in memory (docs/architecture.md "Speed habits"). Ties keep slot order.
   std::vector<int> curveOrder() const;  // sorted by curveKey, ties by slot
