@@ -250,8 +250,7 @@ TEST(CpuTiming, OneLineOfPhasesThatAddUpToTheStep) {
   ASSERT_NE(at, std::string::npos) << line;
   const double total = std::stod(line.substr(line.rfind(' ', at - 1) + 1));
   double sum = 0;
-  for (const char* phase :
-       {"broadphase", "narrowphase tests", "narrowphase join", "pair views and events", "body updates", "topology"}) {
+  for (const char* phase : {"broadphase", "narrowphase tests", "narrowphase join", "pair views and events", "body updates", "topology"}) {
     const size_t p = line.find(std::string(phase) + " ", at);
     ASSERT_NE(p, std::string::npos) << phase << " missing in: " << line;
     sum += std::stod(line.substr(p + std::string(phase).size() + 1));
