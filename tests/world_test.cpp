@@ -123,4 +123,23 @@ TEST(World, CurveOrderAndPermuteOnOneThreadOrAsTasks) {
   for (size_t k = 0; k < order.size(); ++k) inverse[static_cast<size_t>(order[k])] = static_cast<int>(k);
   alone.permute(inverse);
   expectCompacted(before, alone, keepAll);  // and back again: every array moved with its row
+
+  // With a kept room (the CPU stepper's re-sorts), the second and third permutes write over the
+  // arrays the earlier ones left, one of them after the world grew by a body: the same worlds.
+  World::PermuteRoom room;
+  World roomed = before;
+  roomed.permute(order, nullptr, &room);
+  expectCompacted(pooled, roomed, keepAll);
+  roomed.permute(inverse, nullptr, &room);
+  expectCompacted(before, roomed, keepAll);
+  World grown = before;
+  BodySpec extra;
+  extra.vertices = {{-10, -10}, {-8, -10}, {-8, -8}, {-10, -8}};
+  extra.thickness = 0.7;
+  grown.addBody(extra), roomed.addBody(extra);
+  std::vector<int> reversed(static_cast<size_t>(grown.size()));
+  for (size_t k = 0; k < reversed.size(); ++k) reversed[k] = grown.size() - 1 - static_cast<int>(k);
+  grown.permute(reversed);
+  roomed.permute(reversed, nullptr, &room);
+  expectCompacted(grown, roomed, std::vector<char>(static_cast<size_t>(grown.size()), 0));
 }
