@@ -102,10 +102,9 @@ class NeighbourList {
   std::vector<std::vector<ListedPair>> m_raw;  // the build's parts
   std::vector<ListedPair> m_pairs, m_kept;
   std::vector<CandidatePair> m_filtered;
-  std::vector<int> m_count;
-  // The parallel counting sort's counts, part by part (part x bodies), and each range's count of
-  // the filters' survivors.
-  std::vector<int> m_partCount;
+  // The counting sort's row starts (bodies + 1) and next free places (bodies), and each range's
+  // count of the filters' survivors.
+  std::vector<int> m_count, m_cursor;
   std::vector<size_t> m_rangeCount;
   std::vector<std::vector<CandidatePair>> m_directParts;
   // Reference state at the last build, by slot.
