@@ -177,9 +177,10 @@ class CpuStepper final : public Stepper {
     std::vector<PairContact> contacts;
     std::vector<std::pair<std::int64_t, std::int64_t>> keys;
     std::vector<SeparatedPair> separated;
-    std::vector<int> boxSurvivors;  // scratch: the candidates whose boxes overlap
+    std::vector<int> boxSurvivors;  // scratch: the candidates of its range whose boxes overlap
   };
   std::vector<NarrowphasePart> m_parts;
+  std::vector<long> m_survivorsBefore;              // the box survivors of the parts before each part, and all of them last
   std::vector<std::pair<size_t, size_t>> m_joinAt;  // each part's first contact and separated pair in the join
   void joinParts(int tasks);
   // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads; body(i) for
