@@ -70,7 +70,7 @@ void NeighbourList::relistDirect(const World& world) {
   std::vector<int> relisted, vessels;
   for (int v : m_directList) (world.kind[v] == BodyKind::Vessel ? vessels : relisted).push_back(v);
   std::sort(relisted.begin(), relisted.end());
-  m_relisting.assign(static_cast<size_t>(n), 0);
+  m_relisting.resize(static_cast<size_t>(n), 0);  // all 0 between relists: only the relisted floes' flags are set and reset
   for (int v : relisted) m_relisting[static_cast<size_t>(v)] = 1;
 
   const Real margin = kRelistReach * m_skin;
@@ -116,6 +116,7 @@ void NeighbourList::relistDirect(const World& world) {
     m_x0[static_cast<size_t>(v)] = x[v], m_y0[static_cast<size_t>(v)] = y[v], m_angle0[static_cast<size_t>(v)] = world.angle[v];
     m_direct[static_cast<size_t>(v)] = 0;
     m_masked[static_cast<size_t>(v)] = 1;
+    m_relisting[static_cast<size_t>(v)] = 0;
   }
   m_directList = vessels;
   m_relistedSinceBuild += static_cast<int>(relisted.size());
@@ -187,17 +188,26 @@ void NeighbourList::sortRaw(int bodyCount) {
 
 void NeighbourList::finish(const World& world) {
   const int n = world.size();
-  bool sorted = true;
-  const ListedPair* last = nullptr;
-  for (const std::vector<ListedPair>& part : m_raw) {
-    for (const ListedPair& p : part) {
-      if (last && !(last->a < p.a || (last->a == p.a && last->b < p.b))) {
-        sorted = false;
-        break;
+  // Whether the parts joined in order are sorted by (a, b): each part, and each part's first pair
+  // against the last pair of the part before it (empty parts skipped), checked part by part.
+  const int parts = static_cast<int>(m_raw.size());
+  auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
+  std::vector<char> partSorted(static_cast<size_t>(parts), 1);
+  parallelEach(parts, [&](int t) {
+    const std::vector<ListedPair>& part = m_raw[static_cast<size_t>(t)];
+    for (size_t k = 1; k < part.size(); ++k)
+      if (!before(part[k - 1], part[k])) {
+        partSorted[static_cast<size_t>(t)] = 0;
+        return;
       }
-      last = &p;
-    }
-    if (!sorted) break;
+  });
+  bool sorted = std::all_of(partSorted.begin(), partSorted.end(), [](char c) { return c != 0; });
+  const ListedPair* last = nullptr;
+  for (int t = 0; sorted && t < parts; ++t) {
+    const std::vector<ListedPair>& part = m_raw[static_cast<size_t>(t)];
+    if (part.empty()) continue;
+    if (last && !before(*last, part.front())) sorted = false;
+    last = &part.back();
   }
   if (!sorted) {
     sortRaw(n);
@@ -236,15 +246,21 @@ void NeighbourList::finish(const World& world) {
               m_pairs.begin() + static_cast<std::ptrdiff_t>(at));
   });
   m_pairs.resize(kept);
-  m_x0.assign(world.x.begin(), world.x.end());
-  m_y0.assign(world.y.begin(), world.y.end());
-  m_angle0.assign(world.angle.begin(), world.angle.end());
-  m_id0.assign(world.id.begin(), world.id.end());
-  m_direct.assign(n, 0);
+  // The reference state and the direct flags, over ranges of bodies (at 10^5 floes these copies
+  // were a few milliseconds of one thread at every rebuild, while the others waited).
+  const size_t bodies = static_cast<size_t>(n);
+  m_x0.resize(bodies), m_y0.resize(bodies), m_angle0.resize(bodies), m_id0.resize(bodies);
+  m_direct.resize(bodies), m_masked.resize(bodies);
+  parallelRanges(n, kBodyGrain, [&](int, long begin, long end) {
+    for (long i = begin; i < end; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      m_x0[k] = world.x[k], m_y0[k] = world.y[k], m_angle0[k] = world.angle[k], m_id0[k] = world.id[k];
+      m_direct[k] = m_masked[k] = world.kind[k] == BodyKind::Vessel;
+    }
+  });
   m_directList.clear();
   for (int i = 0; i < n; ++i)
-    if (world.kind[i] == BodyKind::Vessel) m_direct[i] = 1, m_directList.push_back(i);
-  m_masked = m_direct;
+    if (m_direct[static_cast<size_t>(i)]) m_directList.push_back(i);
   m_sidePairs.clear();
   m_valid = true;
   m_relistedSinceBuild = 0;

@@ -410,18 +410,16 @@ void CpuStepper::narrowphase() {
       survivor[survivors] = p;
       survivors += !(boxA.x0 > boxB.x1) & !(boxB.x0 > boxA.x1) & !(boxA.y0 > boxB.y1) & !(boxB.y0 > boxA.y1);
     }
-    part.boxSurvivors.resize(static_cast<size_t>(survivors));
+    part.survivors = survivors;  // the scratch keeps its size: grown again, it would be zeroed every step
   };
-  // The exact tests of the survivors from..to - 1 of survivors(k), k counted over the parts' survivors in order.
-  auto exactPass = [&](NarrowphasePart& part, long from, long to, auto survivorAt) {
-    part.a.clear(), part.b.clear(), part.contacts.clear(), part.keys.clear(), part.separated.clear();
-    if (from >= to) return;
-    // The last step's separated pairs, in the same (a, b) order as the candidates: one cursor walks
-    // them alongside. A broadphase that lists its pairs out of order only finds fewer of them.
-    auto cached = std::lower_bound(m_lastSeparated.cbegin(), m_lastSeparated.cend(), m_pairs[static_cast<size_t>(survivorAt(from))],
-                                   [](const SeparatedPair& s, const CandidatePair& c) { return s.a < c.a || (s.a == c.a && s.b < c.b); });
-    for (long k = from; k < to; ++k) {
-      const int p = survivorAt(k);
+  // The exact tests of `count` survivors (candidate numbers, in order), appended to `part`'s
+  // contacts and separated pairs. `cached` walks the last step's separated pairs, in the same
+  // (a, b) order as the candidates, alongside: a broadphase that lists its pairs out of order only
+  // finds fewer of them.
+  using SeparatedCursor = std::vector<SeparatedPair>::const_iterator;
+  auto exactTests = [&](NarrowphasePart& part, const int* survivor, int count, SeparatedCursor& cached) {
+    for (int s = 0; s < count; ++s) {
+      const int p = survivor[s];
       const int a = m_pairs[static_cast<size_t>(p)].a, b = m_pairs[static_cast<size_t>(p)].b;
       if (m_world.invMass[a] == 0 && m_world.invMass[b] == 0) continue;  // mayTouch: two walls (the boxes passed above)
       const bool touchedBefore = touchedAtLastStep(a, b);
@@ -456,28 +454,44 @@ void CpuStepper::narrowphase() {
       part.keys.emplace_back(std::minmax(m_world.id[a], m_world.id[b]));
     }
   };
+  auto clearContacts = [](NarrowphasePart& part) {
+    part.a.clear(), part.b.clear(), part.contacts.clear(), part.keys.clear(), part.separated.clear();
+  };
   if (tasks == 1) {
     boxPass(0);
     NarrowphasePart& part = m_parts[0];
-    exactPass(part, 0, static_cast<long>(part.boxSurvivors.size()), [&](long k) { return part.boxSurvivors[static_cast<size_t>(k)]; });
+    clearContacts(part);
+    SeparatedCursor cached = m_lastSeparated.cbegin();
+    exactTests(part, part.boxSurvivors.data(), part.survivors, cached);
   } else {
     m_pool->run(tasks, boxPass);
     // The survivors numbered across the parts: part t's come from m_survivorsBefore[t] on.
     m_survivorsBefore.resize(static_cast<size_t>(tasks) + 1);
     m_survivorsBefore[0] = 0;
     for (int t = 0; t < tasks; ++t)
-      m_survivorsBefore[static_cast<size_t>(t) + 1] =
-          m_survivorsBefore[static_cast<size_t>(t)] + static_cast<long>(m_parts[static_cast<size_t>(t)].boxSurvivors.size());
+      m_survivorsBefore[static_cast<size_t>(t) + 1] = m_survivorsBefore[static_cast<size_t>(t)] + m_parts[static_cast<size_t>(t)].survivors;
     const long survivors = m_survivorsBefore[static_cast<size_t>(tasks)];
     m_pool->run(tasks, [&](int t) {
-      const long from = survivors * t / tasks, to = survivors * (t + 1) / tasks;
-      // The part holding survivor `from`, then a walk: the survivors k in order, part by part.
+      NarrowphasePart& part = m_parts[static_cast<size_t>(t)];
+      clearContacts(part);
+      long from = survivors * t / tasks;
+      const long to = survivors * (t + 1) / tasks;
+      if (from >= to) return;
+      // The part holding survivor `from`, then the survivors up to `to` part by part.
       int source =
           static_cast<int>(std::upper_bound(m_survivorsBefore.begin(), m_survivorsBefore.end(), from) - m_survivorsBefore.begin()) - 1;
-      exactPass(m_parts[static_cast<size_t>(t)], from, to, [&](long k) {
-        while (k >= m_survivorsBefore[static_cast<size_t>(source) + 1]) ++source;
-        return m_parts[static_cast<size_t>(source)].boxSurvivors[static_cast<size_t>(k - m_survivorsBefore[static_cast<size_t>(source)])];
-      });
+      const int first =
+          m_parts[static_cast<size_t>(source)].boxSurvivors[static_cast<size_t>(from - m_survivorsBefore[static_cast<size_t>(source)])];
+      SeparatedCursor cached =
+          std::lower_bound(m_lastSeparated.cbegin(), m_lastSeparated.cend(), m_pairs[static_cast<size_t>(first)],
+                           [](const SeparatedPair& s, const CandidatePair& c) { return s.a < c.a || (s.a == c.a && s.b < c.b); });
+      for (; from < to; ++source) {
+        const long begin = m_survivorsBefore[static_cast<size_t>(source)],
+                   end = std::min(to, m_survivorsBefore[static_cast<size_t>(source) + 1]);
+        if (from >= end) continue;
+        exactTests(part, m_parts[static_cast<size_t>(source)].boxSurvivors.data() + (from - begin), static_cast<int>(end - from), cached);
+        from = end;
+      }
     });
   }
   m_clock.lap(PhaseClock::Tests);

@@ -177,7 +177,8 @@ class CpuStepper final : public Stepper {
     std::vector<PairContact> contacts;
     std::vector<std::pair<std::int64_t, std::int64_t>> keys;
     std::vector<SeparatedPair> separated;
-    std::vector<int> boxSurvivors;  // scratch: the candidates of its range whose boxes overlap
+    std::vector<int> boxSurvivors;  // scratch: the candidates of its range whose boxes overlap, the first `survivors`
+    int survivors = 0;
   };
   std::vector<NarrowphasePart> m_parts;
   std::vector<long> m_survivorsBefore;              // the box survivors of the parts before each part, and all of them last
