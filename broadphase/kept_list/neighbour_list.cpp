@@ -148,9 +148,18 @@ void NeighbourList::sortRaw(int bodyCount) {
   if (parts == 1) {
     for (const ListedPair& p : m_raw[0]) ++m_count[static_cast<size_t>(p.a) + 1];
   } else {
+    // A part lists a row's pairs in runs (a grid body's pairs one after another, a wall's in its
+    // range likewise): one atomic addition a run. One a pair made every thread wait on the line of
+    // a wall's count, which every part adds to.
     parallelEach(parts, [&](int t) {
-      for (const ListedPair& p : m_raw[static_cast<size_t>(t)])
-        std::atomic_ref<int>(m_count[static_cast<size_t>(p.a) + 1]).fetch_add(1, std::memory_order_relaxed);
+      const std::vector<ListedPair>& part = m_raw[static_cast<size_t>(t)];
+      for (size_t k = 0; k < part.size();) {
+        const int a = part[k].a;
+        size_t end = k + 1;
+        while (end < part.size() && part[end].a == a) ++end;
+        std::atomic_ref<int>(m_count[static_cast<size_t>(a) + 1]).fetch_add(static_cast<int>(end - k), std::memory_order_relaxed);
+        k = end;
+      }
     });
   }
   for (size_t a = 0; a < n; ++a) m_count[a + 1] += m_count[a];
@@ -159,10 +168,16 @@ void NeighbourList::sortRaw(int bodyCount) {
   if (parts == 1) {
     for (const ListedPair& p : m_raw[0]) m_pairs[static_cast<size_t>(m_cursor[static_cast<size_t>(p.a)]++)] = p;
   } else {
-    parallelEach(parts, [&](int t) {
-      for (const ListedPair& p : m_raw[static_cast<size_t>(t)]) {
-        const int at = std::atomic_ref<int>(m_cursor[static_cast<size_t>(p.a)]).fetch_add(1, std::memory_order_relaxed);
-        m_pairs[static_cast<size_t>(at)] = p;
+    parallelEach(parts, [&](int t) {  // a run's places claimed at once
+      const std::vector<ListedPair>& part = m_raw[static_cast<size_t>(t)];
+      for (size_t k = 0; k < part.size();) {
+        const int a = part[k].a;
+        size_t end = k + 1;
+        while (end < part.size() && part[end].a == a) ++end;
+        const int at =
+            std::atomic_ref<int>(m_cursor[static_cast<size_t>(a)]).fetch_add(static_cast<int>(end - k), std::memory_order_relaxed);
+        std::copy(part.begin() + static_cast<std::ptrdiff_t>(k), part.begin() + static_cast<std::ptrdiff_t>(end), m_pairs.begin() + at);
+        k = end;
       }
     });
   }

@@ -14,7 +14,7 @@ ParallelScope::~ParallelScope() { t_runner = m_previous; }
 
 int parallelTasks(long n, int grain) {
   if (!t_runner || t_runner->size() <= 1 || n < 4L * grain) return 1;
-  return static_cast<int>(std::min<long>(n / grain, 4L * t_runner->size()));
+  return static_cast<int>(std::min<long>(n / grain, static_cast<long>(kTasksPerThread) * t_runner->size()));
 }
 
 void parallelEach(int tasks, const std::function<void(int)>& task) {

@@ -32,9 +32,16 @@ class ParallelScope {
   ParallelRunner* m_previous;
 };
 
+// How many tasks a round of work is cut into at most, per thread. Threads take tasks one at a time
+// until none is left, so a round ends at most one task after the last thread to start its final
+// one: with 4 tasks a thread (the first choice) that tail was a seventh of the main thread's time
+// at 10^5 floes on 16 threads (docs/performance.md 3.10). A task costs a call and an atomic
+// increment, nothing next to the 512 bodies or 4,096 pairs it takes at least.
+constexpr int kTasksPerThread = 16;
+
 // How many ranges parallelRanges(n, grain, ...) cuts [0, n) into: 1 without a runner or when n is
-// under 4 grains (then waking threads costs more than the work), else at most 4 per thread and at
-// least `grain` items each. A caller sizes its per-range buffers with it.
+// under 4 grains (then waking threads costs more than the work), else at most kTasksPerThread per
+// thread and at least `grain` items each. A caller sizes its per-range buffers with it.
 int parallelTasks(long n, int grain);
 
 // range(task, begin, end) for task 0 .. tasks - 1, over contiguous ranges that cover [0, n) in

@@ -15,6 +15,7 @@
 #include "framework/api/errors.hpp"
 #include "framework/field/ice_file.hpp"
 #include "framework/api/log_channel.hpp"
+#include "framework/api/parallel.hpp"
 #include "framework/api/table_reader.hpp"
 #include "framework/world/constants.hpp"
 #include "framework/world/vessel.hpp"
@@ -334,7 +335,7 @@ void CpuStepper::reorderAlongCurve() {
 void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range) {
   // Small fields stay on one thread: waking the pool costs more than their work (on 2 cores the
   // 456-hexagon field took 0.116 ms a step on 2 threads against 0.079 ms on one).
-  const int tasks = m_pool && n >= kParallelBodies ? std::min(n / kGrain, 4 * m_pool->size()) : 1;
+  const int tasks = m_pool && n >= kParallelBodies ? std::min(n / kGrain, kTasksPerThread * m_pool->size()) : 1;
   if (tasks <= 1) {
     range(0, n);
     return;
@@ -384,7 +385,7 @@ void CpuStepper::narrowphase() {
   // 10^5 floes on 16 threads that one task was the narrowphase). The parts' contacts, joined in
   // order, are the contacts of one pass over all the pairs.
   const int pairs = static_cast<int>(m_pairs.size());
-  const int tasks = m_pool && pairs >= kParallelPairs ? std::min(pairs / kGrain, 4 * m_pool->size()) : 1;
+  const int tasks = m_pool && pairs >= kParallelPairs ? std::min(pairs / kGrain, kTasksPerThread * m_pool->size()) : 1;
   m_parts.resize(static_cast<size_t>(tasks));
   auto boxPass = [&](int t) {
     NarrowphasePart& part = m_parts[static_cast<size_t>(t)];
@@ -636,7 +637,7 @@ void CpuStepper::step() {
   // phase runs again (pair events only write their slots and records, so running them again is
   // running them once).
   const int streams = m_streams.count();
-  const int ranges = m_pool && contacts >= kParallelContacts ? std::min(contacts / kContactGrain, 4 * m_pool->size()) : 1;
+  const int ranges = m_pool && contacts >= kParallelContacts ? std::min(contacts / kContactGrain, kTasksPerThread * m_pool->size()) : 1;
   auto rangeStart = [&](int t) { return static_cast<int>(static_cast<long>(contacts) * t / ranges); };
   const size_t cells = static_cast<size_t>(ranges) * static_cast<size_t>(streams);
   m_pairRecordRows.resize(std::max(m_pairRecordRows.size(), cells));
