@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
+#include <type_traits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -354,11 +356,9 @@ void CpuStepper::narrowphase() {
   // Whether a slot changed hands since the last narrowphase (a re-sort, a break, a restored state),
   // seen in this pass over the bodies rather than in a serial one of its own.
   const int lastSlots = static_cast<int>(m_lastSlotId.size());
-  std::atomic<bool> slotsChanged{n > lastSlots};
-  m_slotIdNow.resize(static_cast<size_t>(n));
+  std::atomic<bool> slotsChanged{n != lastSlots};
   forEachBody(n, [&](int i) {
     if (i < lastSlots && m_lastSlotId[i] != m_world.id[i]) slotsChanged.store(true, std::memory_order_relaxed);
-    m_slotIdNow[static_cast<size_t>(i)] = m_world.id[i];
     // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
     // vertices from an earlier step are still exact, so only bodies that moved are transformed.
     const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
@@ -498,7 +498,7 @@ void CpuStepper::narrowphase() {
   m_clock.lap(PhaseClock::Tests);
 
   joinParts(tasks);
-  m_lastSlotId.swap(m_slotIdNow);
+  if (slotsChanged.load(std::memory_order_relaxed)) m_lastSlotId.assign(m_world.id.begin(), m_world.id.end());
   m_byBody.build(m_contactA, m_contactB, n);
   m_clock.lap(PhaseClock::Join);
 }
@@ -804,15 +804,22 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
     const MotionPhaseData motionData{motion.data(), count, ctx};
     for (auto& e : m_events)
       if (e.phase == EventPhase::Motion) e.instance->runMotion(motionData);
+    // The write-back, only where a bit changed: most floes of a pack rest, and storing their
+    // unchanged state dirtied six cache lines per eight bodies, each written back to memory, in a
+    // phase bound by memory on many threads. Compared as bits, so that -0 over +0 is stored.
+    using Bits = std::conditional_t<sizeof(Real) == 8, std::uint64_t, std::uint32_t>;
+    auto store = [](Real& to, Real value) {
+      if (std::bit_cast<Bits>(to) != std::bit_cast<Bits>(value)) to = value;
+    };
     for (int q = 0; q < count; ++q) {
       const int i = begin + q;
       const MotionBody& b = motion[q];
-      m_world.x[i] = b.position.x;
-      m_world.y[i] = b.position.y;
-      m_world.angle[i] = b.angle;
-      m_world.vx[i] = b.velocity.x;
-      m_world.vy[i] = b.velocity.y;
-      m_world.omega[i] = b.omega;
+      store(m_world.x[i], b.position.x);
+      store(m_world.y[i], b.position.y);
+      store(m_world.angle[i], b.angle);
+      store(m_world.vx[i], b.velocity.x);
+      store(m_world.vy[i], b.velocity.y);
+      store(m_world.omega[i], b.omega);
     }
   });
   m_vesselIceForce = forceOfImpulse(vesselImpulse, m_scenario.dt);

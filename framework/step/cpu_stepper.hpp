@@ -155,11 +155,12 @@ class CpuStepper final : public Stepper {
     bool has(int i) const { return static_cast<size_t>(i) < stamp.size() && stamp[static_cast<size_t>(i)] == current; }
   };
   ContactsByBody m_byBody;
-  // By slot, at the end of the last narrowphase, the id there (m_slotIdNow is filled by this step's
-  // pass over the bodies, then the two swap), so that a candidate learns whether it touched before
-  // from its body's contacts of the last step (m_byBody with m_contactA/B, not yet overwritten)
-  // instead of a search of m_previousContacts.
-  std::vector<std::int64_t> m_lastSlotId, m_slotIdNow;
+  // By slot, at the end of the last narrowphase, the id there, so that a candidate learns whether
+  // it touched before from its body's contacts of the last step (m_byBody with m_contactA/B, not yet
+  // overwritten) instead of a search of m_previousContacts. Copied afresh only after a step in which
+  // a slot changed hands (a re-sort, a break, a restored state): copied every step, it was 16 bytes
+  // a body of memory traffic for nothing, in a step bound by memory on many threads.
+  std::vector<std::int64_t> m_lastSlotId;
   bool touchedAtLastStep(int a, int b) const;
   // The pairs whose polygons a full test found apart, in candidate order, with the edge that
   // separated them: next step that edge is tried first (only ever to reject; sat.hpp).
