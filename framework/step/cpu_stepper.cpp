@@ -381,9 +381,9 @@ void CpuStepper::narrowphase() {
   // The candidates in two passes. The box pass keeps, part by part over contiguous ranges of the
   // candidates, those whose boxes overlap; the exact pass tests the survivors, cut into parts of
   // equal counts of survivors. The survivors crowd around the vessel, which the curve order keeps
-  // in a few slots, so ranges of candidates would give one task nearly all the exact tests (at
-  // 10^5 floes on 16 threads that one task was the narrowphase). The parts' contacts, joined in
-  // order, are the contacts of one pass over all the pairs.
+  // in a few slots, so ranges of candidates can give one task nearly all the exact tests while the
+  // other threads wait. The parts' contacts, joined in order, are the contacts of one pass over
+  // all the pairs.
   const int pairs = static_cast<int>(m_pairs.size());
   const int tasks = m_pool && pairs >= kParallelPairs ? std::min(pairs / kGrain, kTasksPerThread * m_pool->size()) : 1;
   m_parts.resize(static_cast<size_t>(tasks));
