@@ -33,11 +33,11 @@ class ParallelScope {
 };
 
 // How many tasks a round of work is cut into at most, per thread. Threads take tasks one at a time
-// until none is left, so a round ends at most one task after the last thread to start its final
-// one: with 4 tasks a thread (the first choice) that tail was a seventh of the main thread's time
-// at 10^5 floes on 16 threads (docs/performance.md 3.10). A task costs a call and an atomic
-// increment, nothing next to the 512 bodies or 4,096 pairs it takes at least.
-constexpr int kTasksPerThread = 16;
+// until none is left, so a round ends at most one task after the last thread starts its final
+// one; but each task costs a call, a counter and, in most phases, a part of its own to join. 16 a
+// thread was tried (2026-12-05): no gain beyond the noise on 16 Xeon threads, and 3 % slower at 10^5
+// floes on the development machine's 2 (docs/performance.md 3.10).
+constexpr int kTasksPerThread = 4;
 
 // How many ranges parallelRanges(n, grain, ...) cuts [0, n) into: 1 without a runner or when n is
 // under 4 grains (then waking threads costs more than the work), else at most kTasksPerThread per
