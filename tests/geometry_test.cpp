@@ -468,6 +468,19 @@ Poly randomConvex(std::mt19937& rng, Vec2 centre, Real radius) {
   return p;
 }
 
+// q: p mirrored across one of its edges, picked at random, so that the two share that edge; then
+// moved off it along its normal by up to nudge / 2 either way (touching, a sliver, or a hair apart).
+Poly mirroredAcrossAnEdge(std::mt19937& rng, const Poly& p, Real nudge) {
+  std::uniform_real_distribution<Real> unit(0, 1);
+  const size_t i = static_cast<size_t>(unit(rng) * static_cast<Real>(p.size())) % p.size();
+  const Vec2 a = p[i], e = p[(i + 1) % p.size()] - a, t = (Real(1) / norm(e)) * e;
+  Poly q;
+  for (auto it = p.rbegin(); it != p.rend(); ++it) q.push_back(a + 2 * dot(*it - a, t) * t - (*it - a));
+  const Real by = (unit(rng) - 0.5) * nudge;
+  for (Vec2& v : q) v = v + by * Vec2{t.y, -t.x};
+  return q;
+}
+
 }  // namespace
 
 // Whatever edge is tried (the cache may hold a stale or wrong one), an edge that separates means
@@ -483,13 +496,8 @@ TEST(Geometry, CachedSeparatingEdgeNeverRejectsATouchingPair) {
     const Real r = 0.5 + 5 * unit(rng);
     Poly p = randomConvex(rng, origin, r), q;
     if (trial % 4 == 3) {
-      // q mirrors p across one of p's edges: the two share that edge, then a nudge of a few ulps
-      // to a few nanometres either way (touching, a sliver, or a hair apart).
-      const int i = static_cast<int>(unit(rng) * p.size()) % static_cast<int>(p.size());
-      const Vec2 a = p[i], e = p[(i + 1) % p.size()] - a, t = (Real(1) / norm(e)) * e;
-      for (auto it = p.rbegin(); it != p.rend(); ++it) q.push_back(a + 2 * dot(*it - a, t) * t - (*it - a));
-      const Real nudge = (unit(rng) - 0.5) * 1e-8 * (trial % 8 == 3 ? 1 : 1e-5);
-      for (Vec2& v : q) v = v + nudge * Vec2{t.y, -t.x};
+      // q shares an edge with p, nudged by a few ulps to a few nanometres.
+      q = mirroredAcrossAnEdge(rng, p, trial % 8 == 3 ? 1e-8 : 1e-13);
       ++sharedEdges;
     } else {
       q = randomConvex(rng, origin + 2.5 * r * Vec2{unit(rng) - 0.5, unit(rng) - 0.5}, 0.5 + 5 * unit(rng));
@@ -550,11 +558,7 @@ TEST(Geometry, WitnessSearchGivesThePlainSearchsAnswer) {
     // From deep overlap to well apart, and sharing an edge to within a few nanometres.
     Poly q;
     if (trial % 4 == 3) {
-      const int i = static_cast<int>(unit(rng) * p.size()) % static_cast<int>(p.size());
-      const Vec2 a = p[static_cast<size_t>(i)], e = p[(static_cast<size_t>(i) + 1) % p.size()] - a, t = (Real(1) / norm(e)) * e;
-      for (auto it = p.rbegin(); it != p.rend(); ++it) q.push_back(a + 2 * dot(*it - a, t) * t - (*it - a));
-      const Real nudge = (unit(rng) - 0.5) * 1e-8;
-      for (Vec2& v : q) v = v + nudge * Vec2{t.y, -t.x};
+      q = mirroredAcrossAnEdge(rng, p, 1e-8);
     } else {
       q = randomConvex(rng, origin + 3 * r * unit(rng) * Vec2{unit(rng) - 0.5, unit(rng) - 0.5}, 0.5 + 5 * unit(rng));
     }
@@ -617,12 +621,8 @@ TEST(Geometry, ClipSkipsOnlyEdgesThatCutNothing) {
     const Vec2 origin = trial % 3 == 0 ? Vec2{0, 0} : Vec2{far * unit(rng), -far * unit(rng)};
     const Real r = 0.5 + 5 * unit(rng);
     Poly p = randomConvex(rng, origin, r), q;
-    if (trial % 4 == 3) {  // q mirrors p across one of its edges, nudged
-      const int i = static_cast<int>(unit(rng) * p.size()) % static_cast<int>(p.size());
-      const Vec2 a = p[static_cast<size_t>(i)], e = p[(static_cast<size_t>(i) + 1) % p.size()] - a, t = (Real(1) / norm(e)) * e;
-      for (auto it = p.rbegin(); it != p.rend(); ++it) q.push_back(a + 2 * dot(*it - a, t) * t - (*it - a));
-      const Real nudge = (unit(rng) - 0.5) * 1e-8 * (trial % 8 == 3 ? 1 : 1e-5);
-      for (Vec2& v : q) v = v + nudge * Vec2{t.y, -t.x};
+    if (trial % 4 == 3) {
+      q = mirroredAcrossAnEdge(rng, p, trial % 8 == 3 ? 1e-8 : 1e-13);
     } else if (trial % 4 == 2) {  // a floe against a 24-sided hull
       q = regular(kMaxVertices, 20 * r, unit(rng), origin + 20 * r * Vec2{1 + 0.1 * (unit(rng) - 0.5), 0.2 * (unit(rng) - 0.5)});
     } else {
