@@ -80,10 +80,6 @@ struct ClipWriter {
   }
 };
 
-// Which side of the clip line through a along e the point x lies on: >= 0 is inside (left of a
-// counter-clockwise edge of Q), < 0 outside.
-GEM_HD inline Real clipSide(Vec2 a, Vec2 e, Vec2 x) { return cross(e, x - a); }
-
 // The merge tolerance of clipConvex for polygons p (n vertices) and q (m): vertices closer than
 // this are one vertex. Relative to the smaller body (the overlap's scale) and to the coordinate
 // magnitude (the rounding of world coordinates).
@@ -94,19 +90,9 @@ GEM_HD inline Real clipTolerance(const Vec2* p, int n, const Vec2* q, int m) {
   return kGeomRelTol * (minR(extP, extQ) + maxR(magP, magQ));
 }
 
-// A clip edge's test on P's bounding box (magnitude R: its largest |coordinate|): true when every
-// vertex clipConvex can hold while it clips P is surely inside the line of the edge from a along e,
-// so that clipConvex's pass over them would count none outside and change nothing. The side is
-// linear in the point, so its least value over the box is at one corner; that corner's side must
-// clear the rounding of every side computed in the pass. The vertices are P's (inside the box)
-// and crossings rounded from points of its segments: after up to kMaxVertices clips they lie
-// within about 150 u (R + |a|) of the box, u the unit roundoff, and each side's own rounding is a
-// few u of |e|_1 (R + |a|); 512 epsilon (1024 u) times that clears both several times over.
-GEM_HD inline bool clipEdgeKeepsBox(Vec2 a, Vec2 e, const Box& box, Real magnitude) {
-  const Vec2 corner{e.y >= Real(0) ? box.x1 : box.x0, e.x >= Real(0) ? box.y0 : box.y1};
-  const Real margin = Real(512) * kRealEpsilon * l1Norm(e) * (magnitude + l1Norm(a));
-  return clipSide(a, e, corner) > margin;
-}
+// Which side of the clip line through a along e the point x lies on: >= 0 is inside (left of a
+// counter-clockwise edge of Q), < 0 outside.
+GEM_HD inline Real clipSide(Vec2 a, Vec2 e, Vec2 x) { return cross(e, x - a); }
 
 // Where the segment prev -> cur, with sides sPrev and sCur of opposite signs, crosses the clip
 // line. The signs differ, so the denominator is never zero.
@@ -131,11 +117,6 @@ GEM_HD inline int closeRing(ClipVertex* v, int k, Real tol) {
 GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVertex* out) {
   if (n < 3 || m < 3) return 0;
   const Real tol = detail::clipTolerance(p, n, q, m);
-  // P's bounding box, for the edges that surely leave it whole (detail::clipEdgeKeepsBox). (The
-  // box of the polygon left after each cut rules out a few more edges, but costs more than it saves.)
-  const Box box = boundingBox(p, n);
-  const Real magnitude =
-      detail::maxR(detail::maxR(std::fabs(box.x0), std::fabs(box.x1)), detail::maxR(std::fabs(box.y0), std::fabs(box.y1)));
 
   ClipVertex tmp[kMaxClipVertices];
   ClipVertex* src = out;
@@ -147,9 +128,6 @@ GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVer
   Real side[kMaxClipVertices];
   for (int j = 0; j < m && k >= 3; ++j) {
     Vec2 a = q[j], e = q[j + 1 == m ? 0 : j + 1] - a;
-    // Most of Q's edges face away from the overlap: one corner of P's box shows that they cut
-    // nothing, where the pass below would compute every vertex's side to learn the same.
-    if (detail::clipEdgeKeepsBox(a, e, box, magnitude)) continue;
     // Signed test: cross(e, x - a) >= 0 is inside (left of a counter-clockwise edge). Each
     // vertex's side is computed once and kept for the clipping below; counting instead of
     // branching, as most edges leave the polygon untouched.

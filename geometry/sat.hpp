@@ -4,7 +4,6 @@
 #pragma once
 #include <cmath>
 
-#include "geometry/polygon.hpp"
 #include "geometry/vec2.hpp"
 
 namespace gem {
@@ -16,10 +15,6 @@ namespace gem {
 // Without it, bodies that share an edge touch or overlap at random once rotated into world
 // coordinates (tests/cgal: DegenerateGridPairs).
 constexpr Real kGeomRelTol = sizeof(Real) >= 8 ? Real(1e-12) : Real(1e-6);
-
-// The machine epsilon of Real (2^-52 or 2^-23), spelled out for device code: the scale of the
-// rounding bounds below.
-constexpr Real kRealEpsilon = sizeof(Real) >= 8 ? Real(2.220446049250313e-16) : Real(1.1920929e-7);
 
 // Cheap length scale of a vector without a square root: |a|_1 lies within sqrt(2) of |a|.
 GEM_HD inline Real l1Norm(Vec2 a) { return std::fabs(a.x) + std::fabs(a.y); }
