@@ -566,7 +566,9 @@ TEST(Geometry, WitnessSearchGivesThePlainSearchsAnswer) {
     const SeparatingEdge plain = plainFirstSeparatingEdge(p, q);
     const SeparatingEdge found = findSeparatingEdge(p.data(), n, q.data(), m);
     ASSERT_EQ(found.side, plain.side) << "trial " << trial;
-    if (plain.side >= 0) ASSERT_EQ(found.edge, plain.edge) << "trial " << trial;
+    if (plain.side >= 0) {
+      ASSERT_EQ(found.edge, plain.edge) << "trial " << trial;
+    }
     ASSERT_EQ(convexOverlap(p.data(), n, q.data(), m), plain.side < 0) << "trial " << trial;
     ASSERT_EQ(convexOverlap(q.data(), m, p.data(), n), plain.side < 0) << "trial " << trial;
     for (int i = 0; i < n; ++i) ASSERT_EQ(edgeSeparatesAt(p.data(), n, i, q.data(), m), plainEdgeSeparates(p, i, q)) << "trial " << trial;
