@@ -15,6 +15,8 @@
 namespace gem {
 
 struct Autopilot {
+  // apply reads neither ctx.time nor ctx.step: the same at every step (registry.hpp, eventIsTimeInvariant).
+  static constexpr bool kTimeInvariant = true;
   struct Params {
     Real setHeading;        // rad
     Vec2 trackPoint;        // a point of the set track line, m

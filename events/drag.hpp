@@ -16,6 +16,8 @@
 namespace gem {
 
 struct Drag {
+  // apply reads neither ctx.time nor ctx.step: the same at every step (registry.hpp, eventIsTimeInvariant).
+  static constexpr bool kTimeInvariant = true;
   struct Params {
     Real cd;              // C_d, dimensionless (0.05)
     Real rhoWater;        // kg/m^3 (1025)

@@ -15,6 +15,8 @@
 namespace gem {
 
 struct EnvironmentalForce {
+  // apply reads neither ctx.time nor ctx.step: the same at every step (registry.hpp, eventIsTimeInvariant).
+  static constexpr bool kTimeInvariant = true;
   struct Params {
     Vec2 stress;        // F (cos theta, sin theta), N/m^2
     Vec2 flowVelocity;  // U, m/s

@@ -13,6 +13,8 @@
 namespace gem {
 
 struct Motion {
+  // apply reads neither ctx.time nor ctx.step: the same at every step (registry.hpp, eventIsTimeInvariant).
+  static constexpr bool kTimeInvariant = true;
   struct Params {
     int unused;  // motion has no parameters
   };

@@ -13,6 +13,8 @@
 namespace gem {
 
 struct Propulsion {
+  // apply reads neither ctx.time nor ctx.step: the same at every step (registry.hpp, eventIsTimeInvariant).
+  static constexpr bool kTimeInvariant = true;
   struct Params {
     Real bollardThrust;          // N
     Real resistanceCoefficient;  // C_res, N s^3/m^3

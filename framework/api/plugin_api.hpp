@@ -22,9 +22,10 @@
 // 4: the descriptor note (".gem_plugin"), declared event order, contact slots with normal and
 //    tangential impulses, record streams owned by their events.
 // 5: EventConfig::enabled (a parse knows whether its event is on).
+// 6: EventInstance::timeInvariant (a solo or motion event's kTimeInvariant).
 // Bump on any change to the descriptor, the Registry/EventEntry/BroadphaseEntry layout, the event
 // API structs (framework/api/event_api.hpp) or the World that a plugin's code may see.
-#define GEM_PLUGIN_ABI_VERSION 5
+#define GEM_PLUGIN_ABI_VERSION 6
 
 #define GEM_PLUGIN_STRINGIFY_INNER(x) #x
 #define GEM_PLUGIN_STRINGIFY(x) GEM_PLUGIN_STRINGIFY_INNER(x)

@@ -79,6 +79,8 @@ class EventInstance {
   virtual std::vector<std::int64_t> bodiesRead(const StepRecords&) const { return {}; }
   // The parsed Params, so that a device driver of the same event is made from the very same values.
   virtual const void* params() const = 0;
+  // Solo and motion events: whether the event declares itself time invariant (eventIsTimeInvariant).
+  virtual bool timeInvariant() const { return false; }
 };
 
 // What an event's factory gets: its parameter table (strict) and the whole scenario
@@ -108,6 +110,19 @@ constexpr int eventOrderOf() {
     return Event::kOrder;
   else
     return event_order::kDefault;
+}
+
+// Whether a solo or motion event declares `static constexpr bool kTimeInvariant = true`: its apply
+// reads neither ctx.time nor ctx.step and keeps no state of its own, so a body in the same state
+// gets the same change at every step. The CPU stepper then leaves out a body that its last update
+// left exactly as it was and that touches nothing, while every such event of the run declares it
+// (docs/plugins.md "Time-invariant events"). Undeclared is the safe default: every body every step.
+template <class Event>
+constexpr bool eventIsTimeInvariant() {
+  if constexpr (requires { Event::kTimeInvariant; })
+    return Event::kTimeInvariant;
+  else
+    return false;
 }
 
 struct BroadphaseEntry {
@@ -242,6 +257,7 @@ class CpuSoloDriver final : public EventInstance {
     for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.changes[i], d.ctx);
   }
   const void* params() const override { return &m_params; }
+  bool timeInvariant() const override { return eventIsTimeInvariant<Event>(); }
 
  private:
   Params m_params;
@@ -258,6 +274,7 @@ class CpuMotionDriver final : public EventInstance {
     for (int i = 0; i < d.count; ++i) Event::apply(m_params, d.bodies[i], d.ctx);
   }
   const void* params() const override { return &m_params; }
+  bool timeInvariant() const override { return eventIsTimeInvariant<Event>(); }
 
  private:
   Params m_params;

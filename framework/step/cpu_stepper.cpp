@@ -263,6 +263,9 @@ void CpuStepper::setUp() {
   }
   errors.throwIfAny();
   m_records.reset(m_streams);
+  m_skipStillBodies = std::all_of(m_events.begin(), m_events.end(), [](const EnabledEvent& e) {
+    return (e.phase != EventPhase::Solo && e.phase != EventPhase::Motion) || e.instance->timeInvariant();
+  });
   for (int i = 0; i < m_world.size(); ++i)
     if (m_world.kind[i] == BodyKind::Vessel) m_vesselId = m_world.id[i];
   if (m_scenario.mortonSort) reorderAlongCurve();
@@ -303,6 +306,7 @@ void CpuStepper::restoreState(const StepperState& state) {
   m_lastSlotId.clear();  // "touched before" then comes from state.touching
   m_lastSeparated.clear();
   m_broadphase->invalidate();
+  m_stillnessKnown = false;
   m_vesselId = -1;
   for (int i = 0; i < m_world.size(); ++i)
     if (m_world.kind[i] == BodyKind::Vessel) m_vesselId = m_world.id[i];
@@ -332,6 +336,7 @@ void CpuStepper::reorderAlongCurve() {
   if (m_pool) onThePool = [this](int count, const std::function<void(int)>& task) { m_pool->run(count, task); };
   m_world.permute(m_world.curveOrder(), onThePool, &m_permuteRoom);
   m_broadphase->invalidate();
+  m_stillnessKnown = false;  // the flags are by slot
 }
 
 void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range) {
@@ -357,7 +362,16 @@ void CpuStepper::narrowphase() {
   // seen in this pass over the bodies rather than in a serial one of its own.
   const int lastSlots = static_cast<int>(m_lastSlotId.size());
   std::atomic<bool> slotsChanged{n != lastSlots};
+  // A body the last body updates left still is where it was at the last narrowphase, which set
+  // m_vertexPose to that pose (no slot has changed hands since, or the flags would not be known):
+  // one byte read in place of its id, pose and the pose kept, in a pass bound by memory.
+  const char* stillness = m_stillnessKnown && static_cast<int>(m_stillness.size()) == n ? m_stillness.data() : nullptr;
   forEachBody(n, [&](int i) {
+    if (stillness && stillness[i] != kMoving) {
+      m_moved[i] = 0;
+      m_active[i] = m_byBody.has(i);
+      return;
+    }
     if (i < lastSlots && m_lastSlotId[i] != m_world.id[i]) slotsChanged.store(true, std::memory_order_relaxed);
     // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
     // vertices from an earlier step are still exact, so only bodies that moved are transformed.
@@ -726,6 +740,7 @@ void CpuStepper::step() {
   m_rubbleMass += topology.rubbleMass;
   m_floesBroken += topology.floesBroken;
   if (topology.changed) m_broadphase->invalidate();
+  if (topology.changed || m_world.size() != n) m_stillnessKnown = false;
 
   ++m_step;
   m_time = stepTime(m_step, m_scenario.dt);
@@ -754,15 +769,31 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
   Vec2 vesselImpulse{0, 0};
   m_contactForceOfSlot.resize(n);
   m_contactForceId.resize(n);
+  // The bodies the last updates left still, with no contact now, are left out while the run's solo
+  // and motion events are time invariant (m_stillness): most of a pack rests ahead of the vessel,
+  // and reading each resting body's state every step made this phase bound by memory.
+  m_stillness.resize(static_cast<size_t>(n), kMoving);
+  const char* stillness = m_skipStillBodies && m_stillnessKnown ? m_stillness.data() : nullptr;
+  std::atomic<int> updated{0};
   forEachBlock(n, [&](int begin, int end) {
     // A thread's views of its current block (kBlock bodies at most): cache-sized, made once.
     thread_local std::vector<SoloBody> solo;
     thread_local std::vector<VelocityChange> total;
     thread_local std::vector<MotionBody> motion;
-    solo.resize(kBlock), total.resize(kBlock), motion.resize(kBlock);
-    const int count = end - begin;
+    thread_local std::vector<int> slotOf;     // the slots of the block's bodies that are updated
+    thread_local std::vector<char> touching;  // whether each has contacts this step
+    solo.resize(kBlock), total.resize(kBlock), motion.resize(kBlock), slotOf.resize(kBlock), touching.resize(kBlock);
+    int count = 0;
+    for (int i = begin; i < end; ++i) {
+      const bool hasContacts = m_byBody.has(i);
+      if (stillness && stillness[i] == kStill && !hasContacts) continue;
+      slotOf[count] = i, touching[count] = hasContacts;
+      ++count;
+    }
+    if (count == 0) return;
+    updated.fetch_add(count, std::memory_order_relaxed);
     for (int q = 0; q < count; ++q) {
-      const int i = begin + q;
+      const int i = slotOf[q];
       const BodyKind kind = m_world.kind[i];
       solo[q] = SoloBody{kind,
                          degreesOfFreedom(kind, vesselDof),
@@ -779,8 +810,8 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
     for (auto& e : m_events)
       if (e.phase == EventPhase::Solo) e.instance->runSolo(soloData);
     for (int q = 0; q < count; ++q) {
-      const int i = begin + q;
-      const int own = m_byBody.has(i) ? m_byBody.count[static_cast<size_t>(i)] : 0;
+      const int i = slotOf[q];
+      const int own = touching[q] ? m_byBody.count[static_cast<size_t>(i)] : 0;
       if (own) {  // most bodies have no contact
         Vec2 onBody{0, 0};
         const int* entry = &m_byBody.entries[static_cast<size_t>(m_byBody.start[static_cast<size_t>(i)])];
@@ -806,22 +837,28 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
       if (e.phase == EventPhase::Motion) e.instance->runMotion(motionData);
     // The write-back, only where a bit changed: most floes of a pack rest, and storing their
     // unchanged state dirtied six cache lines per eight bodies, each written back to memory, in a
-    // phase bound by memory on many threads. Compared as bits, so that -0 over +0 is stored.
+    // phase bound by memory on many threads. Compared as bits, so that -0 over +0 is stored, and
+    // a body none of whose bits changed is still.
     using Bits = std::conditional_t<sizeof(Real) == 8, std::uint64_t, std::uint32_t>;
-    auto store = [](Real& to, Real value) {
-      if (std::bit_cast<Bits>(to) != std::bit_cast<Bits>(value)) to = value;
-    };
     for (int q = 0; q < count; ++q) {
-      const int i = begin + q;
+      const int i = slotOf[q];
       const MotionBody& b = motion[q];
+      bool changed = false;
+      auto store = [&changed](Real& to, Real value) {
+        if (std::bit_cast<Bits>(to) != std::bit_cast<Bits>(value)) to = value, changed = true;
+      };
       store(m_world.x[i], b.position.x);
       store(m_world.y[i], b.position.y);
       store(m_world.angle[i], b.angle);
       store(m_world.vx[i], b.velocity.x);
       store(m_world.vy[i], b.velocity.y);
       store(m_world.omega[i], b.omega);
+      const char now = changed ? kMoving : touching[q] ? kStillInContact : kStill;
+      if (m_stillness[static_cast<size_t>(i)] != now) m_stillness[static_cast<size_t>(i)] = now;
     }
   });
+  m_stillnessKnown = true;
+  m_updatedBodies = updated.load(std::memory_order_relaxed);
   m_vesselIceForce = forceOfImpulse(vesselImpulse, m_scenario.dt);
   m_contactForcesBuilt = false;
 }

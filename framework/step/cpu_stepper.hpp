@@ -42,7 +42,12 @@ class CpuStepper final : public Stepper {
 
   void step() override;
 
-  World& world() { return m_world; }
+  // An edit through this reference, made before the next step(), is seen by it: the stepper then
+  // takes no body for still (m_stillness) and reads every body afresh.
+  World& world() {
+    m_stillnessKnown = false;
+    return m_world;
+  }
   const World& world() const { return m_world; }
   const Scenario& scenario() const { return m_scenario; }
   long stepIndex() const override { return m_step; }
@@ -63,6 +68,9 @@ class CpuStepper final : public Stepper {
   // Pairs whose boxes overlap that an edge separated (those tested: a pair at rest is not).
   int separatedCount() const { return static_cast<int>(m_lastSeparated.size()); }
   int threads() const { return m_pool ? m_pool->size() : 1; }  // after the first step
+  // Bodies the last step's body updates ran for: the others were still and touched nothing
+  // (m_stillness below).
+  int updatedBodies() const { return m_updatedBodies; }
   // The sizes from which a phase runs on the pool at all (docs/performance.md 3.8).
   static constexpr int kParallelBodies = 2048, kParallelPairs = 2048;
   // Contacts from which the pair events run over ranges of contacts, kContactGrain at least a range.
@@ -135,6 +143,18 @@ class CpuStepper final : public Stepper {
   std::vector<Pose> m_vertexPose;    // the pose m_worldVertices and m_boxes were computed for, by slot
   std::vector<char> m_moved;         // this step: the body's pose differs from the last step's
   std::vector<char> m_active;        // this step: moved, or in a contact at the last step
+  // By slot, what the last body updates did to each body (docs/performance.md 3.12): kMoving (a bit
+  // of its position, angle or velocities changed), kStillInContact (none did, but it had contacts)
+  // or kStill (neither). Known while no slot has changed hands and nothing has edited the world
+  // since (m_stillnessKnown). The narrowphase takes a still body's pose for unchanged without
+  // reading it. The body updates leave out a kStill body that has no contact now, while every solo
+  // and motion event of the run is time invariant (m_skipStillBodies): the same state, no contact
+  // and the same events give the very same bits, so its update would write nothing.
+  enum Stillness : char { kMoving = 0, kStillInContact = 1, kStill = 2 };
+  std::vector<char> m_stillness;
+  bool m_stillnessKnown = false;
+  bool m_skipStillBodies = false;
+  int m_updatedBodies = 0;
   std::vector<CandidatePair> m_pairs;
   std::vector<int> m_contactA, m_contactB;
   std::vector<PairContact> m_contacts;

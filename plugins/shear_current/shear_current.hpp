@@ -15,6 +15,8 @@
 namespace gem {
 
 struct ShearCurrent {
+  // apply reads neither ctx.time nor ctx.step: the same at every step (registry.hpp, eventIsTimeInvariant).
+  static constexpr bool kTimeInvariant = true;
   struct Params {
     Real u0;           // current speed along x at y = y_ref, m/s (0.2)
     Real shear;        // dU/dy, 1/s (0.01)
