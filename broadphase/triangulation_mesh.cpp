@@ -34,6 +34,8 @@ class TriangulationMesh final : public KeptListBroadphase {
   static constexpr const char* kSettings[] = {"skin"};  // docs/scenario.md [broadphase.NAME]
   explicit TriangulationMesh(const BroadphaseSettings& s) : KeptListBroadphase(checkedSettings(s).skin) {}
   std::string name() const override { return "triangulation_mesh"; }
+  // Its triangles are kept by slot, refreshed by a build: renamed bodies rebuild.
+  void bodiesRenamed() override { invalidate(); }
 
  protected:
   void build(const World& world, NeighbourList& list) override {

@@ -546,6 +546,62 @@ TEST(Broadphase, InvalidateAfterTopologyChanges) {
   checkAll(w, all, "permute, no invalidate");
 }
 
+// A break (bodies removed, new ones appended) and a re-sort (every body to another slot) told by
+// bodiesRenamed(): the kept lists follow the bodies by id (NeighbourList::followRenamed) without a
+// rebuild, the new floes direct and then relisted, and every strategy still proposes exactly what
+// it did (the circle strategies all_pairs's set), through the moves after each.
+TEST(Broadphase, KeptListsFollowRenamedBodiesWithoutARebuild) {
+  World w = randomWorld(13, 300, 140);
+  auto all = makeAll();
+  std::mt19937 rng(9);
+  checkAll(w, all, "before");
+  auto keptLists = [&] {
+    std::vector<const NeighbourList*> lists;
+    for (auto& b : all)
+      if (b->name() == "variable_radius" || b->name() == "fixed_radius") lists.push_back(&dynamic_cast<KeptListBroadphase&>(*b).list());
+    return lists;
+  };
+  ASSERT_EQ(keptLists().size(), 2u);
+  for (int k = 0; k < 4; ++k) {
+    jiggle(w, rng, Real(0.05), Real(0.005));
+    checkAll(w, all, "small moves " + std::to_string(k));
+  }
+  std::vector<long> built;
+  for (const NeighbourList* list : keptLists()) built.push_back(list->rebuilds());
+
+  // A break: every fifth floe goes, twenty new floes come at the end.
+  std::vector<char> remove(w.size(), 0);
+  for (int i = 0; i < w.size(); i += 5)
+    if (w.kind[i] == BodyKind::Floe) remove[i] = 1;
+  w.removeBodies(remove);
+  std::uniform_real_distribution<Real> place(0, 140);
+  for (int k = 0; k < 20; ++k) w.addBody(spec(BodyKind::Floe, regularPolygon({place(rng), place(rng)}, 2, 6, place(rng))));
+  for (auto& b : all) b->bodiesRenamed();
+  checkAll(w, all, "after a break");
+  for (const NeighbourList* list : keptLists()) EXPECT_EQ(list->follows(), 1);
+  for (int k = 0; k < 3; ++k) {
+    jiggle(w, rng, Real(0.05), Real(0.005));
+    checkAll(w, all, "after a break, moves " + std::to_string(k));
+  }
+  for (const NeighbourList* list : keptLists()) EXPECT_GE(list->relists(), 1) << "the new floes should have been relisted";
+
+  // The re-sort: every body to another slot.
+  std::vector<int> order(w.size());
+  for (int i = 0; i < w.size(); ++i) order[i] = w.size() - 1 - i;
+  w.permute(order);
+  for (auto& b : all) b->bodiesRenamed();
+  checkAll(w, all, "after a re-sort");
+  for (int k = 0; k < 3; ++k) {
+    jiggle(w, rng, Real(0.05), Real(0.005));
+    checkAll(w, all, "after a re-sort, moves " + std::to_string(k));
+  }
+  const std::vector<const NeighbourList*> lists = keptLists();
+  for (size_t k = 0; k < lists.size(); ++k) {
+    EXPECT_EQ(lists[k]->follows(), 2);
+    EXPECT_EQ(lists[k]->rebuilds(), built[k]) << "a rename was followed by a rebuild";
+  }
+}
+
 TEST(Broadphase, SettingsVariants) {
   World w = randomWorld(21, 200, 120);
   std::mt19937 rng(3);

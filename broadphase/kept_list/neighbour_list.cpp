@@ -13,6 +13,10 @@ namespace gem {
 
 NeighbourList::Need NeighbourList::update(const World& world) {
   if (!m_valid) return Need::Rebuild;
+  if (m_renamed) {
+    m_renamed = false;
+    if (!followRenamed(world)) return Need::Rebuild;
+  }
   const int n = world.size();
   if (n != static_cast<int>(m_x0.size())) return Need::Rebuild;
   const Real* x = world.x.data();
@@ -55,6 +59,87 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   const int direct = static_cast<int>(m_directList.size());
   if (direct <= kMaxDirect) return Need::Nothing;
   return m_relistedSinceBuild + direct > n / 8 ? Need::Rebuild : Need::Relist;
+}
+
+// After bodiesRenamed(): a break removed some bodies and added others, or the re-sort moved every
+// body to another slot, and the rest kept their ids, shapes and states. A full build costs about as
+// much as 20 steps at 10^5 floes, and the vessel's breaks and the re-sort asked for one every 50 to
+// 100 steps. Instead each listed pair is renamed to its bodies' new slots (a pair of a removed body
+// goes) and each body takes its reference state with it, so the list stays what the rule of
+// docs/model.md 9 needs: every pair within reach of the references, the references within half a
+// skin of where the bodies are. A new body has no pairs listed: it is direct from now on (the
+// direct pass finds its pairs every step until it is relisted), its reference where it is now. The
+// candidates, the pairs whose circles overlap, are the same as after a build. Returns false (the
+// caller rebuilds) when the ids cannot be followed: negative, repeated, or too sparse for a table.
+bool NeighbourList::followRenamed(const World& world) {
+  const int n = world.size();
+  const size_t oldCount = m_id0.size();
+  std::int64_t largest = -1;
+  for (const std::int64_t id : world.id) largest = std::max(largest, id);
+  for (const std::int64_t id : m_id0) largest = std::max(largest, id);
+  if (largest >= 4 * static_cast<std::int64_t>(n + oldCount) + 1024) return false;
+  m_slotOfId.assign(static_cast<size_t>(largest) + 1, -1);
+  for (int i = 0; i < n; ++i) {
+    const std::int64_t id = world.id[static_cast<size_t>(i)];
+    if (id < 0 || m_slotOfId[static_cast<size_t>(id)] >= 0) return false;
+    m_slotOfId[static_cast<size_t>(id)] = i;
+  }
+  m_newSlot.resize(oldCount);
+  std::vector<char> known(static_cast<size_t>(n), 0);
+  for (size_t j = 0; j < oldCount; ++j) {
+    if (m_id0[j] < 0) return false;
+    const int i = m_slotOfId[static_cast<size_t>(m_id0[j])];
+    m_newSlot[j] = i;
+    if (i >= 0) known[static_cast<size_t>(i)] = 1;
+  }
+  // The reference state and the flags move with their bodies; a new body starts direct.
+  std::vector<Real> x0(static_cast<size_t>(n)), y0(static_cast<size_t>(n)), angle0(static_cast<size_t>(n));
+  std::vector<std::int64_t> id0(static_cast<size_t>(n));
+  std::vector<char> direct(static_cast<size_t>(n)), masked(static_cast<size_t>(n));
+  for (size_t j = 0; j < oldCount; ++j) {
+    const int i = m_newSlot[j];
+    if (i < 0) continue;
+    const size_t k = static_cast<size_t>(i);
+    x0[k] = m_x0[j], y0[k] = m_y0[j], angle0[k] = m_angle0[j], id0[k] = m_id0[j];
+    direct[k] = m_direct[j], masked[k] = m_masked[j];
+  }
+  std::vector<int> directList;
+  for (const int v : m_directList)
+    if (m_newSlot[static_cast<size_t>(v)] >= 0) directList.push_back(m_newSlot[static_cast<size_t>(v)]);
+  for (int i = 0; i < n; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    if (known[k]) continue;
+    x0[k] = world.x[k], y0[k] = world.y[k], angle0[k] = world.angle[k], id0[k] = world.id[k];
+    direct[k] = masked[k] = 1;
+    directList.push_back(i);
+  }
+  m_x0.swap(x0), m_y0.swap(y0), m_angle0.swap(angle0), m_id0.swap(id0);
+  m_direct.swap(direct), m_masked.swap(masked), m_directList.swap(directList);
+  m_relisting.assign(static_cast<size_t>(n), 0);
+  // The pairs renamed, each with its reach (the two shapes are the same). Removing bodies keeps the
+  // order of the others, and the pairs stay sorted; a re-sort is sorted again by rows.
+  auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
+  auto rename = [&](std::vector<ListedPair>& pairs) {
+    size_t kept = 0;
+    bool sorted = true;
+    for (const ListedPair& p : pairs) {
+      const int a = m_newSlot[static_cast<size_t>(p.a)], b = m_newSlot[static_cast<size_t>(p.b)];
+      if (a < 0 || b < 0) continue;
+      const ListedPair q{std::min(a, b), std::max(a, b), p.reach2};
+      if (kept > 0 && !before(pairs[kept - 1], q)) sorted = false;
+      pairs[kept++] = q;
+    }
+    pairs.resize(kept);
+    return sorted;
+  };
+  if (!rename(m_pairs)) {
+    begin(1);
+    m_raw[0].swap(m_pairs);
+    sortRaw(n);
+  }
+  if (!rename(m_sidePairs)) std::sort(m_sidePairs.begin(), m_sidePairs.end(), before);
+  ++m_follows;
+  return true;
 }
 
 // The relisted floes' new pairs (each floe against every body, like the direct pass, over ranges of
@@ -278,6 +363,7 @@ void NeighbourList::finish(const World& world) {
     if (m_direct[static_cast<size_t>(i)]) m_directList.push_back(i);
   m_sidePairs.clear();
   m_valid = true;
+  m_renamed = false;  // built from the bodies as they are
   m_relistedSinceBuild = 0;
   ++m_rebuilds;
 }

@@ -73,7 +73,11 @@ class NeighbourList {
   // nanoseconds each), bodies of an O(1) pass.
   static constexpr int kPairGrain = 4096, kBodyGrain = 1024;
   void invalidate() { m_valid = false; }
+  // Bodies were added, removed or moved to other slots, the rest unchanged: the next update()
+  // follows them by id (followRenamed) instead of rebuilding.
+  void bodiesRenamed() { m_renamed = true; }
   long rebuilds() const { return m_rebuilds; }
+  long follows() const { return m_follows; }  // renames followed without a rebuild
 
   // Building: begin, add each pair once (a != b, either order), finish. finish() drops wall-wall
   // pairs (two immovable bodies never interact), sorts by (a, b) when the pairs did not come in
@@ -94,10 +98,13 @@ class NeighbourList {
 
  private:
   void sortRaw(int bodyCount);
+  bool followRenamed(const World& world);
   static constexpr int kShortRow = 32;  // rows up to this long are insertion-sorted
   Real m_skin;
   bool m_valid = false;
-  long m_rebuilds = 0, m_relists = 0;
+  bool m_renamed = false;
+  long m_rebuilds = 0, m_relists = 0, m_follows = 0;
+  std::vector<int> m_slotOfId, m_newSlot;  // followRenamed's scratch: by id, and by old slot
   int m_relistedSinceBuild = 0;
   std::vector<std::vector<ListedPair>> m_raw;  // the build's parts
   std::vector<ListedPair> m_pairs, m_kept;
@@ -135,6 +142,7 @@ class KeptListBroadphase : public Broadphase {
   explicit KeptListBroadphase(Real skin) : m_list(skin) {}
   void findCandidates(const World& world, std::vector<CandidatePair>& pairs) override;
   void invalidate() override { m_list.invalidate(); }
+  void bodiesRenamed() override { m_list.bodiesRenamed(); }
   long rebuilds() const override { return m_list.rebuilds(); }
   // The kept list itself, for tests and benchmarks.
   const NeighbourList& list() const { return m_list; }

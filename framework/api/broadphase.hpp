@@ -86,6 +86,10 @@ class Broadphase {
   virtual void findCandidates(const World& world, std::vector<CandidatePair>& pairs) = 0;
   // Bodies were added, removed or reordered: any kept list is stale.
   virtual void invalidate() = 0;
+  // Bodies were added, removed or moved to other slots (a break, the re-sort), and every other
+  // body kept its id, shape and state: a strategy that can follow the bodies by id may keep its
+  // list (the kept lists do, docs/model.md 9); by default it is invalidate().
+  virtual void bodiesRenamed() { invalidate(); }
   // How many times the strategy has (re)built its structure: for benchmarks and tests.
   virtual long rebuilds() const { return 0; }
 };

@@ -335,7 +335,7 @@ void CpuStepper::reorderAlongCurve() {
   World::TaskRunner onThePool;
   if (m_pool) onThePool = [this](int count, const std::function<void(int)>& task) { m_pool->run(count, task); };
   m_world.permute(m_world.curveOrder(), onThePool, &m_permuteRoom);
-  m_broadphase->invalidate();
+  m_broadphase->bodiesRenamed();
   m_stillnessKnown = false;  // the flags are by slot
 }
 
@@ -739,7 +739,7 @@ void CpuStepper::step() {
   }
   m_rubbleMass += topology.rubbleMass;
   m_floesBroken += topology.floesBroken;
-  if (topology.changed) m_broadphase->invalidate();
+  if (topology.changed) m_broadphase->bodiesRenamed();  // removeBodies and addBody only (TopologyData)
   if (topology.changed || m_world.size() != n) m_stillnessKnown = false;
 
   ++m_step;
