@@ -68,8 +68,8 @@ class CpuStepper final : public Stepper {
   // Pairs whose boxes overlap that an edge separated (those tested: a pair at rest is not).
   int separatedCount() const { return static_cast<int>(m_lastSeparated.size()); }
   int threads() const { return m_pool ? m_pool->size() : 1; }  // after the first step
-  // Bodies the last step's body updates ran for: the others were still and touched nothing
-  // (m_stillness below).
+  // Bodies the last step's body updates ran for: the others were in blocks of still bodies that
+  // touched nothing (m_stillness below).
   int updatedBodies() const { return m_updatedBodies; }
   // The sizes from which a phase runs on the pool at all (docs/performance.md 3.8).
   static constexpr int kParallelBodies = 2048, kParallelPairs = 2048;
@@ -147,9 +147,10 @@ class CpuStepper final : public Stepper {
   // of its position, angle or velocities changed), kStillInContact (none did, but it had contacts)
   // or kStill (neither). Known while no slot has changed hands and nothing has edited the world
   // since (m_stillnessKnown). The narrowphase takes a still body's pose for unchanged without
-  // reading it. The body updates leave out a kStill body that has no contact now, while every solo
-  // and motion event of the run is time invariant (m_skipStillBodies): the same state, no contact
-  // and the same events give the very same bits, so its update would write nothing.
+  // reading it. The body updates leave out a block of kStill bodies none of which has a contact
+  // now, while every solo and motion event of the run is time invariant (m_skipStillBodies): the
+  // same state, no contact and the same events give the very same bits, so its update would write
+  // nothing.
   enum Stillness : char { kMoving = 0, kStillInContact = 1, kStill = 2 };
   std::vector<char> m_stillness;
   bool m_stillnessKnown = false;
