@@ -772,9 +772,8 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
   // A block whose bodies the last updates all left still, none with a contact now, is left out
   // while the run's solo and motion events are time invariant (m_stillness): most of a pack rests
   // ahead of the vessel, and reading each resting body's state every step made this phase bound by
-  // memory. Whole blocks only (bodies in curve order, so a resting stretch of the pack is a run of
-  // blocks): leaving out single bodies cost the 824-floe field, where most floes move, 2 % more
-  // instructions in all, for the indirection and the test of every body.
+  // memory. Whole blocks only: bodies are in curve order, so a resting stretch of the pack is a run
+  // of blocks, and a block is tested in a few loads where single bodies took a slot list.
   m_stillness.resize(static_cast<size_t>(n), kMoving);
   const char* stillness = m_skipStillBodies && m_stillnessKnown ? m_stillness.data() : nullptr;
   std::atomic<int> updated{0};
