@@ -62,9 +62,9 @@ NeighbourList::Need NeighbourList::update(const World& world) {
 }
 
 // After bodiesRenamed(): a break removed some bodies and added others, or the re-sort moved every
-// body to another slot, and the rest kept their ids, shapes and states. A full build costs about as
-// much as 20 steps at 10^5 floes, and the vessel's breaks and the re-sort asked for one every 50 to
-// 100 steps. Instead each listed pair is renamed to its bodies' new slots (a pair of a removed body
+// body to another slot, and the rest kept their ids, shapes and states. A full build costs several
+// steps at 10^5 floes, and the vessel's breaks and the re-sort asked for one every 50 to 100 steps
+// (docs/performance.md 3.12). Instead each listed pair is renamed to its bodies' new slots (a pair of a removed body
 // goes) and each body takes its reference state with it, so the list stays what the rule of
 // docs/model.md 9 needs: every pair within reach of the references, the references within half a
 // skin of where the bodies are. A new body has no pairs listed: it is direct from now on (the
