@@ -845,15 +845,15 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
       const MotionBody& b = motion[q];
       const Bits changed = differ(m_world.x[i], b.position.x) | differ(m_world.y[i], b.position.y) | differ(m_world.angle[i], b.angle) |
                            differ(m_world.vx[i], b.velocity.x) | differ(m_world.vy[i], b.velocity.y) | differ(m_world.omega[i], b.omega);
-      char& stillness = m_stillness[static_cast<size_t>(i)];
+      char& flag = m_stillness[static_cast<size_t>(i)];
       if (changed) {
         m_world.x[i] = b.position.x, m_world.y[i] = b.position.y, m_world.angle[i] = b.angle;
         m_world.vx[i] = b.velocity.x, m_world.vy[i] = b.velocity.y, m_world.omega[i] = b.omega;
-        if (stillness != kMoving) stillness = kMoving;
+        if (flag != kMoving) flag = kMoving;
         continue;
       }
       const char now = m_byBody.has(i) ? kStillInContact : kStill;
-      if (stillness != now) stillness = now;
+      if (flag != now) flag = now;
     }
   });
   m_stillnessKnown = true;
