@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "framework/api/registry.hpp"
-#include "framework/api/table_reader.hpp"
 #include "framework/step/cpu_stepper.hpp"
 #include "test_support.hpp"
 

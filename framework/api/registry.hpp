@@ -114,9 +114,10 @@ constexpr int eventOrderOf() {
 
 // Whether a solo or motion event declares `static constexpr bool kTimeInvariant = true`: its apply
 // reads neither ctx.time nor ctx.step and keeps no state of its own, so a body in the same state
-// gets the same change at every step. The CPU stepper then leaves out a body that its last update
-// left exactly as it was and that touches nothing, while every such event of the run declares it
-// (docs/plugins.md "Time-invariant events"). Undeclared is the safe default: every body every step.
+// gets the same change at every step. While every such event of the run declares it, the CPU
+// stepper leaves out a block of 256 bodies whose last update left each exactly as it was and none of
+// which touches anything (docs/plugins.md "Time-invariant solo and motion events"). Undeclared is
+// the safe default: every body every step.
 template <class Event>
 constexpr bool eventIsTimeInvariant() {
   if constexpr (requires { Event::kTimeInvariant; })
