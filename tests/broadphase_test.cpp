@@ -18,6 +18,7 @@
 #include "framework/api/errors.hpp"
 #include "framework/api/parallel.hpp"
 #include "framework/api/registry.hpp"
+#include "framework/api/still_bodies.hpp"
 #include "framework/step/thread_pool.hpp"
 #include "framework/world/world.hpp"
 
@@ -376,7 +377,7 @@ TEST(Broadphase, MovingBodiesNeverMissed) {
 
 // Relisting (NeighbourList::relistDirect) under the motion it is for and the motion that tests its
 // 1.5-skin reach: each step a few floes jump 1.2 m (past half the skin: direct, then relisted once
-// more than kMaxDirect are), while every floe swings about its own base by up to 0.49 m, each in
+// more than kRelistPast are), while every floe swings about its own base by up to 0.49 m, each in
 // its own phase and direction, so that a floe listed at a relist can close in on a relisted one from
 // the far end of its swing. Every step, every kept-list strategy gives all_pairs' candidates.
 TEST(Broadphase, RelistedFloesNeverMissAPair) {
@@ -479,7 +480,7 @@ TEST(Broadphase, RebuildOnlyWhenNeeded) {
     EXPECT_EQ(list.directCount(), vessels);  // a build starts afresh
 
     // Every movable body moving 0.3 m a step: all pass half the skin at k = 4, far more than
-    // kMaxDirect of them, so the list is rebuilt then.
+    // kRelistPast of them, so the list is rebuilt then.
     for (int k = 1; k <= 4; ++k) {
       for (int i = 0; i < w.size(); ++i)
         if (w.kind[i] != BodyKind::Wall) w.y[i] += Real(0.3);
@@ -599,6 +600,85 @@ TEST(Broadphase, KeptListsFollowRenamedBodiesWithoutARebuild) {
   for (size_t k = 0; k < lists.size(); ++k) {
     EXPECT_EQ(lists[k]->follows(), 2);
     EXPECT_EQ(lists[k]->rebuilds(), built[k]) << "a rename was followed by a rebuild";
+  }
+}
+
+// The CPU stepper tells the broadphase which bodies its last step left still
+// (framework/api/still_bodies.hpp), and a kept list then skips their displacement checks. Told
+// truly, a list gives every step the candidates of a list told nothing: here a wake of floes moves
+// across a resting field, a few floes jump past half the skin (direct, then relisted), and the
+// rest keep still. On one thread with the exact pairs checked, and on a pool of three over 6,000
+// floes (the flags are read on the caller's thread and used on the pool's). Told falsely, a moved
+// floe is not judged: the list really does skip what it is told is still.
+TEST(Broadphase, KeptListsToldWhichBodiesAreStillGiveTheSameCandidates) {
+  for (const int floes : {400, 6000}) {
+    World w = randomWorld(23, floes, floes == 400 ? Real(130) : Real(500));
+    const Real side = floes == 400 ? Real(130) : Real(500);
+    ThreadPool pool(3);
+    const ParallelScope lend(floes == 400 ? nullptr : &pool);
+    BroadphaseSettings s;
+    s.skin = 2;
+    std::vector<std::unique_ptr<Broadphase>> told, plain;
+    for (const char* name : {"variable_radius", "fixed_radius", "triangulation_mesh"})
+      told.push_back(make(name, s)), plain.push_back(make(name, s));
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<Real> u(-1, 1);
+    std::uniform_int_distribution<int> pick(0, w.size() - 1);
+    std::vector<char> still(static_cast<size_t>(w.size()), 0);
+    std::vector<CandidatePair> a, b;
+    long stillSeen = 0;
+    for (int step = 0; step < 60; ++step) {
+      const Real front = side * static_cast<Real>(step) / 60;  // the wake: floes within 15 m behind it drift
+      for (int i = 0; i < w.size(); ++i) {
+        const bool moves = w.kind[i] != BodyKind::Wall && w.x[i] < front && w.x[i] > front - 15;
+        still[static_cast<size_t>(i)] = !moves;
+        if (!moves) continue;
+        w.x[i] += Real(0.15) + Real(0.02) * u(rng), w.y[i] += Real(0.05) * u(rng), w.angle[i] += Real(0.01) * u(rng);
+      }
+      for (int jumps = 0; jumps < 3; ++jumps) {
+        const int i = pick(rng);
+        if (w.kind[i] != BodyKind::Floe) continue;
+        w.x[i] += Real(1.2) * u(rng), w.y[i] += Real(1.2) * u(rng);
+        still[static_cast<size_t>(i)] = 0;
+      }
+      for (size_t k = 0; k < told.size(); ++k) {
+        {
+          const StillBodiesScope tell(step > 0 ? still.data() : nullptr);  // nothing is known before the first call
+          told[k]->findCandidates(w, a);
+        }
+        plain[k]->findCandidates(w, b);
+        ASSERT_EQ(toSet(a), toSet(b)) << told[k]->name() << " step " << step << " floes " << floes;
+        if (floes == 400 && step % 10 == 0) checkCandidates(w, toSet(a), truthPairs(w), told[k]->name() + " step " + std::to_string(step));
+      }
+      if (step > 0) stillSeen += std::count(still.begin(), still.end(), 1);
+    }
+    EXPECT_GT(stillSeen, 60L * w.size() / 2) << "most bodies should have been still";
+    for (size_t k = 0; k < told.size(); ++k) {
+      const NeighbourList& list = dynamic_cast<const KeptListBroadphase&>(*told[k]).list();
+      EXPECT_GE(list.relists(), 1) << told[k]->name() << ": relisting went untested";
+    }
+
+    // Told falsely: a floe that has moved 1.5 m, past half the skin, said to be still.
+    int f = -1;
+    const NeighbourList& toldList = dynamic_cast<const KeptListBroadphase&>(*told[0]).list();
+    const NeighbourList& plainList = dynamic_cast<const KeptListBroadphase&>(*plain[0]).list();
+    for (int i = 0; i < w.size() && f < 0; ++i)
+      if (w.kind[i] == BodyKind::Floe && w.x[i] > side / 2 + 20) f = i;  // out of the wake, not direct
+    ASSERT_GE(f, 0);
+    std::fill(still.begin(), still.end(), 1);
+    told[0]->invalidate(), plain[0]->invalidate();  // built afresh: only the vessel is direct
+    told[0]->findCandidates(w, a), plain[0]->findCandidates(w, b);
+    w.x[f] += Real(1.5);
+    const int before = toldList.directCount();
+    ASSERT_EQ(before, plainList.directCount());
+    ASSERT_LE(before + 1, NeighbourList::kRelistPast) << "one more direct body must not start a relist here";
+    {
+      const StillBodiesScope tell(still.data());
+      told[0]->findCandidates(w, a);
+    }
+    plain[0]->findCandidates(w, b);
+    EXPECT_EQ(plainList.directCount(), before + 1) << "the moved floe is direct when judged";
+    EXPECT_EQ(toldList.directCount(), before) << "a body said to be still was judged anyway";
   }
 }
 

@@ -114,10 +114,12 @@ TEST(Threads, KeptListsBuildAndFilterTheSameOnAnyThreadCount) {
     std::mt19937 random(7);
     bool sawDirect = false;
     for (int call = 0; call < 12; ++call) {
-      // Odd calls move 3 floes past half the skin (direct, no rebuild), calls 2 and 6 40 (relisted:
-      // within an eighth of the bodies), the other even ones a third of the bodies (a rebuild).
+      // Odd calls move 2 floes past half the skin (direct, no relist: kRelistPast), calls 2 and 6
+      // 40 (relisted: within an eighth of the bodies), the other even ones a third of the bodies (a
+      // rebuild).
+      static_assert(NeighbourList::kRelistPast >= 3, "the vessel and 2 floes must stay direct");
       std::uniform_int_distribution<int> body(0, world.size() - 1);
-      const int moves = call % 2 ? 3 : call % 4 == 2 ? 40 : world.size() / 3;
+      const int moves = call % 2 ? 2 : call % 4 == 2 ? 40 : world.size() / 3;
       for (int moved = 0; moved < moves; ++moved) {
         const int i = body(random);
         if (world.kind[i] != BodyKind::Floe) continue;

@@ -8,6 +8,7 @@
 
 #include "framework/api/errors.hpp"
 #include "framework/api/parallel.hpp"
+#include "framework/api/still_bodies.hpp"
 
 namespace gem {
 
@@ -25,6 +26,10 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   const Real* radius = world.radius.data();
   const std::int64_t* id = world.id.data();
   const Real limit = kRebuildTrigger * m_skin / 2;
+  // A body the stepper's last step left still (framework/api/still_bodies.hpp) is in the slot, and
+  // at the pose, that the last update judged: the same answer, for one byte read in place of nine
+  // values. Read here, on the caller's thread: the scope is not the pool's.
+  const char* still = stillBodies();
   // Over ranges of bodies, each range's newly direct bodies into a part of its own, appended in
   // range order: the same list as one pass.
   const int tasks = parallelTasks(n, kBodyGrain);
@@ -34,6 +39,7 @@ NeighbourList::Need NeighbourList::update(const World& world) {
     std::vector<int>& part = m_newlyDirect[static_cast<size_t>(t)];
     part.clear();
     for (long i = begin; i < end; ++i) {
+      if (still && still[i]) continue;
       // A reorder or an in-place replacement without invalidate() would make the list point at the
       // wrong bodies: the ids guard against it for the price of one load per body.
       if (id[i] != m_id0[static_cast<size_t>(i)]) {
@@ -57,7 +63,7 @@ NeighbourList::Need NeighbourList::update(const World& world) {
     if (r) return Need::Rebuild;
   for (const std::vector<int>& part : m_newlyDirect) m_directList.insert(m_directList.end(), part.begin(), part.end());
   const int direct = static_cast<int>(m_directList.size());
-  if (direct <= kMaxDirect) return Need::Nothing;
+  if (direct <= kRelistPast) return Need::Nothing;
   return m_relistedSinceBuild + direct > n / 8 ? Need::Rebuild : Need::Relist;
 }
 

@@ -16,9 +16,9 @@
 // is missed. The vessel is always direct (it moves at several m/s through resting ice and would
 // set the rebuild rate alone), and so are the few floes it is shoving.
 //
-// When more than kMaxDirect bodies are direct, the direct floes are *relisted* rather than the whole
-// list rebuilt (at 10^5 floes the vessel's wake passed kMaxDirect every 5 steps, and a rebuild cost
-// two steps): each one's pairs are listed afresh from where it is now, with the reach
+// When more than kRelistPast bodies are direct, the direct floes are *relisted* rather than the
+// whole list rebuilt (at 10^5 floes the vessel's wake passed 8 direct bodies every 5 steps, and a
+// rebuild cost two steps): each one's pairs are listed afresh from where it is now, with the reach
 // R_a + R_b + 1.5 skin, into a side list, its pairs in the main list are masked from then on, and
 // its reference state becomes its state now. Why 1.5 skin: take a pair and the last time T it was
 // judged, by the build or by relisting either body. If neither is direct now, neither has been
@@ -57,15 +57,24 @@ class NeighbourList {
 
   Real skin() const { return m_skin; }
   // What the list needs before this step's filter. Rebuild: never built, invalidated, body count or
-  // identities changed, or more than kMaxDirect bodies are direct and relisting them would pass the
-  // budget (an eighth of the bodies since the build). Relist: more than kMaxDirect are direct,
+  // identities changed, or more than kRelistPast bodies are direct and relisting them would pass
+  // the budget (an eighth of the bodies since the build). Relist: more than kRelistPast are direct,
   // within the budget (relistDirect()). Otherwise marks every body that has moved more than half
-  // the skin since its reference as direct. One pass over the bodies.
+  // the skin since its reference as direct. One pass over the bodies, but those the stepper says
+  // are still (framework/api/still_bodies.hpp): their answer is the last one.
   enum class Need { Nothing, Relist, Rebuild };
   Need update(const World& world);
   // The direct floes' rows listed afresh from where they are now (see above); they stop being direct.
   void relistDirect(const World& world);
   int directCount() const { return static_cast<int>(m_directList.size()); }
+  // Direct bodies (the vessel among them) past which the CPU list relists the floes. A direct floe
+  // costs a pass over every body each step, its relisting about one such pass: relisting early
+  // won on the 824-floe field (callgrind, 2100 steps: 3.64 billion instructions with 3 or 1,
+  // 3.72 with 8, 3.83 with 16) and changed nothing measurable at 10^5 floes (docs/performance.md
+  // 3.13). The candidates are the same whenever it relists.
+  static constexpr int kRelistPast = 3;
+  // The direct bodies the device list holds beyond the always-direct ones before it rebuilds
+  // (device_neighbour_list.cuh: the device does not relist).
   static constexpr int kMaxDirect = 8;
   static constexpr Real kRelistReach = Real(1.5);  // skins
   long relists() const { return m_relists; }

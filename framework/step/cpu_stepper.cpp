@@ -18,6 +18,7 @@
 #include "framework/field/ice_file.hpp"
 #include "framework/api/log_channel.hpp"
 #include "framework/api/parallel.hpp"
+#include "framework/api/still_bodies.hpp"
 #include "framework/api/table_reader.hpp"
 #include "framework/world/constants.hpp"
 #include "framework/world/vessel.hpp"
@@ -620,9 +621,13 @@ void CpuStepper::step() {
   const int vesselDof = m_scenario.vessel.dof;
 
   // 1-2. Candidates, then contacts. The broadphase may borrow the pool (framework/api/parallel.hpp):
-  // the kept lists' build and filter run over ranges joined in order.
+  // the kept lists' build and filter run over ranges joined in order. It is told which bodies the
+  // last step left still (framework/api/still_bodies.hpp): the flags hold while no slot has changed
+  // hands and nothing has edited the world since the last body updates.
   {
     const ParallelScope lend(m_pool.get());
+    const bool stillKnown = m_stillnessKnown && static_cast<int>(m_stillness.size()) == n;
+    const StillBodiesScope still(stillKnown ? m_stillness.data() : nullptr);
     m_broadphase->findCandidates(m_world, m_pairs);
   }
   if (m_broadphaseFromPlugin) normalizeCandidatePairs(m_pairs);
