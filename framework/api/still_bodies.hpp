@@ -5,8 +5,8 @@
 // step, the largest part of the broadphase's memory traffic.
 //
 // A hint, never needed: without a scope on the calling thread (a test, the CUDA backend's host
-// mirror, a plugin's own stepper) stillBodies() is null and every body is checked. Not part of the
-// plugin ABI: nothing here travels in a struct a plugin reads.
+// mirror, a broadphase called outside a step) stillBodies() is null and every body is checked. Not
+// part of the plugin ABI: nothing here travels in a struct a plugin reads.
 #pragma once
 
 namespace gem {
