@@ -604,8 +604,9 @@ TEST(Broadphase, KeptListsFollowRenamedBodiesWithoutARebuild) {
 }
 
 // The CPU stepper tells the broadphase which bodies its last step left still
-// (framework/api/still_bodies.hpp), and a kept list then skips their displacement checks. Told
-// truly, a list gives every step the candidates of a list told nothing: here a wake of floes moves
+// (framework/api/still_bodies.hpp), and a kept list then skips their displacement checks and keeps
+// the last answer of each chunk of pairs whose bodies are all still. Told truly, a list gives every
+// step the candidates of a list told nothing: here a wake of floes moves
 // across a resting field, a few floes jump past half the skin (direct, then relisted), and the
 // rest keep still. On one thread with the exact pairs checked, and on a pool of three over 6,000
 // floes (the flags are read on the caller's thread and used on the pool's). Told falsely, a moved

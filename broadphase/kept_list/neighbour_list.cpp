@@ -13,6 +13,7 @@
 namespace gem {
 
 NeighbourList::Need NeighbourList::update(const World& world) {
+  m_stillKnown = false;
   if (!m_valid) return Need::Rebuild;
   if (m_renamed) {
     m_renamed = false;
@@ -30,37 +31,53 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   // at the pose, that the last update judged: the same answer, for one byte read in place of nine
   // values. Read here, on the caller's thread: the scope is not the pool's.
   const char* still = stillBodies();
-  // Over ranges of bodies, each range's newly direct bodies into a part of its own, appended in
-  // range order: the same list as one pass.
-  const int tasks = parallelTasks(n, kBodyGrain);
+  m_stillKnown = still != nullptr;
+  // Over ranges of whole blocks of bodies, each range's newly direct bodies into a part of its own,
+  // appended in range order: the same list as one pass. Each block also notes whether a body of it
+  // is not known to be still: the filter keeps the last answer of a chunk of pairs none of whose
+  // bodies lies in such a block.
+  const long blocks = (n + kFlagBlock - 1) / kFlagBlock;
+  m_blockMoving.resize(static_cast<size_t>(blocks));
+  const int tasks = parallelTasks(blocks, kBodyGrain / kFlagBlock);
   m_newlyDirect.resize(static_cast<size_t>(tasks));
   std::vector<char> renamed(static_cast<size_t>(tasks), 0);
-  parallelRanges(n, kBodyGrain, [&](int t, long begin, long end) {
+  parallelRanges(blocks, kBodyGrain / kFlagBlock, [&](int t, long firstBlock, long endBlock) {
     std::vector<int>& part = m_newlyDirect[static_cast<size_t>(t)];
     part.clear();
-    for (long i = begin; i < end; ++i) {
-      if (still && still[i]) continue;
-      // A reorder or an in-place replacement without invalidate() would make the list point at the
-      // wrong bodies: the ids guard against it for the price of one load per body.
-      if (id[i] != m_id0[static_cast<size_t>(i)]) {
-        renamed[static_cast<size_t>(t)] = 1;
-        return;
+    for (long block = firstBlock; block < endBlock; ++block) {
+      const long begin = block * kFlagBlock, end = std::min<long>(n, begin + kFlagBlock);
+      char moving = still ? 0 : 1;
+      for (long i = begin; i < end; ++i) {
+        if (still && still[i]) continue;
+        moving = 1;
+        // A reorder or an in-place replacement without invalidate() would make the list point at the
+        // wrong bodies: the ids guard against it for the price of one load per body.
+        if (id[i] != m_id0[static_cast<size_t>(i)]) {
+          renamed[static_cast<size_t>(t)] = 1;
+          return;
+        }
+        if (m_direct[static_cast<size_t>(i)]) continue;  // its pairs are found afresh every step
+        const Real dx = x[i] - m_x0[static_cast<size_t>(i)], dy = y[i] - m_y0[static_cast<size_t>(i)];
+        // The farthest a point at distance R from the centroid moves under a turn of da is the chord
+        // 2 R |sin(da / 2)| <= R |da wrapped to [-pi, pi]|: an angle that was wrapped by the motion
+        // code (a jump of 2 pi) then counts as no turn, as it should. The wrap is rare, so branched.
+        Real da = std::fabs(angle[i] - m_angle0[static_cast<size_t>(i)]);
+        if (da > kPi) da = std::fabs(std::remainder(da, Real(2) * kPi));
+        if (std::sqrt(dx * dx + dy * dy) + radius[i] * da > limit) {
+          m_direct[static_cast<size_t>(i)] = 1, m_masked[static_cast<size_t>(i)] = 1;
+          part.push_back(static_cast<int>(i));
+        }
       }
-      if (m_direct[static_cast<size_t>(i)]) continue;  // its pairs are found afresh every step
-      const Real dx = x[i] - m_x0[static_cast<size_t>(i)], dy = y[i] - m_y0[static_cast<size_t>(i)];
-      // The farthest a point at distance R from the centroid moves under a turn of da is the chord
-      // 2 R |sin(da / 2)| <= R |da wrapped to [-pi, pi]|: an angle that was wrapped by the motion
-      // code (a jump of 2 pi) then counts as no turn, as it should. The wrap is rare, so branched.
-      Real da = std::fabs(angle[i] - m_angle0[static_cast<size_t>(i)]);
-      if (da > kPi) da = std::fabs(std::remainder(da, Real(2) * kPi));
-      if (std::sqrt(dx * dx + dy * dy) + radius[i] * da > limit) {
-        m_direct[static_cast<size_t>(i)] = 1, m_masked[static_cast<size_t>(i)] = 1;
-        part.push_back(static_cast<int>(i));
-      }
+      m_blockMoving[static_cast<size_t>(block)] = moving;
     }
   });
   for (char r : renamed)
     if (r) return Need::Rebuild;
+  m_movingBlocksBefore.resize(static_cast<size_t>(blocks) + 1);
+  m_movingBlocksBefore[0] = 0;
+  for (long block = 0; block < blocks; ++block)
+    m_movingBlocksBefore[static_cast<size_t>(block) + 1] =
+        m_movingBlocksBefore[static_cast<size_t>(block)] + m_blockMoving[static_cast<size_t>(block)];
   for (const std::vector<int>& part : m_newlyDirect) m_directList.insert(m_directList.end(), part.begin(), part.end());
   const int direct = static_cast<int>(m_directList.size());
   if (direct <= kRelistPast) return Need::Nothing;
@@ -144,6 +161,7 @@ bool NeighbourList::followRenamed(const World& world) {
     sortRaw(n);
   }
   if (!rename(m_sidePairs)) std::sort(m_sidePairs.begin(), m_sidePairs.end(), before);
+  m_chunksKnown = false;  // the pairs were renamed
   ++m_follows;
   return true;
 }
@@ -368,6 +386,7 @@ void NeighbourList::finish(const World& world) {
   for (int i = 0; i < n; ++i)
     if (m_direct[static_cast<size_t>(i)]) m_directList.push_back(i);
   m_sidePairs.clear();
+  m_chunksKnown = false;
   m_valid = true;
   m_renamed = false;  // built from the bodies as they are
   m_relistedSinceBuild = 0;
@@ -378,29 +397,46 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   // Branch-free: every listed pair is written to a scratch row and kept by advancing the count;
   // about a third pass, so a branch would mispredict often. The scratch never shrinks. Pairs of a
   // direct body are skipped here: the direct pass below finds them; so are those of a relisted
-  // floe: the side list holds them. In parallel ranges, each compacting into its own stretch of
-  // the scratch; the stretches are joined in order below.
+  // floe: the side list holds them. By chunks of kChunkPairs pairs, each compacting into its own
+  // stretch of the scratch; the stretches are joined in order below.
+  //
+  // A chunk none of whose bodies has moved since the last filter gives the last answer, which its
+  // stretch still holds: the answer depends on the pairs (the same until a build or a rename, which
+  // forget every chunk), the bodies' x and y, and their masks (which change only when a body moves
+  // past half the skin, or at a build). Whether its bodies are still is told by update(), block by
+  // block of kFlagBlock slots; a chunk spans the slots from its first pair's first body to the
+  // largest second body it names. Most of a resting pack is skipped without reading its pairs.
   const long listed = static_cast<long>(m_pairs.size());
   if (m_filtered.size() < m_pairs.size()) m_filtered.resize(m_pairs.size());
   const Real* x = world.x.data();
   const Real* y = world.y.data();
   const char* direct = m_direct.data();
   const char* masked = m_masked.data();
-  const int tasks = parallelTasks(listed, kPairGrain);
-  m_rangeCount.assign(static_cast<size_t>(tasks), 0);
-  std::vector<long> first(static_cast<size_t>(tasks));
-  parallelRanges(listed, kPairGrain, [&](int t, long begin, long end) {
-    CandidatePair* dst = m_filtered.data() + begin;
-    size_t count = 0;
-    for (long k = begin; k < end; ++k) {
-      const ListedPair& p = m_pairs[static_cast<size_t>(k)];
-      const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
-      dst[count] = {p.a, p.b};
-      count += (dx * dx + dy * dy <= p.reach2) & !(masked[p.a] | masked[p.b]);
+  const long chunks = (listed + kChunkPairs - 1) / kChunkPairs;
+  const bool reuse = m_chunksKnown && m_stillKnown && static_cast<long>(m_chunkCount.size()) == chunks;
+  m_chunkCount.resize(static_cast<size_t>(chunks)), m_chunkFirstBlock.resize(static_cast<size_t>(chunks));
+  m_chunkLastBlock.resize(static_cast<size_t>(chunks));
+  const int* movingBefore = m_movingBlocksBefore.data();
+  parallelRanges(chunks, kPairGrain / kChunkPairs, [&](int, long firstChunk, long endChunk) {
+    for (long c = firstChunk; c < endChunk; ++c) {
+      const size_t chunk = static_cast<size_t>(c);
+      if (reuse && movingBefore[m_chunkLastBlock[chunk] + 1] == movingBefore[m_chunkFirstBlock[chunk]]) continue;
+      const long begin = c * kChunkPairs, end = std::min(listed, begin + kChunkPairs);
+      CandidatePair* dst = m_filtered.data() + begin;
+      int count = 0, last = 0;
+      for (long k = begin; k < end; ++k) {
+        const ListedPair& p = m_pairs[static_cast<size_t>(k)];
+        const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
+        dst[count] = {p.a, p.b};
+        count += (dx * dx + dy * dy <= p.reach2) & !(masked[p.a] | masked[p.b]);
+        last = std::max(last, p.b);
+      }
+      m_chunkCount[chunk] = count;
+      m_chunkFirstBlock[chunk] = m_pairs[static_cast<size_t>(begin)].a / kFlagBlock;  // the pairs are sorted by a, and a < b
+      m_chunkLastBlock[chunk] = last / kFlagBlock;
     }
-    m_rangeCount[static_cast<size_t>(t)] = count;
-    first[static_cast<size_t>(t)] = begin;
   });
+  m_chunksKnown = true;
 
   // Direct bodies (the vessel, and floes that moved more than half the skin since the build) are
   // tested against every body: one pass each, a microsecond per thousand bodies, instead of a
@@ -454,29 +490,38 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
                        before);
   }
 
-  // The join: range t's pairs, merged with the direct and side pairs that fall before the next
-  // range's first pair, go after everything of the earlier ranges. A pair is in one of the three only.
-  std::vector<size_t> offset(static_cast<size_t>(tasks) + 1, 0), directFrom(static_cast<size_t>(tasks) + 1, m_directPairs.size());
-  for (int t = 0; t < tasks; ++t)
-    offset[static_cast<size_t>(t) + 1] = offset[static_cast<size_t>(t)] + m_rangeCount[static_cast<size_t>(t)];
-  for (int t = tasks - 1; t >= 1; --t) {
-    directFrom[static_cast<size_t>(t)] = directFrom[static_cast<size_t>(t) + 1];
-    if (m_rangeCount[static_cast<size_t>(t)] > 0)
-      directFrom[static_cast<size_t>(t)] =
-          static_cast<size_t>(std::lower_bound(m_directPairs.begin(), m_directPairs.end(),
-                                               m_filtered[static_cast<size_t>(first[static_cast<size_t>(t)])], before) -
-                              m_directPairs.begin());
+  // The join: chunk c's pairs, merged with the direct and side pairs that fall before the next
+  // non-empty chunk's first pair, go after everything of the earlier chunks. A pair is in one of
+  // the three only. Where each chunk's direct pairs start: one walk along both, in order.
+  if (chunks == 0) {
+    out.assign(m_directPairs.begin(), m_directPairs.end());
+    return;
   }
-  directFrom[0] = 0;
-  out.resize(offset[static_cast<size_t>(tasks)] + m_directPairs.size());
-  auto join = [&](int t) {
-    const auto from = m_filtered.begin() + first[static_cast<size_t>(t)];
-    const auto direct0 = m_directPairs.begin() + static_cast<std::ptrdiff_t>(directFrom[static_cast<size_t>(t)]);
-    const auto direct1 = m_directPairs.begin() + static_cast<std::ptrdiff_t>(directFrom[static_cast<size_t>(t) + 1]);
-    std::merge(from, from + static_cast<std::ptrdiff_t>(m_rangeCount[static_cast<size_t>(t)]), direct0, direct1,
-               out.begin() + static_cast<std::ptrdiff_t>(offset[static_cast<size_t>(t)] + directFrom[static_cast<size_t>(t)]), before);
-  };
-  parallelEach(tasks, join);
+  m_chunkOffset.resize(static_cast<size_t>(chunks) + 1);
+  m_directFrom.resize(static_cast<size_t>(chunks) + 1);
+  m_chunkOffset[0] = 0;
+  size_t walk = 0;
+  for (size_t c = 0; c < static_cast<size_t>(chunks); ++c) {
+    m_chunkOffset[c + 1] = m_chunkOffset[c] + static_cast<size_t>(m_chunkCount[c]);
+    if (c == 0 || m_chunkCount[c] == 0) continue;
+    const CandidatePair head = m_filtered[c * kChunkPairs];
+    while (walk < m_directPairs.size() && before(m_directPairs[walk], head)) ++walk;
+    m_directFrom[c] = walk;
+  }
+  m_directFrom[0] = 0;
+  m_directFrom[static_cast<size_t>(chunks)] = m_directPairs.size();
+  for (size_t c = static_cast<size_t>(chunks) - 1; c >= 1; --c)  // an empty chunk takes the next one's start
+    if (m_chunkCount[c] == 0) m_directFrom[c] = m_directFrom[c + 1];
+  out.resize(m_chunkOffset[static_cast<size_t>(chunks)] + m_directPairs.size());
+  parallelRanges(chunks, kPairGrain / kChunkPairs, [&](int, long firstChunk, long endChunk) {
+    for (size_t c = static_cast<size_t>(firstChunk); c < static_cast<size_t>(endChunk); ++c) {
+      const auto from = m_filtered.begin() + static_cast<std::ptrdiff_t>(c * kChunkPairs);
+      const auto direct0 = m_directPairs.begin() + static_cast<std::ptrdiff_t>(m_directFrom[c]);
+      const auto direct1 = m_directPairs.begin() + static_cast<std::ptrdiff_t>(m_directFrom[c + 1]);
+      std::merge(from, from + m_chunkCount[c], direct0, direct1,
+                 out.begin() + static_cast<std::ptrdiff_t>(m_chunkOffset[c] + m_directFrom[c]), before);
+    }
+  });
 }
 
 void KeptListBroadphase::findCandidates(const World& world, std::vector<CandidatePair>& pairs) {

@@ -81,6 +81,9 @@ class NeighbourList {
   // Items a parallel range takes at least (framework/api/parallel.hpp): pairs of a stream (a few
   // nanoseconds each), bodies of an O(1) pass.
   static constexpr int kPairGrain = 4096, kBodyGrain = 1024;
+  // The filter's chunks of listed pairs, and the blocks of slots that say whether a chunk's bodies
+  // are all still (filterByCircles). Both divide the grains above.
+  static constexpr int kChunkPairs = 256, kFlagBlock = 64;
   void invalidate() { m_valid = false; }
   // Bodies were added, removed or moved to other slots, the rest unchanged: the next update()
   // follows them by id (followRenamed) instead of rebuilding.
@@ -118,6 +121,16 @@ class NeighbourList {
   std::vector<std::vector<ListedPair>> m_raw;  // the build's parts
   std::vector<ListedPair> m_pairs, m_kept;
   std::vector<CandidatePair> m_filtered;
+  // The filter's answer by chunks (filterByCircles): each chunk's survivors, kept at the start of its
+  // stretch of m_filtered, its count, and the blocks of slots its bodies span; whether they hold the
+  // last filter's answers for the pairs as they are (m_chunksKnown); whether this step's update()
+  // was told which bodies are still (m_stillKnown), and then, block by block, whether one is not,
+  // as a running count.
+  bool m_chunksKnown = false, m_stillKnown = false;
+  std::vector<int> m_chunkCount, m_chunkFirstBlock, m_chunkLastBlock;
+  std::vector<char> m_blockMoving;
+  std::vector<int> m_movingBlocksBefore;
+  std::vector<size_t> m_chunkOffset, m_directFrom;  // the join's: where each chunk's pairs and its direct pairs go
   // The counting sort's row starts (bodies + 1) and next free places (bodies), and each range's
   // count of the filters' survivors.
   std::vector<int> m_count, m_cursor;

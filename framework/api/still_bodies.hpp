@@ -1,8 +1,8 @@
 // Which bodies the CPU stepper's last step left exactly as they were, lent to the broadphase it
-// calls next (docs/performance.md 3.13). A kept list then skips a still body's displacement check:
-// its state is the one the last check judged, so the answer is the one given then. Most of a
-// 10^5-floe pack rests ahead of the vessel, and that check read about 70 bytes of each body every
-// step, the largest part of the broadphase's memory traffic.
+// calls next (docs/performance.md 3.13). A kept list then skips a still body's displacement check,
+// and keeps the last answer of a chunk of listed pairs whose bodies are all still: their states are
+// the ones the last step judged, so the answers are the ones given then. Most of a 10^5-floe pack
+// rests ahead of the vessel, and those two passes read every body and every listed pair each step.
 //
 // A hint, never needed: without a scope on the calling thread (a test, the CUDA backend's host
 // mirror, a broadphase called outside a step) stillBodies() is null and every body is checked. Not
