@@ -103,7 +103,8 @@ class NeighbourList {
   void finish(const World& world);
 
   // This step's candidates: the listed pairs whose bounding circles overlap now, in list order
-  // (sorted). Clears out first.
+  // (sorted), with the direct and side lists' pairs merged in. Clears out first. A chunk of listed
+  // pairs whose bodies update() was told are all still keeps its last answer unread.
   void filterByCircles(const World& world, std::vector<CandidatePair>& out);
   const std::vector<ListedPair>& pairs() const { return m_pairs; }
   const std::vector<ListedPair>& sidePairs() const { return m_sidePairs; }  // those of the relisted floes

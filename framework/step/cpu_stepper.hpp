@@ -218,14 +218,6 @@ class CpuStepper final : public Stepper {
       for (int b = begin; b < end; b += kBlock) block(b, std::min(end, b + kBlock));
     });
   }
-  // body(i) for every slot, in ranges as forEachRange: a template, so that the per-body call is
-  // inlined (a std::function per body cost an indirect call each).
-  template <class Body>
-  void forEachBody(int n, Body&& body) {
-    forEachRange(n, [&](int begin, int end) {
-      for (int i = begin; i < end; ++i) body(i);
-    });
-  }
   RecordStreams m_streams;  // opened by the events as their Params are parsed
   StepRecords m_records;    // the last step's rows
   bool m_deliverLogs = true;
