@@ -70,8 +70,9 @@ class NeighbourList {
   // Direct bodies (the vessel among them) past which the CPU list relists the floes. A direct floe
   // costs a pass over every body each step, its relisting about one such pass: relisting early
   // won on the 824-floe field (callgrind, 2100 steps: 3.64 billion instructions with 3 or 1,
-  // 3.72 with 8, 3.83 with 16) and changed nothing measurable at 10^5 floes (docs/performance.md
-  // 3.13). The candidates are the same whenever it relists.
+  // 3.72 with 8, 3.83 with 16); at 10^5 floes three noisy rounds showed no difference, though
+  // relisting's pass is now 12 % of that step on one thread (docs/performance.md 3.13, 3.14). The
+  // candidates are the same whenever it relists.
   static constexpr int kRelistPast = 3;
   // The direct bodies the device list holds beyond the always-direct ones before it rebuilds
   // (device_neighbour_list.cuh: the device does not relist).
