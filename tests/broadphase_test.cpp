@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 #include <string>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "broadphase/kept_list/neighbour_list.hpp"
+#include "broadphase/kept_list/reference_grid.hpp"
 #include "framework/api/errors.hpp"
 #include "framework/api/parallel.hpp"
 #include "framework/api/registry.hpp"
@@ -680,6 +682,128 @@ TEST(Broadphase, KeptListsToldWhichBodiesAreStillGiveTheSameCandidates) {
     plain[0]->findCandidates(w, b);
     EXPECT_EQ(plainList.directCount(), before + 1) << "the moved floe is direct when judged";
     EXPECT_EQ(toldList.directCount(), before) << "a body said to be still was judged anyway";
+  }
+}
+
+// The kept list's grid of references (reference_grid.hpp): near() visits every body whose
+// reference lies in the square, each once, and every body in no cell; after bodies move to other
+// cells (move) and are binned again by new slots (bin), and for squares and references outside the
+// laid-out bounds, which are clamped into the border cells. Against a plain scan of every body.
+TEST(Broadphase, ReferenceGridVisitsEveryReferenceInTheSquareOnce) {
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<Real> u(0, 1);
+  const int n = 3000;
+  std::vector<Real> x(n), y(n), radius(n);
+  for (int i = 0; i < n; ++i) x[i] = 300 * u(rng), y[i] = 200 * u(rng), radius[i] = Real(0.3) + 2 * u(rng);
+  radius[7] = 400, radius[1234] = 250;             // two walls' worth: in no cell
+  x[99] = std::numeric_limits<Real>::quiet_NaN();  // in no cell either
+  ReferenceGrid grid;
+  grid.layOut(x.data(), y.data(), radius.data(), n, 3);
+  EXPECT_EQ(grid.outsideCount(), 3);
+  EXPECT_LE(grid.largestRadius(), Real(2.3));
+  auto check = [&](const std::string& what, const std::vector<int>& inNoCell) {
+    for (int query = 0; query < 300; ++query) {
+      // Squares from a metre to a field wide, some reaching past the field's edges.
+      const Real cx = 360 * u(rng) - 30, cy = 260 * u(rng) - 30, reach = query % 10 == 0 ? 150 * u(rng) : 1 + 9 * u(rng);
+      std::vector<int> seen(n, 0);
+      grid.near(cx, cy, reach, [&](int j) { ++seen[j]; });
+      for (int i = 0; i < n; ++i) {
+        ASSERT_LE(seen[i], 1) << what << ": body " << i << " visited twice";
+        const bool inside = std::fabs(x[i] - cx) <= reach && std::fabs(y[i] - cy) <= reach;
+        const bool outside = std::find(inNoCell.begin(), inNoCell.end(), i) != inNoCell.end();
+        if (inside || outside) {
+          ASSERT_EQ(seen[i], 1) << what << ": body " << i << " at (" << x[i] << ", " << y[i] << ") missed";
+        }
+      }
+    }
+  };
+  check("laid out", {7, 99, 1234});
+  // References move, some far past the laid-out bounds (clamped into a border cell).
+  for (int k = 0; k < 2000; ++k) {
+    const int i = static_cast<int>(u(rng) * n) % n;
+    if (i == 99) continue;
+    const bool far = k % 50 == 0;
+    x[i] = far ? 500 * u(rng) - 100 : std::clamp<Real>(x[i] + 6 * (u(rng) - Real(0.5)), -20, 320);
+    y[i] = far ? 400 * u(rng) - 100 : std::clamp<Real>(y[i] + 6 * (u(rng) - Real(0.5)), -20, 220);
+    grid.move(i, x[i], y[i]);
+  }
+  check("after moves", {7, 99, 1234});
+  // A rename: the bodies reversed, binned again in the same cells.
+  std::reverse(x.begin(), x.end()), std::reverse(y.begin(), y.end()), std::reverse(radius.begin(), radius.end());
+  grid.bin(x.data(), y.data(), radius.data(), n);
+  EXPECT_EQ(grid.outsideCount(), 3);
+  check("binned by new slots", {n - 1 - 7, n - 1 - 99, n - 1 - 1234});
+}
+
+// The direct pass and relisting search near their floes through the grid of references; a body not
+// direct may be anywhere within half the skin of its reference. Small floes (radii 0.4 to 0.8 m)
+// and a 4 m skin make that half skin wide against the cells, and every floe swings about its base
+// by just under it, each in its own phase, while a few floes jump 1.2 m (past half the skin: direct,
+// then relisted) and the vessel crosses the field; then a break and a re-sort rename the bodies.
+// Every step the kept lists give all_pairs' candidates.
+TEST(Broadphase, DirectAndRelistedFloesFindEveryPairNearTheirReferences) {
+  World w;
+  std::mt19937 rng(43);
+  std::uniform_real_distribution<Real> u(0, 1);
+  const Real side = 70;
+  w.addBody(spec(BodyKind::Vessel, rectangle({-10, side / 2}, 12, 4, 0)));
+  for (int k = 0; k < 1500; ++k)
+    w.addBody(spec(BodyKind::Floe, regularPolygon({side * u(rng), side * u(rng)}, Real(0.4) + Real(0.4) * u(rng), 5, 6 * u(rng))));
+  BroadphaseSettings s;
+  s.skin = 4;
+  std::vector<std::unique_ptr<Broadphase>> all;
+  for (const char* name : {"all_pairs", "variable_radius", "fixed_radius"}) all.push_back(make(name, s));
+  std::vector<Vec2> base(w.size()), swing(w.size());
+  std::vector<Real> phase(w.size());
+  auto setSwing = [&](int i) {
+    base[i] = {w.x[i], w.y[i]};
+    swing[i] = rotate(Vec2{Real(0.99), 0}, 2 * kPi * u(rng));  // peak to peak just under half the skin
+    phase[i] = 2 * kPi * u(rng);
+  };
+  for (int i = 0; i < w.size(); ++i) setSwing(i);
+  long candidates = 0;
+  for (int step = 0; step < 90; ++step) {
+    if (step == 30 || step == 60) {
+      if (step == 30) {  // a break: every seventh floe goes, thirty come
+        std::vector<char> remove(w.size(), 0);
+        for (int i = 1; i < w.size(); i += 7) remove[i] = 1;
+        w.removeBodies(remove);
+        for (int k = 0; k < 30; ++k) w.addBody(spec(BodyKind::Floe, regularPolygon({side * u(rng), side * u(rng)}, Real(0.6), 6, u(rng))));
+      } else {  // a re-sort
+        std::vector<int> order(w.size());
+        for (int i = 0; i < w.size(); ++i) order[i] = w.size() - 1 - i;
+        w.permute(order);
+      }
+      base.resize(w.size()), swing.resize(w.size()), phase.resize(w.size());
+      for (int i = 0; i < w.size(); ++i) setSwing(i);
+      for (auto& b : all) b->bodiesRenamed();
+    }
+    for (int jumps = 0; jumps < 5; ++jumps) {
+      const int i = static_cast<int>(u(rng) * w.size()) % w.size();
+      if (w.kind[i] == BodyKind::Floe) base[i] = base[i] + rotate(Vec2{Real(1.2), 0}, 2 * kPi * u(rng));
+    }
+    for (int i = 0; i < w.size(); ++i) {
+      if (w.kind[i] == BodyKind::Vessel) {
+        w.x[i] += Real(1.1);
+        continue;
+      }
+      const Real t = std::sin(phase[i] + Real(0.9) * static_cast<Real>(step));
+      w.x[i] = base[i].x + t * swing[i].x, w.y[i] = base[i].y + t * swing[i].y;
+    }
+    std::vector<CandidatePair> pairs;
+    all[0]->findCandidates(w, pairs);
+    const PairSet reference = toSet(pairs);
+    candidates += static_cast<long>(reference.size());
+    for (size_t k = 1; k < all.size(); ++k) {
+      all[k]->findCandidates(w, pairs);
+      ASSERT_EQ(toSet(pairs), reference) << all[k]->name() << " step " << step;
+    }
+  }
+  EXPECT_GT(candidates, 90L * 500) << "the floes should crowd";
+  for (size_t k = 1; k < all.size(); ++k) {
+    const auto& kept = dynamic_cast<const KeptListBroadphase&>(*all[k]);
+    EXPECT_GE(kept.list().relists(), 30) << all[k]->name() << ": relisting went untested";
+    EXPECT_EQ(kept.list().follows(), 2) << all[k]->name();
   }
 }
 

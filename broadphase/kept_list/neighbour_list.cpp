@@ -139,6 +139,7 @@ bool NeighbourList::followRenamed(const World& world) {
   m_x0.swap(x0), m_y0.swap(y0), m_angle0.swap(angle0), m_id0.swap(id0);
   m_direct.swap(direct), m_masked.swap(masked), m_directList.swap(directList);
   m_relisting.assign(static_cast<size_t>(n), 0);
+  m_grid.bin(m_x0.data(), m_y0.data(), world.radius.data(), n);  // by their new slots, in the same cells
   // The pairs renamed, each with its reach (the two shapes are the same). Removing bodies keeps the
   // order of the others, and the pairs stay sorted; a re-sort is sorted again by rows.
   auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
@@ -166,11 +167,25 @@ bool NeighbourList::followRenamed(const World& world) {
   return true;
 }
 
-// The relisted floes' new pairs (each floe against every body, like the direct pass, over ranges of
-// bodies and joined in range order, then sorted: the same on any number of threads) replace their
-// pairs in the side list. The main list is left as it is: its pairs of a relisted floe are masked
-// from then on (m_masked), so a pair is in one list only, and relisting costs a pass over the
-// bodies per floe plus one over the side list, never one over the whole list.
+void NeighbourList::binReferences(const World& world) {
+  m_grid.layOut(m_x0.data(), m_y0.data(), world.radius.data(), world.size(), (kRelistReach + Real(0.5)) * m_skin);
+}
+
+// The half-width of the square of references that holds every body not direct within
+// r + R_j + beyond of (x, y), R_j a binned body's radius: such a body is within half the skin of
+// its reference. Widened by a millionth, and a millionth of the coordinates, for the rounding of
+// the distances the tests compute.
+Real NeighbourList::searchReach(Real x, Real y, Real r, Real beyond) const {
+  const Real reach = r + m_grid.largestRadius() + beyond + m_skin / 2;
+  return reach * (1 + Real(1e-6)) + Real(1e-6) * (std::fabs(x) + std::fabs(y)) + Real(1e-9);
+}
+
+// The relisted floes' new pairs (each floe against the bodies near it, like the direct pass, then
+// sorted) replace their pairs in the side list. The main list is left as it is: its pairs of a
+// relisted floe are masked from then on (m_masked), so a pair is in one list only, and relisting
+// costs a search per floe plus a pass over the side list, never one over the whole list. (Until
+// 2026-12-06 each floe was tested against every body: at 10^5 floes that pass was the largest item
+// of a one-thread step, docs/performance.md 3.15.)
 void NeighbourList::relistDirect(const World& world) {
   const int n = world.size();
   const Real* x = world.x.data();
@@ -182,36 +197,25 @@ void NeighbourList::relistDirect(const World& world) {
   m_relisting.resize(static_cast<size_t>(n), 0);  // all 0 between relists: only the relisted floes' flags are set and reset
   for (int v : relisted) m_relisting[static_cast<size_t>(v)] = 1;
 
+  // Each relisted floe against the bodies near it (ReferenceGrid): every body that is not direct
+  // is within half the skin of its reference, so the square around the floe that reaches its
+  // radius, the largest binned radius, the relisting reach and half the skin holds the reference of
+  // every body it could list. The direct bodies are the relisted floes and the vessels (never listed).
   const Real margin = kRelistReach * m_skin;
-  // The box of every relisted floe's reach but the other body's radius: a body whose circle misses
-  // it is beyond every relisted floe's reach, so one test of the box spares the |relisted| tests
-  // of most bodies (the relisted floes are usually the vessel's wake, close together).
-  Real bx0 = 0, bx1 = 0, by0 = 0, by1 = 0;
-  for (size_t k = 0; k < relisted.size(); ++k) {
-    const int v = relisted[k];
-    const Real e = radius[v] + margin;
-    bx0 = k ? std::min(bx0, x[v] - e) : x[v] - e, bx1 = k ? std::max(bx1, x[v] + e) : x[v] + e;
-    by0 = k ? std::min(by0, y[v] - e) : y[v] - e, by1 = k ? std::max(by1, y[v] + e) : y[v] + e;
-  }
-  const int bodyTasks = parallelTasks(n, kBodyGrain);
-  m_relistParts.resize(static_cast<size_t>(bodyTasks));
-  parallelRanges(n, kBodyGrain, [&](int t, long begin, long end) {
-    std::vector<ListedPair>& part = m_relistParts[static_cast<size_t>(t)];
-    part.clear();
-    for (int j = static_cast<int>(begin); j < end; ++j) {
-      // Not negated comparisons: a body at no finite place is tested the plain way.
-      if (x[j] + radius[j] < bx0 || x[j] - radius[j] > bx1 || y[j] + radius[j] < by0 || y[j] - radius[j] > by1) continue;
-      for (int v : relisted) {
-        if (j == v || (m_relisting[static_cast<size_t>(j)] && j < v)) continue;  // a pair of two relisted floes once
-        // As finish(): wall-wall pairs never interact, vessel pairs are found by the direct pass.
-        if (world.kind[j] == BodyKind::Vessel || (world.kind[v] == BodyKind::Wall && world.kind[j] == BodyKind::Wall)) continue;
-        const Real dx = x[v] - x[j], dy = y[v] - y[j], touch = radius[v] + radius[j], reach = touch + margin;
-        if (dx * dx + dy * dy <= reach * reach) part.push_back({j < v ? j : v, j < v ? v : j, touch * touch});
-      }
-    }
-  });
   m_relisted.clear();
-  for (const std::vector<ListedPair>& part : m_relistParts) m_relisted.insert(m_relisted.end(), part.begin(), part.end());
+  for (const int v : relisted) {
+    auto test = [&](int j) {
+      if (j == v || (m_relisting[static_cast<size_t>(j)] && j < v)) return;  // a pair of two relisted floes once
+      // As finish(): wall-wall pairs never interact, vessel pairs are found by the direct pass.
+      if (world.kind[j] == BodyKind::Vessel || (world.kind[v] == BodyKind::Wall && world.kind[j] == BodyKind::Wall)) return;
+      const Real dx = x[v] - x[j], dy = y[v] - y[j], touch = radius[v] + radius[j], reach = touch + margin;
+      if (dx * dx + dy * dy <= reach * reach) m_relisted.push_back({j < v ? j : v, j < v ? v : j, touch * touch});
+    };
+    m_grid.near(x[v], y[v], searchReach(x[v], y[v], radius[v], margin), [&](int j) {
+      if (!m_direct[static_cast<size_t>(j)]) test(j);
+    });
+    for (const int j : relisted) test(j);
+  }
   auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
   std::sort(m_relisted.begin(), m_relisted.end(), before);
   // The side list without the relisted floes' old pairs, merged with their new ones.
@@ -226,6 +230,7 @@ void NeighbourList::relistDirect(const World& world) {
     m_direct[static_cast<size_t>(v)] = 0;
     m_masked[static_cast<size_t>(v)] = 1;
     m_relisting[static_cast<size_t>(v)] = 0;
+    m_grid.move(v, x[v], y[v]);  // to the cell of its new reference
   }
   m_directList = vessels;
   m_relistedSinceBuild += static_cast<int>(relisted.size());
@@ -385,6 +390,7 @@ void NeighbourList::finish(const World& world) {
   m_directList.clear();
   for (int i = 0; i < n; ++i)
     if (m_direct[static_cast<size_t>(i)]) m_directList.push_back(i);
+  binReferences(world);
   m_sidePairs.clear();
   m_chunksKnown = false;
   m_valid = true;
@@ -439,33 +445,26 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   m_chunksKnown = true;
 
   // Direct bodies (the vessel, and floes that moved more than half the skin since the build) are
-  // tested against every body: one pass each, a microsecond per thousand bodies, instead of a
-  // rebuild of the whole list every few steps while the vessel shoves floes at its own speed. The
-  // pass is split over ranges of bodies; the pairs are sorted afterwards, so their order is one.
+  // tested against the bodies near them, instead of a rebuild of the whole list every few steps
+  // while the vessel shoves floes at its own speed: the bodies that are not direct through the grid
+  // of references (as relisting), the direct ones in turn. The pairs are sorted afterwards, so the
+  // order of the tests does not matter.
   m_directPairs.clear();
-  if (!m_directList.empty()) {
-    const Real* radius = world.radius.data();
-    const int n = world.size();
-    const int bodyTasks = parallelTasks(n, kBodyGrain);
-    m_directParts.resize(static_cast<size_t>(bodyTasks));
-    parallelRanges(n, kBodyGrain, [&](int t, long begin, long end) {
-      std::vector<CandidatePair>& part = m_directParts[static_cast<size_t>(t)];
-      part.clear();
-      for (int v : m_directList) {
-        const Real xv = x[v], yv = y[v], rv = radius[v];
-        const bool wall = world.kind[v] == BodyKind::Wall;
-        for (int j = static_cast<int>(begin); j < end; ++j) {
-          // The circles first: most bodies are far, so this branch is well predicted and the
-          // rarer conditions are looked up only for the near ones.
-          const Real dx = xv - x[j], dy = yv - y[j], reach = rv + radius[j];
-          if (!(dx * dx + dy * dy <= reach * reach)) continue;
-          if (j == v || (direct[j] && j < v)) continue;  // a pair of two direct bodies is found once
-          if (wall && world.kind[j] == BodyKind::Wall) continue;
-          part.push_back(j < v ? CandidatePair{j, v} : CandidatePair{v, j});
-        }
-      }
+  const Real* radius = world.radius.data();
+  for (const int v : m_directList) {
+    const Real xv = x[v], yv = y[v], rv = radius[v];
+    const bool wall = world.kind[v] == BodyKind::Wall;
+    auto test = [&](int j) {
+      const Real dx = xv - x[j], dy = yv - y[j], reach = rv + radius[j];
+      if (!(dx * dx + dy * dy <= reach * reach)) return;
+      if (j == v || (direct[j] && j < v)) return;  // a pair of two direct bodies is found once
+      if (wall && world.kind[j] == BodyKind::Wall) return;
+      m_directPairs.push_back(j < v ? CandidatePair{j, v} : CandidatePair{v, j});
+    };
+    m_grid.near(xv, yv, searchReach(xv, yv, rv, 0), [&](int j) {
+      if (!direct[j]) test(j);
     });
-    for (const std::vector<CandidatePair>& part : m_directParts) m_directPairs.insert(m_directPairs.end(), part.begin(), part.end());
+    for (const int j : m_directList) test(j);
   }
   auto before = [](CandidatePair p, CandidatePair q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
   std::sort(m_directPairs.begin(), m_directPairs.end(), before);

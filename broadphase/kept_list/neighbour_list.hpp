@@ -10,8 +10,10 @@
 // have moved more than half the skin") keeps every d <= skin / 2, which guarantees that.
 //
 // Here a body that passes half the skin does not force a rebuild at once: it becomes *direct*,
-// its listed pairs are ignored, and it is tested against every body each step (one O(n) pass of
-// bounding circles, merged into the sorted candidates). For the bodies still listed every d stays
+// its listed pairs are ignored, and each step it is tested against the bodies near it (their
+// bounding circles, merged into the sorted candidates; "near" through a grid of the references,
+// reference_grid.hpp, since every body not direct is within half the skin of its reference). For
+// the bodies still listed every d stays
 // <= skin / 2, so the list stays complete for them, and the direct pass covers the rest: nothing
 // is missed. The vessel is always direct (it moves at several m/s through resting ice and would
 // set the rebuild rate alone), and so are the few floes it is shoving.
@@ -29,12 +31,13 @@
 // candidates (listed pairs whose circles overlap now, plus the direct pass) are the same pairs in
 // the same order, so trajectories do not change. The list is rebuilt whole when the bodies
 // change, or once the floes relisted since the build pass an eighth of the bodies (the side list
-// grows with every relist, and a relist costs a pass over every body per relisted floe).
+// grows with every relist, and each relist rewrites it).
 #pragma once
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include "broadphase/kept_list/reference_grid.hpp"
 #include "framework/api/broadphase.hpp"
 
 namespace gem {
@@ -68,11 +71,8 @@ class NeighbourList {
   void relistDirect(const World& world);
   int directCount() const { return static_cast<int>(m_directList.size()); }
   // Direct bodies (the vessel among them) past which the CPU list relists the floes. A direct floe
-  // costs a pass over every body each step, its relisting about one such pass: relisting early
-  // won on the 824-floe field (callgrind, 2100 steps: 3.64 billion instructions with 3 or 1,
-  // 3.72 with 8, 3.83 with 16); at 10^5 floes three noisy rounds showed no difference, though
-  // relisting's pass is now 12 % of that step on one thread (docs/performance.md 3.13, 3.14). The
-  // candidates are the same whenever it relists.
+  // costs a search of the bodies near it each step, its relisting one such search and a pass over
+  // the side list (docs/performance.md 3.13, 3.15). The candidates are the same whenever it relists.
   static constexpr int kRelistPast = 3;
   // The direct bodies the device list holds beyond the always-direct ones before it rebuilds
   // (device_neighbour_list.cuh: the device does not relist).
@@ -113,6 +113,8 @@ class NeighbourList {
  private:
   void sortRaw(int bodyCount);
   bool followRenamed(const World& world);
+  void binReferences(const World& world);
+  Real searchReach(Real x, Real y, Real r, Real beyond) const;
   static constexpr int kShortRow = 32;  // rows up to this long are insertion-sorted
   Real m_skin;
   bool m_valid = false;
@@ -137,16 +139,18 @@ class NeighbourList {
   // count of the filters' survivors.
   std::vector<int> m_count, m_cursor;
   std::vector<size_t> m_rangeCount;
-  std::vector<std::vector<CandidatePair>> m_directParts;
+
   // Reference state at the last build, by slot.
   std::vector<Real> m_x0, m_y0, m_angle0;
   std::vector<std::int64_t> m_id0;
-  // Direct bodies, tested against every body each step by filterByCircles: the vessels, and the
-  // bodies that moved more than half the skin since the build.
+  // Direct bodies, tested against the bodies near them each step by filterByCircles: the vessels,
+  // and the bodies that moved more than half the skin since their reference.
   std::vector<char> m_direct;
   std::vector<int> m_directList;
   std::vector<std::vector<int>> m_newlyDirect;  // update()'s, range by range
   std::vector<CandidatePair> m_directPairs;
+  // The references binned in cells, for the direct pass and relisting (reference_grid.hpp).
+  ReferenceGrid m_grid;
   // Relisting: the side list (every pair of a floe relisted since the build, sorted), the bodies
   // whose pairs the main list no longer gives (direct or relisted, by slot), and scratch: the
   // floes being relisted (by slot), their new pairs (range by range, then all), the side pairs
@@ -154,7 +158,6 @@ class NeighbourList {
   std::vector<ListedPair> m_sidePairs;
   std::vector<char> m_masked;
   std::vector<char> m_relisting;
-  std::vector<std::vector<ListedPair>> m_relistParts;
   std::vector<ListedPair> m_relisted, m_merged;
   std::vector<std::vector<CandidatePair>> m_sideParts;
 };
