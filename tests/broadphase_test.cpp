@@ -453,6 +453,38 @@ TEST(Broadphase, ARelistedRowCoversWhatItsNeighboursCanStillTravel) {
   }
 }
 
+// The budget that ends relisting (neighbour_list.hpp): the list is rebuilt once the bodies direct
+// or relisted since the build pass an eighth of all bodies, each counted once. The same ten floes
+// jumping past half the skin step after step are relisted again and again without a rebuild (as the
+// vessel's wake is at 10^5 floes); new floes jumping each step bring one soon.
+TEST(Broadphase, KeptListsRebuildOnceAnEighthOfTheBodiesHaveBeenRelisted) {
+  World w = randomWorld(47, 800, 200, 0);
+  BroadphaseSettings s;
+  s.skin = 2;
+  auto list = make("variable_radius", s);
+  const NeighbourList& kept = dynamic_cast<const KeptListBroadphase&>(*list).list();
+  std::vector<CandidatePair> pairs;
+  list->findCandidates(w, pairs);
+  ASSERT_EQ(list->rebuilds(), 1);
+  std::vector<int> floes;
+  for (int i = 0; i < w.size(); ++i)
+    if (w.kind[i] == BodyKind::Floe) floes.push_back(i);
+  for (int step = 0; step < 60; ++step) {
+    for (int k = 0; k < 10; ++k) w.x[floes[static_cast<size_t>(k)]] += step % 2 ? Real(-1.2) : Real(1.2);
+    list->findCandidates(w, pairs);
+  }
+  EXPECT_GE(kept.relists(), 55) << "the ten floes should be relisted nearly every step";
+  EXPECT_EQ(list->rebuilds(), 1) << "floes relisted again were counted again";
+  int steps = 0;
+  for (size_t next = 10; list->rebuilds() == 1 && next + 10 <= floes.size(); next += 10, ++steps) {
+    for (size_t k = next; k < next + 10; ++k) w.y[floes[k]] += Real(1.2);
+    list->findCandidates(w, pairs);
+  }
+  EXPECT_EQ(list->rebuilds(), 2);
+  // The vessel and ten floes masked at first, ten more each step: past 801 / 8 = 100 at the ninth.
+  EXPECT_EQ(steps, 9);
+}
+
 TEST(Broadphase, RebuildOnlyWhenNeeded) {
   BroadphaseSettings s;
   s.skin = 2;

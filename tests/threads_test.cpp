@@ -37,12 +37,15 @@ struct ThreadedRun {
   long rebuilds = 0;   // the broadphase's
 };
 
-ThreadedRun runWithThreads(const Scenario& base, int threads, int steps) {
+// rebuildEvery: the broadphase is invalidated every that many steps (0: never), so that its
+// parallel build runs on a field in motion too, not only on the first step's.
+ThreadedRun runWithThreads(const Scenario& base, int threads, int steps, int rebuildEvery = 0) {
   Scenario s = base;
   s.threads = threads;
   CpuStepper sim(s);
   ThreadedRun r;
   for (int k = 0; k < steps; ++k) {
+    if (rebuildEvery > 0 && k > 0 && k % rebuildEvery == 0) sim.broadphase().invalidate();
     sim.step();
     r.contacts += sim.contactCount();
     r.mostContacts = std::max(r.mostContacts, sim.contactCount());
@@ -78,16 +81,17 @@ void expectSame(const ThreadedRun& one, const ThreadedRun& many, int threads) {
 
 // A field large enough that every parallel phase runs on the pool (CpuStepper::kParallelBodies).
 TEST(Threads, ALargeFieldStepsBitForBitOnOneTwoAndFourThreads) {
+  const int steps = 120;
   test::TempDir dir;
-  const Scenario s =
-      test::scenarioFromToml(dir, test::kBusyScene, {"simulation.steps=120", "domain.x=[0.0, 700.0]", "domain.y=[-200.0, 200.0]"});
-  const ThreadedRun one = runWithThreads(s, 1, 120);
+  const Scenario s = test::scenarioFromToml(
+      dir, test::kBusyScene, {"simulation.steps=" + std::to_string(steps), "domain.x=[0.0, 700.0]", "domain.y=[-200.0, 200.0]"});
+  const ThreadedRun one = runWithThreads(s, 1, steps, 50);
   ASSERT_GE(one.ids.size(), static_cast<size_t>(CpuStepper::kParallelBodies)) << "the field is too small to run on the pool";
   ASSERT_GE(one.candidates, CpuStepper::kParallelPairs) << "too few pairs for the narrowphase to run on the pool";
   EXPECT_GT(one.contacts, 500) << "the scene must touch a lot, or it guards nothing";
   EXPECT_GT(one.impactRows, 0);
-  EXPECT_GE(one.rebuilds, 2) << "the kept list was never rebuilt: its parallel build went untested";
-  for (int threads : {2, 4}) expectSame(one, runWithThreads(s, threads, 120), threads);
+  EXPECT_GE(one.rebuilds, 3) << "the kept list was not rebuilt mid-run: its parallel build went untested";
+  for (int threads : {2, 4}) expectSame(one, runWithThreads(s, threads, steps, 50), threads);
 }
 
 // The kept lists' build (the sweep, the counting sort, the clean-up) and their per-step filter (the

@@ -64,7 +64,7 @@ NeighbourList::Need NeighbourList::update(const World& world) {
         Real da = std::fabs(angle[i] - m_angle0[static_cast<size_t>(i)]);
         if (da > kPi) da = std::fabs(std::remainder(da, Real(2) * kPi));
         if (std::sqrt(dx * dx + dy * dy) + radius[i] * da > limit) {
-          m_direct[static_cast<size_t>(i)] = 1, m_masked[static_cast<size_t>(i)] = 1;
+          m_direct[static_cast<size_t>(i)] = 1;  // masked below, where the masked bodies are counted
           part.push_back(static_cast<int>(i));
         }
       }
@@ -78,10 +78,13 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   for (long block = 0; block < blocks; ++block)
     m_movingBlocksBefore[static_cast<size_t>(block) + 1] =
         m_movingBlocksBefore[static_cast<size_t>(block)] + m_blockMoving[static_cast<size_t>(block)];
-  for (const std::vector<int>& part : m_newlyDirect) m_directList.insert(m_directList.end(), part.begin(), part.end());
+  for (const std::vector<int>& part : m_newlyDirect) {
+    m_directList.insert(m_directList.end(), part.begin(), part.end());
+    for (const int i : part) m_maskedBodies += !m_masked[static_cast<size_t>(i)], m_masked[static_cast<size_t>(i)] = 1;
+  }
   const int direct = static_cast<int>(m_directList.size());
   if (direct <= kRelistPast) return Need::Nothing;
-  return m_relistedSinceBuild + direct > n / 8 ? Need::Rebuild : Need::Relist;
+  return m_maskedBodies > n / 8 ? Need::Rebuild : Need::Relist;
 }
 
 // After bodiesRenamed(): a break removed some bodies and added others, or the re-sort moved every
@@ -138,6 +141,7 @@ bool NeighbourList::followRenamed(const World& world) {
   }
   m_x0.swap(x0), m_y0.swap(y0), m_angle0.swap(angle0), m_id0.swap(id0);
   m_direct.swap(direct), m_masked.swap(masked), m_directList.swap(directList);
+  m_maskedBodies = static_cast<int>(std::count(m_masked.begin(), m_masked.end(), 1));
   m_relisting.assign(static_cast<size_t>(n), 0);
   m_grid.bin(m_x0.data(), m_y0.data(), world.radius.data(), n);  // by their new slots, in the same cells
   // The pairs renamed, each with its reach (the two shapes are the same). Removing bodies keeps the
@@ -233,7 +237,6 @@ void NeighbourList::relistDirect(const World& world) {
     m_grid.move(v, x[v], y[v]);  // to the cell of its new reference
   }
   m_directList = vessels;
-  m_relistedSinceBuild += static_cast<int>(relisted.size());
   ++m_relists;
 }
 
@@ -390,12 +393,12 @@ void NeighbourList::finish(const World& world) {
   m_directList.clear();
   for (int i = 0; i < n; ++i)
     if (m_direct[static_cast<size_t>(i)]) m_directList.push_back(i);
+  m_maskedBodies = static_cast<int>(m_directList.size());
   binReferences(world);
   m_sidePairs.clear();
   m_chunksKnown = false;
   m_valid = true;
   m_renamed = false;  // built from the bodies as they are
-  m_relistedSinceBuild = 0;
   ++m_rebuilds;
 }
 

@@ -30,8 +30,10 @@
 // references, so the skin suffices there). Extra listed pairs cost only filter time: the
 // candidates (listed pairs whose circles overlap now, plus the direct pass) are the same pairs in
 // the same order, so trajectories do not change. The list is rebuilt whole when the bodies
-// change, or once the floes relisted since the build pass an eighth of the bodies (the side list
-// grows with every relist, and each relist rewrites it).
+// change, or once the bodies direct or relisted since the build pass an eighth of all of them (the
+// side list grows with each floe relisted for the first time, and each relist rewrites it; a floe
+// relisted again only replaces its pairs, so it is counted once: counted at each relist, the wake
+// of the vessel at 10^5 floes spent the budget every 400 steps).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -60,8 +62,8 @@ class NeighbourList {
 
   Real skin() const { return m_skin; }
   // What the list needs before this step's filter. Rebuild: never built, invalidated, body count or
-  // identities changed, or more than kRelistPast bodies are direct and relisting them would pass
-  // the budget (an eighth of the bodies since the build). Relist: more than kRelistPast are direct,
+  // identities changed, or more than kRelistPast bodies are direct and the bodies direct or
+  // relisted since the build pass an eighth of all of them. Relist: more than kRelistPast are direct,
   // within the budget (relistDirect()). Otherwise marks every body that has moved more than half
   // the skin since its reference as direct. One pass over the bodies, but those the stepper says
   // are still (framework/api/still_bodies.hpp): their answer is the last one.
@@ -121,7 +123,9 @@ class NeighbourList {
   bool m_renamed = false;
   long m_rebuilds = 0, m_relists = 0, m_follows = 0;
   std::vector<int> m_slotOfId, m_newSlot;  // followRenamed's scratch: by id, and by old slot
-  int m_relistedSinceBuild = 0;
+  // The bodies whose pairs the main list no longer gives (direct, or relisted since the build):
+  // past an eighth of the bodies, the list is rebuilt.
+  int m_maskedBodies = 0;
   std::vector<std::vector<ListedPair>> m_raw;  // the build's parts
   std::vector<ListedPair> m_pairs, m_kept;
   std::vector<CandidatePair> m_filtered;
