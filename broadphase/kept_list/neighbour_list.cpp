@@ -222,11 +222,19 @@ void NeighbourList::relistDirect(const World& world) {
   }
   auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
   std::sort(m_relisted.begin(), m_relisted.end(), before);
-  // The side list without the relisted floes' old pairs, merged with their new ones.
-  auto old = [&](const ListedPair& p) { return m_relisting[static_cast<size_t>(p.a)] | m_relisting[static_cast<size_t>(p.b)]; };
-  m_sidePairs.erase(std::remove_if(m_sidePairs.begin(), m_sidePairs.end(), old), m_sidePairs.end());
+  // The side list without the relisted floes' old pairs, merged with their new ones, in one pass
+  // (relisting runs nearly every step while the vessel shoves floes, and the side list holds the
+  // pairs of every floe relisted since the build).
   m_merged.resize(m_sidePairs.size() + m_relisted.size());
-  std::merge(m_sidePairs.begin(), m_sidePairs.end(), m_relisted.begin(), m_relisted.end(), m_merged.begin(), before);
+  size_t out = 0;
+  auto fresh = m_relisted.cbegin();
+  for (const ListedPair& p : m_sidePairs) {
+    if (m_relisting[static_cast<size_t>(p.a)] | m_relisting[static_cast<size_t>(p.b)]) continue;
+    while (fresh != m_relisted.cend() && before(*fresh, p)) m_merged[out++] = *fresh++;
+    m_merged[out++] = p;
+  }
+  while (fresh != m_relisted.cend()) m_merged[out++] = *fresh++;
+  m_merged.resize(out);
   m_sidePairs.swap(m_merged);
 
   for (int v : relisted) {
