@@ -737,9 +737,13 @@ TEST(Broadphase, ReferenceGridVisitsEveryReferenceInTheSquareOnce) {
     for (int query = 0; query < 300; ++query) {
       // Squares from a metre to a field wide, some reaching past the field's edges.
       const Real cx = 360 * u(rng) - 30, cy = 260 * u(rng) - 30, reach = query % 10 == 0 ? 150 * u(rng) : 1 + 9 * u(rng);
-      std::vector<int> seen(n, 0);
-      grid.near(cx, cy, reach, [&](int j) { ++seen[j]; });
-      for (int i = 0; i < n; ++i) {
+      const int bodies = static_cast<int>(x.size());
+      std::vector<int> seen(bodies, 0);
+      grid.near(cx, cy, reach, [&](int j) {
+        ASSERT_TRUE(j >= 0 && j < bodies) << what << ": visited slot " << j;
+        ++seen[j];
+      });
+      for (int i = 0; i < bodies; ++i) {
         ASSERT_LE(seen[i], 1) << what << ": body " << i << " visited twice";
         const bool inside = std::fabs(x[i] - cx) <= reach && std::fabs(y[i] - cy) <= reach;
         const bool outside = std::find(inNoCell.begin(), inNoCell.end(), i) != inNoCell.end();
@@ -760,11 +764,25 @@ TEST(Broadphase, ReferenceGridVisitsEveryReferenceInTheSquareOnce) {
     grid.move(i, x[i], y[i]);
   }
   check("after moves", {7, 99, 1234});
-  // A rename: the bodies reversed, binned again in the same cells.
-  std::reverse(x.begin(), x.end()), std::reverse(y.begin(), y.end()), std::reverse(radius.begin(), radius.end());
-  grid.bin(x.data(), y.data(), radius.data(), n);
-  EXPECT_EQ(grid.outsideCount(), 3);
-  check("binned by new slots", {n - 1 - 7, n - 1 - 99, n - 1 - 1234});
+  // A break and a re-sort at once (follow): every tenth body goes (1234, in no cell, among them),
+  // the rest reversed, and 40 new bodies come, two of them too large for a cell.
+  std::vector<int> newSlot(n, -1);
+  std::vector<Real> x2, y2, radius2;
+  for (int j = n - 1; j >= 0; --j) {
+    if (j % 10 == 4) continue;
+    newSlot[j] = static_cast<int>(x2.size());
+    x2.push_back(x[j]), y2.push_back(y[j]), radius2.push_back(radius[j]);
+  }
+  const int kept = static_cast<int>(x2.size());
+  std::vector<char> isNew(static_cast<size_t>(kept), 0);
+  for (int k = 0; k < 40; ++k) {
+    x2.push_back(300 * u(rng)), y2.push_back(200 * u(rng)), radius2.push_back(k < 2 ? Real(300) : Real(1));
+    isNew.push_back(1);
+  }
+  x.swap(x2), y.swap(y2), radius.swap(radius2);
+  grid.follow(newSlot, isNew, x.data(), y.data(), radius.data());
+  EXPECT_EQ(grid.outsideCount(), 4);
+  check("followed to new slots", {newSlot[7], newSlot[99], kept, kept + 1});
 }
 
 // The direct pass and relisting search near their floes through the grid of references; a body not

@@ -99,76 +99,142 @@ NeighbourList::Need NeighbourList::update(const World& world) {
 // caller rebuilds) when the ids cannot be followed: negative, repeated, or too sparse for a table.
 bool NeighbourList::followRenamed(const World& world) {
   const int n = world.size();
-  const size_t oldCount = m_id0.size();
+  const long oldCount = static_cast<long>(m_id0.size());
+  const std::int64_t* id = world.id.data();
   std::int64_t largest = -1;
-  for (const std::int64_t id : world.id) largest = std::max(largest, id);
-  for (const std::int64_t id : m_id0) largest = std::max(largest, id);
+  for (int i = 0; i < n; ++i) largest = std::max(largest, id[i]);
+  for (const std::int64_t old : m_id0) largest = std::max(largest, old);
   if (largest >= 4 * static_cast<std::int64_t>(n + oldCount) + 1024) return false;
-  m_slotOfId.assign(static_cast<size_t>(largest) + 1, -1);
-  for (int i = 0; i < n; ++i) {
-    const std::int64_t id = world.id[static_cast<size_t>(i)];
-    if (id < 0 || m_slotOfId[static_cast<size_t>(id)] >= 0) return false;
-    m_slotOfId[static_cast<size_t>(id)] = i;
-  }
-  m_newSlot.resize(oldCount);
-  std::vector<char> known(static_cast<size_t>(n), 0);
-  for (size_t j = 0; j < oldCount; ++j) {
-    if (m_id0[j] < 0) return false;
-    const int i = m_slotOfId[static_cast<size_t>(m_id0[j])];
-    m_newSlot[j] = i;
-    if (i >= 0) known[static_cast<size_t>(i)] = 1;
-  }
-  // The reference state and the flags move with their bodies; a new body starts direct.
-  std::vector<Real> x0(static_cast<size_t>(n)), y0(static_cast<size_t>(n)), angle0(static_cast<size_t>(n));
-  std::vector<std::int64_t> id0(static_cast<size_t>(n));
-  std::vector<char> direct(static_cast<size_t>(n)), masked(static_cast<size_t>(n));
-  for (size_t j = 0; j < oldCount; ++j) {
-    const int i = m_newSlot[j];
-    if (i < 0) continue;
-    const size_t k = static_cast<size_t>(i);
-    x0[k] = m_x0[j], y0[k] = m_y0[j], angle0[k] = m_angle0[j], id0[k] = m_id0[j];
-    direct[k] = m_direct[j], masked[k] = m_masked[j];
-  }
-  std::vector<int> directList;
-  for (const int v : m_directList)
-    if (m_newSlot[static_cast<size_t>(v)] >= 0) directList.push_back(m_newSlot[static_cast<size_t>(v)]);
-  for (int i = 0; i < n; ++i) {
-    const size_t k = static_cast<size_t>(i);
-    if (known[k]) continue;
-    x0[k] = world.x[k], y0[k] = world.y[k], angle0[k] = world.angle[k], id0[k] = world.id[k];
-    direct[k] = masked[k] = 1;
-    directList.push_back(i);
-  }
-  m_x0.swap(x0), m_y0.swap(y0), m_angle0.swap(angle0), m_id0.swap(id0);
-  m_direct.swap(direct), m_masked.swap(masked), m_directList.swap(directList);
-  m_maskedBodies = static_cast<int>(std::count(m_masked.begin(), m_masked.end(), 1));
-  m_relisting.assign(static_cast<size_t>(n), 0);
-  m_grid.bin(m_x0.data(), m_y0.data(), world.radius.data(), n);  // by their new slots, in the same cells
-  // The pairs renamed, each with its reach (the two shapes are the same). Removing bodies keeps the
-  // order of the others, and the pairs stay sorted; a re-sort is sorted again by rows.
-  auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
-  auto rename = [&](std::vector<ListedPair>& pairs) {
-    size_t kept = 0;
-    bool sorted = true;
-    for (const ListedPair& p : pairs) {
-      const int a = m_newSlot[static_cast<size_t>(p.a)], b = m_newSlot[static_cast<size_t>(p.b)];
-      if (a < 0 || b < 0) continue;
-      const ListedPair q{std::min(a, b), std::max(a, b), p.reach2};
-      if (kept > 0 && !before(pairs[kept - 1], q)) sorted = false;
-      pairs[kept++] = q;
+  // Each id's new slot. Over ranges of bodies: a repeated id makes two ranges write one entry, and
+  // the check after finds the entry naming the other body (the stores are atomic, so the race is
+  // only over which one).
+  m_slotOfId.resize(static_cast<size_t>(largest) + 1);
+  parallelRanges(static_cast<long>(m_slotOfId.size()), kBodyGrain,
+                 [&](int, long begin, long end) { std::fill(m_slotOfId.begin() + begin, m_slotOfId.begin() + end, -1); });
+  std::atomic<bool> unfollowable{false};
+  parallelRanges(n, kBodyGrain, [&](int, long begin, long end) {
+    for (long i = begin; i < end; ++i) {
+      if (id[i] < 0) {
+        unfollowable.store(true, std::memory_order_relaxed);
+        return;
+      }
+      std::atomic_ref<int>(m_slotOfId[static_cast<size_t>(id[i])]).store(static_cast<int>(i), std::memory_order_relaxed);
     }
-    pairs.resize(kept);
-    return sorted;
-  };
-  if (!rename(m_pairs)) {
-    begin(1);
-    m_raw[0].swap(m_pairs);
-    sortRaw(n);
+  });
+  if (unfollowable.load()) return false;
+  // Where each old slot's body went (-1: removed), and which new slots hold a new body.
+  m_newSlot.resize(static_cast<size_t>(oldCount));
+  m_isNew.assign(static_cast<size_t>(n), 1);
+  parallelRanges(n, kBodyGrain, [&](int, long begin, long end) {
+    for (long i = begin; i < end; ++i)
+      if (m_slotOfId[static_cast<size_t>(id[i])] != i) unfollowable.store(true, std::memory_order_relaxed);  // a repeated id
+  });
+  parallelRanges(oldCount, kBodyGrain, [&](int, long begin, long end) {
+    for (long j = begin; j < end; ++j) {
+      const std::int64_t old = m_id0[static_cast<size_t>(j)];
+      const int i = old < 0 ? -1 : m_slotOfId[static_cast<size_t>(old)];
+      m_newSlot[static_cast<size_t>(j)] = i;
+      if (i >= 0) m_isNew[static_cast<size_t>(i)] = 0;
+    }
+  });
+  if (unfollowable.load()) return false;
+  // The reference state and the flags move with their bodies; a new body starts direct, its
+  // reference where it is now. Into buffers kept from one rename to the next, then swapped.
+  const size_t bodies = static_cast<size_t>(n);
+  m_x0Next.resize(bodies), m_y0Next.resize(bodies), m_angle0Next.resize(bodies), m_id0Next.resize(bodies);
+  m_directNext.resize(bodies), m_maskedNext.resize(bodies);
+  parallelRanges(oldCount, kBodyGrain, [&](int, long begin, long end) {
+    for (long j = begin; j < end; ++j) {
+      const int i = m_newSlot[static_cast<size_t>(j)];
+      if (i < 0) continue;
+      const size_t k = static_cast<size_t>(i), from = static_cast<size_t>(j);
+      m_x0Next[k] = m_x0[from], m_y0Next[k] = m_y0[from], m_angle0Next[k] = m_angle0[from], m_id0Next[k] = m_id0[from];
+      m_directNext[k] = m_direct[from], m_maskedNext[k] = m_masked[from];
+    }
+  });
+  size_t keptDirect = 0;
+  for (const int v : m_directList)
+    if (const int i = m_newSlot[static_cast<size_t>(v)]; i >= 0) m_directList[keptDirect++] = i;
+  m_directList.resize(keptDirect);
+  for (int i = 0; i < n; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    if (!m_isNew[k]) continue;
+    m_x0Next[k] = world.x[k], m_y0Next[k] = world.y[k], m_angle0Next[k] = world.angle[k], m_id0Next[k] = world.id[k];
+    m_directNext[k] = m_maskedNext[k] = 1;
+    m_directList.push_back(i);
   }
-  if (!rename(m_sidePairs)) std::sort(m_sidePairs.begin(), m_sidePairs.end(), before);
+  m_x0.swap(m_x0Next), m_y0.swap(m_y0Next), m_angle0.swap(m_angle0Next), m_id0.swap(m_id0Next);
+  m_direct.swap(m_directNext), m_masked.swap(m_maskedNext);
+  m_maskedBodies = static_cast<int>(std::count(m_masked.begin(), m_masked.end(), 1));
+  m_relisting.assign(bodies, 0);
+  m_grid.follow(m_newSlot, m_isNew, m_x0.data(), m_y0.data(), world.radius.data());
+  // The pairs renamed, each with its reach (the two shapes are the same), range by range into the
+  // build's parts. Removing bodies keeps the order of the others, and the parts joined are sorted;
+  // a re-sort's are sorted again by rows (sortRaw), as a build's.
+  auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
+  auto renamed = [&](const ListedPair& p, ListedPair& q) {
+    const int a = m_newSlot[static_cast<size_t>(p.a)], b = m_newSlot[static_cast<size_t>(p.b)];
+    q = ListedPair{std::min(a, b), std::max(a, b), p.reach2};
+    return a >= 0 && b >= 0;
+  };
+  const long listed = static_cast<long>(m_pairs.size());
+  begin(parallelTasks(listed, kPairGrain));
+  std::vector<char> partSorted(m_raw.size(), 1);
+  parallelRanges(listed, kPairGrain, [&](int t, long first, long last) {
+    std::vector<ListedPair>& part = m_raw[static_cast<size_t>(t)];
+    for (long k = first; k < last; ++k) {
+      ListedPair q;
+      if (!renamed(m_pairs[static_cast<size_t>(k)], q)) continue;
+      if (!part.empty() && !before(part.back(), q)) partSorted[static_cast<size_t>(t)] = 0;
+      part.push_back(q);
+    }
+  });
+  if (partsInOrder(partSorted))
+    joinRaw();
+  else
+    sortRaw(n);
+  size_t keptSide = 0;
+  bool sideSorted = true;
+  for (const ListedPair& p : m_sidePairs) {
+    ListedPair q;
+    if (!renamed(p, q)) continue;
+    if (keptSide > 0 && !before(m_sidePairs[keptSide - 1], q)) sideSorted = false;
+    m_sidePairs[keptSide++] = q;
+  }
+  m_sidePairs.resize(keptSide);
+  if (!sideSorted) std::sort(m_sidePairs.begin(), m_sidePairs.end(), before);
   m_chunksKnown = false;  // the pairs were renamed
   ++m_follows;
   return true;
+}
+
+// Whether the build's parts joined in order are sorted by (a, b), given whether each part is:
+// each part's first pair against the last pair of the part before it (empty parts skipped).
+bool NeighbourList::partsInOrder(const std::vector<char>& partSorted) const {
+  auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
+  if (!std::all_of(partSorted.begin(), partSorted.end(), [](char c) { return c != 0; })) return false;
+  const ListedPair* last = nullptr;
+  for (const std::vector<ListedPair>& part : m_raw) {
+    if (part.empty()) continue;
+    if (last && !before(*last, part.front())) return false;
+    last = &part.back();
+  }
+  return true;
+}
+
+// The build's parts, in order, as the list: each part copied to its place on the pool.
+void NeighbourList::joinRaw() {
+  if (m_raw.size() == 1) {
+    m_pairs.swap(m_raw[0]);
+    return;
+  }
+  std::vector<size_t> at(m_raw.size() + 1, 0);
+  for (size_t t = 0; t < m_raw.size(); ++t) at[t + 1] = at[t] + m_raw[t].size();
+  m_pairs.resize(at.back());
+  parallelEach(static_cast<int>(m_raw.size()), [&](int t) {
+    const std::vector<ListedPair>& part = m_raw[static_cast<size_t>(t)];
+    std::copy(part.begin(), part.end(), m_pairs.begin() + static_cast<std::ptrdiff_t>(at[static_cast<size_t>(t)]));
+  });
 }
 
 void NeighbourList::binReferences(const World& world) {
@@ -328,8 +394,7 @@ void NeighbourList::sortRaw(int bodyCount) {
 
 void NeighbourList::finish(const World& world) {
   const int n = world.size();
-  // Whether the parts joined in order are sorted by (a, b): each part, and each part's first pair
-  // against the last pair of the part before it (empty parts skipped), checked part by part.
+  // Whether the parts joined in order are sorted by (a, b): each part checked on its own range.
   const int parts = static_cast<int>(m_raw.size());
   auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
   std::vector<char> partSorted(static_cast<size_t>(parts), 1);
@@ -341,22 +406,10 @@ void NeighbourList::finish(const World& world) {
         return;
       }
   });
-  bool sorted = std::all_of(partSorted.begin(), partSorted.end(), [](char c) { return c != 0; });
-  const ListedPair* last = nullptr;
-  for (int t = 0; sorted && t < parts; ++t) {
-    const std::vector<ListedPair>& part = m_raw[static_cast<size_t>(t)];
-    if (part.empty()) continue;
-    if (last && !before(*last, part.front())) sorted = false;
-    last = &part.back();
-  }
-  if (!sorted) {
+  if (partsInOrder(partSorted))
+    joinRaw();
+  else
     sortRaw(n);
-  } else if (m_raw.size() == 1) {
-    m_pairs.swap(m_raw[0]);
-  } else {
-    m_pairs.clear();
-    for (const std::vector<ListedPair>& part : m_raw) m_pairs.insert(m_pairs.end(), part.begin(), part.end());
-  }
   // Drop wall-wall pairs and duplicates, and fix each pair's reach for the per-step filter, range by
   // range into m_kept, then the ranges' survivors joined in order. The pairs are sorted, so a
   // duplicate follows its twin: "equal to the pair before it" is "equal to the last one kept".

@@ -115,6 +115,8 @@ class NeighbourList {
  private:
   void sortRaw(int bodyCount);
   bool followRenamed(const World& world);
+  bool partsInOrder(const std::vector<char>& partSorted) const;
+  void joinRaw();
   void binReferences(const World& world);
   Real searchReach(Real x, Real y, Real r, Real beyond) const;
   static constexpr int kShortRow = 32;  // rows up to this long are insertion-sorted
@@ -122,7 +124,13 @@ class NeighbourList {
   bool m_valid = false;
   bool m_renamed = false;
   long m_rebuilds = 0, m_relists = 0, m_follows = 0;
-  std::vector<int> m_slotOfId, m_newSlot;  // followRenamed's scratch: by id, and by old slot
+  // followRenamed's scratch: each id's new slot, each old slot's new one, whether a new slot holds a
+  // new body, and the reference state and flags by the new slots before they are swapped in.
+  std::vector<int> m_slotOfId, m_newSlot;
+  std::vector<char> m_isNew;
+  std::vector<Real> m_x0Next, m_y0Next, m_angle0Next;
+  std::vector<std::int64_t> m_id0Next;
+  std::vector<char> m_directNext, m_maskedNext;
   // The bodies whose pairs the main list no longer gives (direct, or relisted since the build):
   // past an eighth of the bodies, the list is rebuilt.
   int m_maskedBodies = 0;

@@ -1,5 +1,7 @@
 #include "broadphase/kept_list/reference_grid.hpp"
 
+#include "framework/api/parallel.hpp"
+
 namespace gem {
 
 void ReferenceGrid::layOut(const Real* x0, const Real* y0, const Real* radius, int n, Real cellFloor) {
@@ -89,6 +91,42 @@ void ReferenceGrid::move(int i, Real x0, Real y0) {
   if (cell == m_in[k]) return;
   unlink(i);
   link(i, cell);
+}
+
+void ReferenceGrid::follow(const std::vector<int>& newSlot, const std::vector<char>& isNew, const Real* x0, const Real* y0,
+                           const Real* radius) {
+  const long oldCount = static_cast<long>(m_in.size());
+  const int n = static_cast<int>(isNew.size());
+  // A removed body leaves its chain first (a break removes a few), so that no chain names it.
+  for (long j = 0; j < oldCount; ++j)
+    if (newSlot[static_cast<size_t>(j)] < 0 && m_in[static_cast<size_t>(j)] >= 0) unlink(static_cast<int>(j));
+  auto renamed = [&](int j) { return j < 0 ? -1 : newSlot[static_cast<size_t>(j)]; };
+  std::vector<int>&next = m_renamed[0], &prev = m_renamed[1], &in = m_renamed[2];
+  next.resize(static_cast<size_t>(n)), prev.resize(static_cast<size_t>(n)), in.resize(static_cast<size_t>(n));
+  parallelRanges(oldCount, 4096, [&](int, long begin, long end) {
+    for (long j = begin; j < end; ++j) {
+      const int i = newSlot[static_cast<size_t>(j)];
+      if (i < 0) continue;
+      const size_t k = static_cast<size_t>(i), from = static_cast<size_t>(j);
+      next[k] = renamed(m_next[from]), prev[k] = renamed(m_prev[from]), in[k] = m_in[from];
+    }
+  });
+  parallelRanges(static_cast<long>(m_head.size()), 4096, [&](int, long begin, long end) {
+    for (long c = begin; c < end; ++c) m_head[static_cast<size_t>(c)] = renamed(m_head[static_cast<size_t>(c)]);
+  });
+  m_next.swap(next), m_prev.swap(prev), m_in.swap(in);
+  size_t kept = 0;
+  for (const int j : m_outside)
+    if (const int i = renamed(j); i >= 0) m_outside[kept++] = i;
+  m_outside.resize(kept);
+  for (int i = 0; i < n; ++i) {
+    if (!isNew[static_cast<size_t>(i)]) continue;
+    m_next[static_cast<size_t>(i)] = m_prev[static_cast<size_t>(i)] = m_in[static_cast<size_t>(i)] = -1;
+    if (m_nx > 0 && radius[i] <= m_largest && std::isfinite(x0[i]) && std::isfinite(y0[i]))
+      link(i, cellOf(x0[i], y0[i]));
+    else
+      m_outside.push_back(i);
+  }
 }
 
 }  // namespace gem

@@ -32,6 +32,12 @@ class ReferenceGrid {
   void bin(const Real* x0, const Real* y0, const Real* radius, int n);
   // Body i's reference is now (x0, y0): it moves to that cell (one in no cell stays in none).
   void move(int i, Real x0, Real y0);
+  // Bodies moved to other slots, keeping their references: old slot j is now newSlot[j] (-1:
+  // removed), and a new slot that no old one maps to (isNew, by new slot) holds a new body, binned
+  // at (x0[i], y0[i]). The chains are renamed over ranges of slots on the caller's parallel runner
+  // (framework/api/parallel.hpp), not binned again: binning is a serial pass of divisions and
+  // scattered writes, and at 10^5 floes a break or a re-sort comes every few dozen steps.
+  void follow(const std::vector<int>& newSlot, const std::vector<char>& isNew, const Real* x0, const Real* y0, const Real* radius);
   bool laidOut() const { return m_nx > 0 || !m_outside.empty(); }
   // The largest radius of the bodies in cells: a search for the bodies within r + R_j + extra of a
   // point reaches largestRadius() + r + extra.
@@ -74,6 +80,7 @@ class ReferenceGrid {
   std::vector<int> m_next, m_prev, m_in;  // by slot: the chain's neighbours (-1: none), its cell (-1: none)
   std::vector<int> m_outside;             // the bodies in no cell, visited by every search
   std::vector<Real> m_scratch;
+  std::vector<int> m_renamed[3];  // follow()'s: next, prev and cell by the new slots
 };
 
 }  // namespace gem
