@@ -31,6 +31,13 @@ using gem::test::TempDir;
 
 namespace {
 
+// A run with no progress line and no closing summary (the other options as a run has them).
+RunOptions quietRun() {
+  RunOptions options;
+  options.quiet = true;
+  return options;
+}
+
 struct Trajectory {
   std::vector<std::int64_t> ids;
   std::vector<Real> state;
@@ -551,7 +558,7 @@ TEST(StopRule, VesselLeftFieldStopsOnceTheHullIsClearOfTheField) {
   test::TempDir dir;
   Scenario s = test::scenarioFromToml(dir, kCrossing, {"simulation.stop_when=\"vessel_left_field\""});
   s.output.dir = dir.path() / "out";
-  const RunSummary r = runScenario(s, RunOptions{true, false});
+  const RunSummary r = runScenario(s, quietRun());
   EXPECT_EQ(r.stopReason, "vessel_left_field");
   EXPECT_TRUE(r.completed);
   const std::vector<double> x = shipX(s.output.dir);
@@ -579,7 +586,7 @@ TEST(StopRule, DistanceStopsAtTheFirstStepPastIt) {
   test::TempDir dir;
   Scenario s = test::scenarioFromToml(dir, kCrossing, {"simulation.stop_when=\"distance\"", "simulation.stop_distance=20.0"});
   s.output.dir = dir.path() / "out";
-  const RunSummary r = runScenario(s, RunOptions{true, false});
+  const RunSummary r = runScenario(s, quietRun());
   EXPECT_EQ(r.stopReason, "distance");
   const std::vector<double> x = shipX(s.output.dir);
   ASSERT_GE(x.size(), 2u);
@@ -591,7 +598,7 @@ TEST(StopRule, DurationRunsEveryStepAndBadSettingsAreRefused) {
   test::TempDir dir;
   Scenario s = test::scenarioFromToml(dir, kCrossing, {"simulation.steps=50"});
   s.output.dir = dir.path() / "out";
-  const RunSummary r = runScenario(s, RunOptions{true, false});
+  const RunSummary r = runScenario(s, quietRun());
   EXPECT_EQ(r.steps, 50);
   EXPECT_EQ(r.stopReason, "duration");
   auto refused = [&](const std::vector<std::string>& overrides, const std::string& expected) {

@@ -24,6 +24,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A run with no progress line and no closing summary (the other options as a run has them).
+RunOptions quietRun() {
+  RunOptions options;
+  options.quiet = true;
+  return options;
+}
+
 const char* const kBase = test::kTinyChannel;
 
 const char* const kProduct = test::kProductSweep;
@@ -268,7 +275,7 @@ TEST(Sweep, FieldFileStaysValidInTheCaseScenario) {
   {
     Scenario s = loadScenario(dir.write("gen.toml", kBase), {"simulation.steps=1", "output.frame_every=1", "output.formats=[\"ice\"]"});
     s.output.dir = dir.path() / "gen";
-    runScenario(s, RunOptions{true, false});
+    runScenario(s, quietRun());
   }
   fs::copy_file(dir.path() / "gen" / "frames.ice", dir.path() / "fields" / "pack.ice");
   dir.write("fields/base.toml",
