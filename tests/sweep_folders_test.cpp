@@ -75,7 +75,7 @@ name = "x=1,y=2"
 TEST(Sweep, ACaseFolderHoldingNoFileWhereItsSummaryGoesIsRefusedBeforeAnyCaseRuns) {
   for (const std::string name : {"summary.json", "case.toml"})
     for (const std::string kind : {"folder", "fifo", "loop"}) {
-      SCOPED_TRACE(name + " as a " + kind);
+      SCOPED_TRACE(::testing::Message() << name << " as a " << kind);
       TempDir dir;
       dir.write("base.toml", kBase);
       const fs::path file = dir.write("study.toml", kProduct), out = dir.path() / "out";
@@ -83,7 +83,9 @@ TEST(Sweep, ACaseFolderHoldingNoFileWhereItsSummaryGoesIsRefusedBeforeAnyCaseRun
       fs::create_directories(caseDir);
       const fs::path place = caseDir / name;
       if (kind == "folder") fs::create_directories(place / "keep");
-      if (kind == "fifo") ASSERT_EQ(::mkfifo(place.c_str(), 0600), 0);
+      if (kind == "fifo") {
+        ASSERT_EQ(::mkfifo(place.c_str(), 0600), 0);
+      }
       if (kind == "loop") fs::create_symlink(name, place);
       const auto log = dir.path() / "log";
       EXPECT_EQ(test::runGem("sweep " + file.string() + " --out " + out.string() + " --quiet", log), 2) << test::readFile(log);
