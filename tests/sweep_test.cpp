@@ -440,12 +440,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadSweep{"nothing_to_run", "[sweep]\nbase = \"base.toml\"\n", {"bad_sweep.toml", "[parameters]"}},
         BadSweep{"toml_syntax", "[sweep]\nbase = \"base.toml\"\n[parameters]\nx = [1\n", {"bad_sweep.toml:4:"}},
         BadSweep{"a_billion_cases",
-                 "[sweep]\nbase = \"base.toml\"\n[parameters]\n" +
+                 std::string("[sweep]\nbase = \"base.toml\"\n[parameters]\n") +
                      [] {
                        std::string lists;
                        for (const char* key : {"\"simulation.dt\"", "\"simulation.seed\"", "\"vessel.bollard_thrust\""}) {
                          lists += std::string(key) + " = [";
-                         for (int k = 1; k <= 1000; ++k) lists += (k > 1 ? ", " : "") + std::to_string(k) + ".0";
+                         for (int k = 1; k <= 1000; ++k) lists.append(k > 1 ? ", " : "").append(std::to_string(k)).append(".0");
                          lists += "]\n";
                        }
                        return lists;
@@ -454,16 +454,16 @@ INSTANTIATE_TEST_SUITE_P(
         // Each [[cases]] entry runs every combination of [parameters]: 400 x 400 cases, each
         // part under the cap, once made 160,000 cases (10^6 of them grew past 7 GB).
         BadSweep{"cases_times_parameters",
-                 "[sweep]\nbase = \"base.toml\"\n[parameters]\n\"simulation.seed\" = [" +
+                 std::string("[sweep]\nbase = \"base.toml\"\n[parameters]\n\"simulation.seed\" = [") +
                      [] {
                        std::string seeds;
-                       for (int k = 0; k < 400; ++k) seeds += (k ? "," : "") + std::to_string(k);
+                       for (int k = 0; k < 400; ++k) seeds.append(k ? "," : "").append(std::to_string(k));
                        return seeds;
                      }() +
                      "]\n" +
                      [] {
                        std::string cases;
-                       for (int k = 0; k < 400; ++k) cases += "[[cases]]\nname = \"c" + std::to_string(k) + "\"\n";
+                       for (int k = 0; k < 400; ++k) cases.append("[[cases]]\nname = \"c").append(std::to_string(k)).append("\"\n");
                        return cases;
                      }(),
                  {"bad_sweep.toml:5:", "400 x 400 = 160000 cases", "at most 100000"}},
