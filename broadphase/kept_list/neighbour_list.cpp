@@ -290,38 +290,47 @@ void NeighbourList::relistDirect(const World& world) {
   std::sort(m_relisted.begin(), m_relisted.end(), before);
   // The side list without the relisted floes' old pairs, merged with their new ones: relisting runs
   // nearly every step while the vessel shoves floes, and the side list holds the pairs of every
-  // floe relisted since the build. Over ranges of the side list, in two passes (each range's kept
-  // pairs counted, then written merged with the new pairs that fall before the next range's first
-  // pair): the same list on any number of threads.
+  // floe relisted since the build. On one thread in one pass; on the pool over ranges of the side
+  // list, in two (each range's kept pairs counted, then written merged with the new pairs that fall
+  // before the next range's first pair): the same list either way.
   const long side = static_cast<long>(m_sidePairs.size());
   const int tasks = parallelTasks(side, kPairGrain);
   auto old = [&](const ListedPair& p) { return (m_relisting[static_cast<size_t>(p.a)] | m_relisting[static_cast<size_t>(p.b)]) != 0; };
-  std::vector<size_t> keptBefore(static_cast<size_t>(tasks) + 1, 0), freshFrom(static_cast<size_t>(tasks) + 1, 0);
-  for (int t = 1; t < tasks; ++t)
-    freshFrom[static_cast<size_t>(t)] = static_cast<size_t>(
-        std::lower_bound(m_relisted.begin(), m_relisted.end(), m_sidePairs[static_cast<size_t>(side * t / tasks)], before) -
-        m_relisted.begin());
-  freshFrom[static_cast<size_t>(tasks)] = m_relisted.size();
-  parallelRanges(side, kPairGrain, [&](int t, long first, long last) {
-    size_t kept = 0;
-    for (long k = first; k < last; ++k) kept += !old(m_sidePairs[static_cast<size_t>(k)]);
-    keptBefore[static_cast<size_t>(t) + 1] = kept;
-  });
-  for (size_t t = 1; t < keptBefore.size(); ++t) keptBefore[t] += keptBefore[t - 1];
-  m_merged.resize(keptBefore.back() + m_relisted.size());
-  parallelRanges(side, kPairGrain, [&](int t, long first, long last) {
-    const size_t range = static_cast<size_t>(t);
-    size_t out = keptBefore[range] + freshFrom[range];
-    auto fresh = m_relisted.cbegin() + static_cast<std::ptrdiff_t>(freshFrom[range]);
-    const auto freshEnd = m_relisted.cbegin() + static_cast<std::ptrdiff_t>(freshFrom[range + 1]);
+  // Range t's pairs merged with the new pairs [freshBegin, freshEnd) from m_merged[out] on; returns the end.
+  auto mergeRange = [&](long first, long last, size_t freshBegin, size_t freshEnd, size_t out) {
+    auto fresh = m_relisted.cbegin() + static_cast<std::ptrdiff_t>(freshBegin);
+    const auto freshStop = m_relisted.cbegin() + static_cast<std::ptrdiff_t>(freshEnd);
     for (long k = first; k < last; ++k) {
       const ListedPair& p = m_sidePairs[static_cast<size_t>(k)];
       if (old(p)) continue;
-      while (fresh != freshEnd && before(*fresh, p)) m_merged[out++] = *fresh++;
+      while (fresh != freshStop && before(*fresh, p)) m_merged[out++] = *fresh++;
       m_merged[out++] = p;
     }
-    while (fresh != freshEnd) m_merged[out++] = *fresh++;
-  });
+    while (fresh != freshStop) m_merged[out++] = *fresh++;
+    return out;
+  };
+  m_merged.resize(m_sidePairs.size() + m_relisted.size());
+  if (tasks == 1) {
+    m_merged.resize(mergeRange(0, side, 0, m_relisted.size(), 0));
+  } else {
+    std::vector<size_t> keptBefore(static_cast<size_t>(tasks) + 1, 0), freshFrom(static_cast<size_t>(tasks) + 1, 0);
+    for (int t = 1; t < tasks; ++t)
+      freshFrom[static_cast<size_t>(t)] = static_cast<size_t>(
+          std::lower_bound(m_relisted.begin(), m_relisted.end(), m_sidePairs[static_cast<size_t>(side * t / tasks)], before) -
+          m_relisted.begin());
+    freshFrom[static_cast<size_t>(tasks)] = m_relisted.size();
+    parallelRanges(side, kPairGrain, [&](int t, long first, long last) {
+      size_t kept = 0;
+      for (long k = first; k < last; ++k) kept += !old(m_sidePairs[static_cast<size_t>(k)]);
+      keptBefore[static_cast<size_t>(t) + 1] = kept;
+    });
+    for (size_t t = 1; t < keptBefore.size(); ++t) keptBefore[t] += keptBefore[t - 1];
+    parallelRanges(side, kPairGrain, [&](int t, long first, long last) {
+      const size_t range = static_cast<size_t>(t);
+      mergeRange(first, last, freshFrom[range], freshFrom[range + 1], keptBefore[range] + freshFrom[range]);
+    });
+    m_merged.resize(keptBefore.back() + m_relisted.size());
+  }
   m_sidePairs.swap(m_merged);
 
   for (int v : relisted) {
