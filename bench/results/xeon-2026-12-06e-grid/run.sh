@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue "CPU speed", 2026-12-06 evening: 33ed364 (new: the kept list's direct pass and relisting
+# Issue "CPU speed", 2026-12-06 evening: b23a4ad (new: the kept list's direct pass and relisting
 # search a grid of the references; the rebuild budget counts each relisted floe once; a rename is
 # followed on the pool; relisting rewrites the side list on the pool) against 8aa28e4 (main: the
 # code of main before, 05afc91 changing only docs and comments) and 4e89f89 (old) on the lent
