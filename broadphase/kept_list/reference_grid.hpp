@@ -5,10 +5,10 @@
 // Why a grid of references, not of positions: the list's rule (docs/model.md 9) keeps every body
 // that is not direct within half the skin of its reference, so a body found near a reference is
 // near the body; and a reference changes only at a build, a rename or a relist, not every step, so
-// the grid is kept: a relisted floe moves to the cell of its new reference (each cell is a
-// doubly linked chain of slots), and a rename bins every body again in the same cells. The bodies
-// far larger than most (the walls span the field) and a reference at no finite place are in no
-// cell: every search visits them.
+// the grid is kept: a relisted floe moves to the cell of its new reference (each cell is a doubly
+// linked chain of slots), and a rename renames the chains. The bodies far larger than most (the
+// walls span the field) and a reference at no finite place are in no cell: every search visits
+// them.
 //
 // At 10^5 floes the two searches were a pass over every body for each direct or relisted floe:
 // relisting's was the largest item of a one-thread step (docs/performance.md 3.14, 3.15).
@@ -27,9 +27,6 @@ class ReferenceGrid {
   // passes twice the 99th percentile of the radii go in no cell. The cells are at least
   // `cellFloor` wider than two of the largest radii in them (the caller's reach beyond the radii).
   void layOut(const Real* x0, const Real* y0, const Real* radius, int n, Real cellFloor);
-  // Bins bodies [0, n) afresh in the cells laid out (after the bodies moved to other slots): one no
-  // larger than the largest binned radius, with a finite reference, goes to its reference's cell.
-  void bin(const Real* x0, const Real* y0, const Real* radius, int n);
   // Body i's reference is now (x0, y0): it moves to that cell (one in no cell stays in none).
   void move(int i, Real x0, Real y0);
   // Bodies moved to other slots, keeping their references: old slot j is now newSlot[j] (-1:
@@ -38,7 +35,6 @@ class ReferenceGrid {
   // (framework/api/parallel.hpp), not binned again: binning is a serial pass of divisions and
   // scattered writes, and at 10^5 floes a break or a re-sort comes every few dozen steps.
   void follow(const std::vector<int>& newSlot, const std::vector<char>& isNew, const Real* x0, const Real* y0, const Real* radius);
-  bool laidOut() const { return m_nx > 0 || !m_outside.empty(); }
   // The largest radius of the bodies in cells: a search for the bodies within r + R_j + extra of a
   // point reaches largestRadius() + r + extra.
   Real largestRadius() const { return m_largest; }
@@ -71,6 +67,9 @@ class ReferenceGrid {
     return c >= static_cast<Real>(count - 1) ? count - 1 : static_cast<int>(c);
   }
   int cellOf(Real x0, Real y0) const { return cellAlong(y0, m_y0, m_ny) * m_nx + cellAlong(x0, m_x0, m_nx); }
+  // Bins bodies [0, n) in the cells laid out: one no larger than the largest radius found in them,
+  // with a finite reference, goes to its reference's cell.
+  void bin(const Real* x0, const Real* y0, const Real* radius, int n);
   void link(int i, int cell);
   void unlink(int i);
 
