@@ -721,18 +721,6 @@ void PairsWithinReach::sweep(const World&, const std::vector<Real>&, Real floor,
   });
 }
 
-namespace {
-
-// The cell of coordinate v along an axis of `count` cells from `origin`: clamped, so that a
-// position outside the box still lands in a cell.
-int cellAlong(Real v, Real origin, Real cell, int count) {
-  const Real c = std::floor((v - origin) / cell);
-  if (!(c >= 0)) return 0;
-  return c >= static_cast<Real>(count - 1) ? count - 1 : static_cast<int>(c);
-}
-
-}  // namespace
-
 double PairsWithinReach::binInGrid(const World& world, const std::vector<Real>& h, Real floor) {
   const int n = world.size();
   const Real* x = world.x.data();
@@ -741,10 +729,7 @@ double PairsWithinReach::binInGrid(const World& world, const std::vector<Real>& 
   for (int i = 0; i < n; ++i) m_extent[i] = std::max(floor / 2, h[i]);
   // Large: more than twice the 99th percentile of the extents (walls, the odd giant floe). The
   // cell: twice the largest of the others, so any pair of them within reach is in adjacent cells.
-  m_scratch.assign(m_extent.begin(), m_extent.end());
-  const auto percentile = m_scratch.begin() + static_cast<std::ptrdiff_t>((n - 1) * 99 / 100);
-  std::nth_element(m_scratch.begin(), percentile, m_scratch.end());
-  const Real cut = 2 * *percentile;
+  const Real cut = grid_cells::largeCut(m_extent.data(), n, m_scratch);
   m_large.clear();
   m_isLarge.assign(static_cast<size_t>(n), 0);
   Real largest = 0, x0 = 0, x1 = 0, y0 = 0, y1 = 0;
@@ -761,20 +746,17 @@ double PairsWithinReach::binInGrid(const World& world, const std::vector<Real>& 
     any = true;
   }
   // A hair wider than 2 e: a pair exactly at reach stays within one cell of each other however the
-  // division rounds. Past 4 n + 1024 cells (a sparse field in a huge box), coarser cells.
-  const Real scale = std::max({Real(1), std::fabs(x0), std::fabs(x1), std::fabs(y0), std::fabs(y1)});
-  Real cell = std::max(2 * largest * (1 + Real(1e-9)), Real(1e-9) * scale);
-  auto cellsAlong = [&](Real span) { return std::min<Real>(std::floor(span / cell) + 1, Real(1 << 30)); };
-  const Real most = 4 * static_cast<Real>(n) + 1024;
-  while (cellsAlong(x1 - x0) * cellsAlong(y1 - y0) > most) cell *= 2;
-  m_nx = static_cast<int>(cellsAlong(x1 - x0)), m_ny = static_cast<int>(cellsAlong(y1 - y0));
+  // division rounds.
+  const grid_cells::Layout cells = grid_cells::layOut(x0, x1, y0, y1, 2 * largest * (1 + Real(1e-9)), n);
+  const Real cell = cells.cell;
+  m_nx = cells.nx, m_ny = cells.ny;
 
   // The counting sort of the ordinary bodies by cell.
   m_cellOf.assign(static_cast<size_t>(n), -1);
   m_cellStart.assign(static_cast<size_t>(m_nx) * static_cast<size_t>(m_ny) + 1, 0);
   for (int i = 0; i < n; ++i) {
     if (m_isLarge[static_cast<size_t>(i)]) continue;
-    const int c = cellAlong(y[i], y0, cell, m_ny) * m_nx + cellAlong(x[i], x0, cell, m_nx);
+    const int c = grid_cells::cellAlong(y[i], y0, cell, m_ny) * m_nx + grid_cells::cellAlong(x[i], x0, cell, m_nx);
     m_cellOf[static_cast<size_t>(i)] = c;
     ++m_cellStart[static_cast<size_t>(c) + 1];
   }

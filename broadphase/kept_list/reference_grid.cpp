@@ -4,6 +4,22 @@
 
 namespace gem {
 
+Real grid_cells::largeCut(const Real* size, int n, std::vector<Real>& scratch) {
+  scratch.assign(size, size + n);
+  const auto percentile = scratch.begin() + static_cast<std::ptrdiff_t>((n - 1) * 99 / 100);
+  std::nth_element(scratch.begin(), percentile, scratch.end());
+  return 2 * *percentile;
+}
+
+grid_cells::Layout grid_cells::layOut(Real x0, Real x1, Real y0, Real y1, Real least, int n) {
+  const Real scale = std::max({Real(1), std::fabs(x0), std::fabs(x1), std::fabs(y0), std::fabs(y1)});
+  Real cell = std::max(least, Real(1e-9) * scale);
+  auto cellsAlong = [&](Real span) { return std::min<Real>(std::floor(span / cell) + 1, Real(1 << 30)); };
+  const Real most = 4 * static_cast<Real>(n) + 1024;
+  while (cellsAlong(x1 - x0) * cellsAlong(y1 - y0) > most) cell *= 2;
+  return Layout{cell, static_cast<int>(cellsAlong(x1 - x0)), static_cast<int>(cellsAlong(y1 - y0))};
+}
+
 void ReferenceGrid::layOut(const Real* x0, const Real* y0, const Real* radius, int n, Real cellFloor) {
   m_nx = m_ny = 0;
   m_largest = 0;
@@ -12,12 +28,7 @@ void ReferenceGrid::layOut(const Real* x0, const Real* y0, const Real* radius, i
     bin(x0, y0, radius, 0);
     return;
   }
-  // In no cell: more than twice the 99th percentile of the radii (the walls, the odd giant floe),
-  // as the build's grid decides (PairsWithinReach::binInGrid).
-  m_scratch.assign(radius, radius + n);
-  const auto percentile = m_scratch.begin() + static_cast<std::ptrdiff_t>((n - 1) * 99 / 100);
-  std::nth_element(m_scratch.begin(), percentile, m_scratch.end());
-  const Real cut = 2 * *percentile;
+  const Real cut = grid_cells::largeCut(radius, n, m_scratch);
   Real x1 = 0, y1 = 0;
   bool any = false;
   for (int i = 0; i < n; ++i) {
@@ -29,14 +40,10 @@ void ReferenceGrid::layOut(const Real* x0, const Real* y0, const Real* radius, i
   }
   if (any) {
     // As wide as a typical search's square (two of the largest radii and the reach beyond them),
-    // so that a search meets about 3 x 3 cells. Past 4 n + 1024 cells (a sparse field in a huge
-    // box), coarser cells. A reference outside these bounds later is clamped into a border cell.
-    const Real scale = std::max({Real(1), std::fabs(m_x0), std::fabs(x1), std::fabs(m_y0), std::fabs(y1)});
-    m_cell = std::max(2 * m_largest + cellFloor, Real(1e-9) * scale);
-    auto cellsAlong = [&](Real span) { return std::min<Real>(std::floor(span / m_cell) + 1, Real(1 << 30)); };
-    const Real most = 4 * static_cast<Real>(n) + 1024;
-    while (cellsAlong(x1 - m_x0) * cellsAlong(y1 - m_y0) > most) m_cell *= 2;
-    m_nx = static_cast<int>(cellsAlong(x1 - m_x0)), m_ny = static_cast<int>(cellsAlong(y1 - m_y0));
+    // so that a search meets about 3 x 3 cells. A reference outside these bounds later is clamped
+    // into a border cell.
+    const grid_cells::Layout cells = grid_cells::layOut(m_x0, x1, m_y0, y1, 2 * m_largest + cellFloor, n);
+    m_cell = cells.cell, m_nx = cells.nx, m_ny = cells.ny;
   }
   bin(x0, y0, radius, n);
 }

@@ -21,6 +21,34 @@
 
 namespace gem {
 
+// What the kept lists' two uniform grids share: the build's (PairsWithinReach::binInGrid) and the
+// grid of reference states below.
+namespace grid_cells {
+
+// The cell of coordinate v along an axis of `count` cells of width `cell` from `origin`: clamped,
+// so that a coordinate outside the grid, or not a number, still lands in a cell. Monotonic in v,
+// so a point inside a square is in a cell between the square's corners' cells, whether or not
+// either was clamped.
+inline int cellAlong(Real v, Real origin, Real cell, int count) {
+  const Real c = std::floor((v - origin) / cell);
+  if (!(c >= 0)) return 0;
+  return c >= static_cast<Real>(count - 1) ? count - 1 : static_cast<int>(c);
+}
+
+// Twice the 99th percentile of size[0 .. n): a body larger is in no cell (the walls, the odd
+// giant floe), so that it does not widen every cell. n > 0.
+Real largeCut(const Real* size, int n, std::vector<Real>& scratch);
+
+// Cells at least `least` wide (and a billionth of the coordinates' scale) over the box [x0, x1] x
+// [y0, y1], doubled past 4 n + 1024 cells (a sparse field in a huge box).
+struct Layout {
+  Real cell;
+  int nx, ny;
+};
+Layout layOut(Real x0, Real x1, Real y0, Real y1, Real least, int n);
+
+}  // namespace grid_cells
+
 class ReferenceGrid {
  public:
   // Lays the cells out for bodies at (x0[i], y0[i]), i < n, and bins them: the bodies whose radius
@@ -57,15 +85,7 @@ class ReferenceGrid {
   }
 
  private:
-  // The cell of coordinate v along an axis of `count` cells from `origin`: clamped, so that a
-  // coordinate outside the grid, or not a number, still lands in a cell. Monotonic in v, so a
-  // reference inside a search's square is in a cell between the square's corners' cells, whether
-  // or not either was clamped.
-  int cellAlong(Real v, Real origin, int count) const {
-    const Real c = std::floor((v - origin) / m_cell);
-    if (!(c >= 0)) return 0;
-    return c >= static_cast<Real>(count - 1) ? count - 1 : static_cast<int>(c);
-  }
+  int cellAlong(Real v, Real origin, int count) const { return grid_cells::cellAlong(v, origin, m_cell, count); }
   int cellOf(Real x0, Real y0) const { return cellAlong(y0, m_y0, m_ny) * m_nx + cellAlong(x0, m_x0, m_nx); }
   // Bins bodies [0, n) in the cells laid out: one no larger than the largest radius found in them,
   // with a finite reference, goes to its reference's cell.
