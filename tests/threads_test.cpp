@@ -268,6 +268,30 @@ TEST(CpuTiming, OneLineOfPhasesThatAddUpToTheStep) {
   }
   EXPECT_GT(total, 0);
   EXPECT_NEAR(sum, total, 1e-3 + 1e-3 * total);  // each figure is rounded to 0.1 us
+  // On several threads a second line tells where the pool's time went: the rounds and the calling
+  // thread's time between them add up to the step.
+  Scenario threaded = s;
+  threaded.threads = 2;
+  ::setenv("GEM_CPU_TIMING", "1", 1);
+  ::testing::internal::CaptureStderr();
+  {
+    CpuStepper sim(threaded);
+    for (int k = 0; k < 12; ++k) sim.step();
+  }
+  const std::string lines = ::testing::internal::GetCapturedStderr();
+  ::unsetenv("GEM_CPU_TIMING");
+  const size_t pool = lines.find("gem cpu pool, 2 threads: ");
+  ASSERT_NE(pool, std::string::npos) << lines;
+  auto figureBefore = [&](const std::string& words) {
+    const size_t w = lines.find(words, pool);
+    EXPECT_NE(w, std::string::npos) << words << " missing in: " << lines;
+    return w == std::string::npos ? -1.0 : std::stod(lines.substr(lines.rfind(' ', w - 1) + 1));
+  };
+  const double threadedTotal = std::stod(lines.substr(lines.rfind(' ', lines.find(" ms a step; of it") - 1) + 1));
+  const double inRounds = figureBefore(" ms a step in rounds"), between = figureBefore(" ms a step between rounds");
+  EXPECT_GE(inRounds, 0);
+  EXPECT_GE(between, 0);
+  EXPECT_NEAR(inRounds + between, threadedTotal, 1e-3 + 1e-3 * threadedTotal);
   // Off, nothing is printed.
   ::testing::internal::CaptureStderr();
   {
@@ -293,29 +317,37 @@ TEST(Threads, ABrokenFieldStepsBitForBitOnThreeThreads) {
 TEST(Threads, RemovingBodiesOnThePoolLeavesTheWorldOneThreadLeaves) {
   World start;
   for (int k = 0; k < 40000; ++k)
-    start.addBody(test::squareFloe({Real(1.5) * static_cast<Real>(k % 200), Real(1.5) * static_cast<Real>(k / 200)}, 1, 0.5,
-                                   {Real(0.001) * static_cast<Real>(k % 7), 0}, Real(0.01) * static_cast<Real>(k % 3)));
-  std::vector<char> remove(start.id.size(), 0);
-  for (size_t i = 3; i < remove.size(); i += 7) remove[i] = 1;
-  World alone = start, pooled = start;
-  alone.removeBodies(remove);
-  ThreadPool pool(3);
-  {
-    const ParallelScope lend(&pool);
-    ASSERT_GT(parallelTasks(static_cast<long>(remove.size()), 4096), 1) << "too few bodies for the pool to be used";
-    pooled.removeBodies(remove, parallelEach);
+    start.addBody(test::squareFloe({Real(1.5) * static_cast<Real>(k % 200), Real(1.5) * static_cast<Real>(k / 200)},
+                                   Real(0.5) + Real(0.001) * static_cast<Real>(k % 499), 0.5, {Real(0.001) * static_cast<Real>(k % 7), 0},
+                                   Real(0.01) * static_cast<Real>(k % 3)));  // sizes that differ, so that each body's vertices do
+  // Every seventh body (a range of the vertices then holds fewer kept rows than it sets aside), and
+  // a break's few (each range sets aside a row or two that the range before it would overwrite).
+  std::vector<char> everySeventh(start.id.size(), 0), aFew(start.id.size(), 0);
+  for (size_t i = 3; i < everySeventh.size(); i += 7) everySeventh[i] = 1;
+  for (const size_t i : {1200u, 9999u, 10000u, 27001u}) aFew[i] = 1;
+  for (const std::vector<char>* remove : {&everySeventh, &aFew}) {
+    World alone = start, pooled = start;
+    alone.removeBodies(*remove);
+    ThreadPool pool(3);
+    {
+      const ParallelScope lend(&pool);
+      ASSERT_GT(parallelTasks(static_cast<long>(remove->size()), 4096), 1) << "too few bodies for the pool to be used";
+      pooled.removeBodies(*remove, parallelEach);
+    }
+    ASSERT_EQ(pooled.size(), alone.size());
+    EXPECT_EQ(alone.size(), 40000 - static_cast<int>(std::count(remove->begin(), remove->end(), 1)));
+    EXPECT_EQ(pooled.id, alone.id);
+    EXPECT_EQ(pooled.kind, alone.kind);
+    EXPECT_EQ(pooled.vertexCount, alone.vertexCount);
+    for (auto member : {&World::x, &World::y, &World::angle, &World::vx, &World::vy, &World::omega, &World::area, &World::thickness,
+                        &World::mass, &World::invMass, &World::invInertia, &World::gyration2, &World::gyrationX2, &World::gyrationY2,
+                        &World::principalAngle, &World::radius})
+      EXPECT_EQ(pooled.*member, alone.*member);
+    ASSERT_EQ(pooled.localVertices.size(), alone.localVertices.size());
+    EXPECT_EQ(0, std::memcmp(pooled.localVertices.data(), alone.localVertices.data(), alone.localVertices.size() * sizeof(Vec2)));
   }
-  ASSERT_EQ(pooled.size(), alone.size());
-  EXPECT_EQ(alone.size(), 40000 - static_cast<int>(std::count(remove.begin(), remove.end(), 1)));
-  EXPECT_EQ(pooled.id, alone.id);
-  EXPECT_EQ(pooled.kind, alone.kind);
-  EXPECT_EQ(pooled.vertexCount, alone.vertexCount);
-  for (auto member : {&World::x, &World::y, &World::angle, &World::vx, &World::vy, &World::omega, &World::area, &World::thickness,
-                      &World::mass, &World::invMass, &World::invInertia, &World::gyration2, &World::gyrationX2, &World::gyrationY2,
-                      &World::principalAngle, &World::radius})
-    EXPECT_EQ(pooled.*member, alone.*member);
-  ASSERT_EQ(pooled.localVertices.size(), alone.localVertices.size());
-  EXPECT_EQ(0, std::memcmp(pooled.localVertices.data(), alone.localVertices.data(), alone.localVertices.size() * sizeof(Vec2)));
+  World alone = start;
+  alone.removeBodies(everySeventh);
   EXPECT_EQ(alone.id[3], start.id[4]) << "the bodies after a removed one move down, in order";
 }
 
@@ -359,6 +391,58 @@ TEST(ThreadPool, RoundsAfterTheWorkersSleptAndTasksThatOutlastTheSpin) {
     });
     for (const auto& s : seen) ASSERT_EQ(s.load(), 1) << "round " << round;
   }
+}
+
+// Each thread takes its own contiguous group of a round's tasks first (ThreadPool::Group), so that
+// a phase's ranges land on the same thread, and in its cache, round after round. Every task here
+// waits until each thread has started one: none can have run out of its own group and stolen yet,
+// so each thread's first task is the head of its own group, and the caller's is the last group's.
+TEST(ThreadPool, EachThreadStartsWithTheHeadOfItsOwnGroupOfTasks) {
+  constexpr int kThreads = 4, kTasks = 8;
+  ThreadPool pool(kThreads);
+  for (int round = 0; round < 20; ++round) {
+    std::atomic<int> started{0};
+    std::vector<std::thread::id> ranBy(kTasks);
+    std::vector<std::atomic<int>> seen(kTasks);
+    pool.run(kTasks, [&](int k) {
+      ranBy[static_cast<size_t>(k)] = std::this_thread::get_id();
+      ++seen[static_cast<size_t>(k)];
+      if (started.fetch_add(1) < kThreads)
+        while (started.load() < kThreads) std::this_thread::yield();
+    });
+    for (const auto& s : seen) ASSERT_EQ(s.load(), 1) << "round " << round;
+    // The heads 0, 2, 4 and 6 ran on four different threads, the last group's on the caller.
+    std::vector<std::thread::id> heads;
+    for (int k = 0; k < kTasks; k += kTasks / kThreads) heads.push_back(ranBy[static_cast<size_t>(k)]);
+    std::sort(heads.begin(), heads.end());
+    EXPECT_EQ(std::unique(heads.begin(), heads.end()), heads.end()) << "two groups' heads on one thread, round " << round;
+    EXPECT_EQ(ranBy[kTasks - kTasks / kThreads], std::this_thread::get_id()) << "round " << round;
+  }
+}
+
+// GEM_CPU_TIMING's account of the pool: off, nothing is counted; on, every round and task is, and
+// the parts add up (the wait on the last tasks is part of a round, a task lies within its round).
+TEST(ThreadPool, CountsItsRoundsAndTasksOnlyWhenMeasuring) {
+  ThreadPool pool(3);
+  pool.run(9, [](int) {});
+  EXPECT_EQ(pool.stats().rounds, 0);
+  pool.setMeasuring(true);
+  for (int round = 0; round < 10; ++round)
+    pool.run(9, [](int k) {
+      if (k == 8) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    });
+  pool.run(1, [](int) {});  // one task runs on the caller alone: not a round on the pool
+  const ThreadPool::Stats& stats = pool.stats();
+  EXPECT_EQ(stats.rounds, 10);
+  EXPECT_EQ(stats.tasks, 90);
+  EXPECT_GE(stats.longestTask, 10 * 200e-6);
+  EXPECT_LE(stats.longestTask, stats.inRounds);
+  EXPECT_LE(stats.tail, stats.inRounds);
+  EXPECT_GE(stats.busy, stats.longestTask);
+  EXPECT_LE(stats.busy, 3 * stats.inRounds);
+  pool.resetStats();
+  EXPECT_EQ(pool.stats().rounds, 0);
+  EXPECT_EQ(pool.stats().busy, 0);
 }
 
 TEST(Threads, TheScenarioKeyAndTheCommandLineOption) {

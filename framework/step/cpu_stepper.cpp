@@ -197,6 +197,20 @@ CpuStepper::~CpuStepper() {
     line += fmt::format("{} {} {:.4f}", p ? "," : "", PhaseClock::kNames[static_cast<size_t>(p)],
                         1e3 * m_clock.seconds[static_cast<size_t>(p)] / static_cast<double>(m_clock.steps));
   std::fprintf(stderr, "%s\n", line.c_str());
+  if (!m_pool) return;
+  // Where the threads' time goes: a step is its rounds on the pool and the calling thread's work
+  // between them; a round ends when its last task does, so "waiting on the last tasks" is the
+  // imbalance, and the threads' busy share of the rounds' time is the pool's efficiency.
+  const ThreadPool::Stats& pool = m_pool->stats();
+  const double steps = static_cast<double>(m_clock.steps);
+  const double threadSeconds = pool.inRounds * m_pool->size();
+  std::fprintf(stderr,
+               "gem cpu pool, %d threads: %.1f rounds and %.1f tasks a step; %.4f ms a step in rounds, %.4f of it waiting on the last "
+               "tasks; %.4f ms a step between rounds on the calling thread; the threads busy %.0f %% of the rounds' time; the longest "
+               "task %.4f ms a round\n",
+               m_pool->size(), pool.rounds / steps, pool.tasks / steps, 1e3 * pool.inRounds / steps, 1e3 * pool.tail / steps,
+               1e3 * (total - pool.inRounds) / steps, threadSeconds > 0 ? 100 * pool.busy / threadSeconds : 0.0,
+               pool.rounds ? 1e3 * pool.longestTask / static_cast<double>(pool.rounds) : 0.0);
 }
 
 namespace {
@@ -624,7 +638,10 @@ void CpuStepper::step() {
   if (!m_poolChecked) {
     m_poolChecked = true;
     const int threads = threadsFor(m_scenario.threads);
-    if (threads > 1) m_pool = std::make_unique<ThreadPool>(threads);
+    if (threads > 1) {
+      m_pool = std::make_unique<ThreadPool>(threads);
+      m_pool->setMeasuring(m_clock.on);
+    }
   }
   m_clock.start();
   const StepContext ctx{m_scenario.dt, m_time, m_step};

@@ -58,7 +58,10 @@ class CpuStepper final : public Stepper {
   std::string backend() const override { return "cpu"; }
   const std::vector<EnabledEvent>& events() const { return m_events; }
   Broadphase& broadphase() { return *m_broadphase; }
-  void restartPhaseClock() override { m_clock.steps = 0, m_clock.seconds = {}; }
+  void restartPhaseClock() override {
+    m_clock.steps = 0, m_clock.seconds = {};
+    if (m_pool) m_pool->resetStats();
+  }
 
   // What the last step produced.
   const StepRecords& records() const override { return m_records; }

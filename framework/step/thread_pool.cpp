@@ -42,7 +42,8 @@ bool spinUntil(Ready ready) {
 
 }  // namespace
 
-ThreadPool::ThreadPool(int threads) {
+ThreadPool::ThreadPool(int threads)
+    : m_groups(static_cast<size_t>(threads < 1 ? 1 : threads)), m_times(static_cast<size_t>(threads < 1 ? 1 : threads)) {
   for (int t = 1; t < threads; ++t) m_workers.emplace_back([this, t] { work(t - 1); });
 }
 
@@ -53,14 +54,28 @@ ThreadPool::~ThreadPool() {
   for (std::thread& t : m_workers) t.join();
 }
 
-// Tasks are taken one at a time from a shared counter until none is left.
-void ThreadPool::drain() {
-  for (int k = m_next++; k < m_tasks; k = m_next++) {
-    try {
-      (*m_task)(k);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(m_mutex);
-      if (!m_error) m_error = std::current_exception();
+// Tasks are taken one at a time, first from the thread's own group, then from the others' in
+// turn, until none is left.
+void ThreadPool::drain(int self) {
+  ThreadTimes* times = m_measuring ? &m_times[static_cast<size_t>(self)] : nullptr;
+  const int groups = m_groupCount;
+  const int own = self < groups - 1 ? self : groups - 1;  // the caller (and only it) takes the last group
+  for (int step = 0; step < groups; ++step) {
+    Group& group = m_groups[static_cast<size_t>((own + step) % groups)];
+    for (int k = group.next++; k < group.end; k = group.next++) {
+      try {
+        if (times) {
+          const auto start = std::chrono::steady_clock::now();
+          (*m_task)(k);
+          const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          times->busy += took, times->longest = std::max(times->longest, took), ++times->tasks;
+        } else {
+          (*m_task)(k);
+        }
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        if (!m_error) m_error = std::current_exception();
+      }
     }
   }
 }
@@ -81,7 +96,7 @@ void ThreadPool::work(int index) {
     const std::uint64_t word = m_round.load();
     seen = word / kRoundUnit;
     if (index >= static_cast<int>(word % kRoundUnit)) continue;
-    drain();
+    drain(index);
     if (m_running.fetch_sub(1) == 1 && m_callerSleeping.load()) {
       std::lock_guard<std::mutex> lock(m_mutex);
       m_done.notify_one();
@@ -96,18 +111,29 @@ void ThreadPool::run(int tasks, const std::function<void(int)>& task) {
   }
   // No worker is in a round here (the last one ended before the previous run() returned), so the
   // round's fields are written plainly; the store of the round word publishes them.
+  std::chrono::steady_clock::time_point published, callerDone;
+  if (m_measuring) {
+    published = std::chrono::steady_clock::now();
+    for (ThreadTimes& t : m_times) t = ThreadTimes{};
+  }
   m_task = &task;
   m_tasks = tasks;
-  m_next.store(0);
   m_error = nullptr;
   const int participants = std::min(static_cast<int>(m_workers.size()), tasks - 1);
+  m_groupCount = participants + 1;
+  for (int g = 0; g < m_groupCount; ++g) {
+    Group& group = m_groups[static_cast<size_t>(g)];
+    group.next.store(static_cast<int>(static_cast<long>(tasks) * g / m_groupCount), std::memory_order_relaxed);
+    group.end = static_cast<int>(static_cast<long>(tasks) * (g + 1) / m_groupCount);
+  }
   m_running.store(participants);
   m_round.store((m_round.load() / kRoundUnit + 1) * kRoundUnit + static_cast<std::uint64_t>(participants));
   if (m_sleepingWorkers.load() > 0) {
     { std::lock_guard<std::mutex> lock(m_mutex); }
     m_wake.notify_all();
   }
-  drain();
+  drain(static_cast<int>(m_workers.size()));  // the caller's group is the last
+  if (m_measuring) callerDone = std::chrono::steady_clock::now();
   if (!spinUntil([&] { return m_running.load() == 0; })) {
     std::unique_lock<std::mutex> lock(m_mutex);
     m_callerSleeping.store(true);  // then the check in wait(): the last worker sees it, or this its end
@@ -115,6 +141,15 @@ void ThreadPool::run(int tasks, const std::function<void(int)>& task) {
     m_callerSleeping.store(false);
   }
   m_task = nullptr;
+  if (m_measuring) {  // every worker's times were written before its decrement of m_running, which this saw
+    const auto end = std::chrono::steady_clock::now();
+    ++m_stats.rounds;
+    m_stats.inRounds += std::chrono::duration<double>(end - published).count();
+    m_stats.tail += std::chrono::duration<double>(end - callerDone).count();
+    double longest = 0;
+    for (const ThreadTimes& t : m_times) m_stats.busy += t.busy, m_stats.tasks += t.tasks, longest = std::max(longest, t.longest);
+    m_stats.longestTask += longest;
+  }
   // Every task's error was stored before its worker's decrement of m_running, which this saw.
   if (std::exception_ptr error = std::exchange(m_error, nullptr)) std::rethrow_exception(error);
 }

@@ -93,7 +93,8 @@ struct World {
   // Removes the bodies whose flag is set, keeping the order of the others.
   // forEachTask, when given, runs tasks 0 .. count - 1 on the caller's threads (a topology event
   // passes framework/api/parallel.hpp's parallelEach when the CPU stepper has lent its pool): each
-  // array is then compacted by a task of its own. The result is the same either way.
+  // array is then compacted by a task of its own, the vertices by ranges of rows. The result is the
+  // same either way.
   using TaskRunner = std::function<void(int count, const std::function<void(int)>& task)>;
   void removeBodies(const std::vector<char>& remove, const TaskRunner& forEachTask = nullptr);
   // The arrays a permute() leaves behind, kept by a caller that permutes again and again (the CPU

@@ -166,7 +166,9 @@ TEST_P(CudaRunFolder, CtrlCInsideABatchStopsCasesRunTogetherWhole) {
     EXPECT_GT(steps, 0);
     const std::string series = readFile(out / "cases" / name / "timeseries.csv");
     EXPECT_EQ(static_cast<long>(std::count(series.begin(), series.end(), '\n')), steps + 1);  // a row a step, whole
-    if (stepsOfA >= 0) EXPECT_EQ(steps, stepsOfA);                                            // the cases stepped together stop at one step
+    if (stepsOfA >= 0) {
+      EXPECT_EQ(steps, stepsOfA);  // the cases stepped together stop at one step
+    }
     stepsOfA = steps;
   }
 }
