@@ -367,6 +367,41 @@ void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range)
   });
 }
 
+namespace {
+
+// Whether none of the eight stillness flags at `flags` is kMoving: one load, a zero byte found by
+// the carry trick.
+inline bool noneMovingOfEight(const char* flags) {
+  static_assert(CpuStepper::kMovingFlag == 0, "the test looks for zero bytes");
+  constexpr std::uint64_t kOnes = 0x0101010101010101ull, kHighs = 0x8080808080808080ull;
+  std::uint64_t word;
+  std::memcpy(&word, flags, sizeof word);
+  return ((word - kOnes) & ~word & kHighs) == 0;
+}
+
+}  // namespace
+
+// Whether every body of [begin, end) was left kStill by the last body updates and none has a
+// contact now: eight flags a load, then the contacts' stamps in one branch-free pass (the compiler
+// vectorizes it). Tested body by body, this was a tenth of a resting 10^5-floe step.
+bool CpuStepper::blockRestsUntouched(const char* stillness, int begin, int end) const {
+  constexpr std::uint64_t kAllStill = 0x0101010101010101ull * static_cast<unsigned char>(kStill);
+  int i = begin;
+  for (; i + 8 <= end; i += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, stillness + i, sizeof word);
+    if (word != kAllStill) return false;
+  }
+  for (; i < end; ++i)
+    if (stillness[i] != kStill) return false;
+  const unsigned* stamp = m_byBody.stamp.data();
+  const unsigned current = m_byBody.current;
+  const int stampedEnd = std::min(end, static_cast<int>(m_byBody.stamp.size()));
+  bool touched = false;
+  for (int j = begin; j < stampedEnd; ++j) touched |= stamp[j] == current;
+  return !touched;
+}
+
 void CpuStepper::narrowphase() {
   const int n = m_world.size();
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
@@ -390,24 +425,31 @@ void CpuStepper::narrowphase() {
     const unsigned* const stamp = m_byBody.stamp.data();
     const int stamped = static_cast<int>(m_byBody.stamp.size());
     const unsigned current = m_byBody.current;
-    for (int i = begin; i < end; ++i) {
-      const bool inContact = i < stamped && stamp[i] == current;  // m_byBody.has(i)
-      if (still && still[i] != kMoving) {
-        movedFlags[i] = 0;
-        activeFlags[i] = inContact;
-        continue;
+    // First every body as if it were still, branch-free (the compiler vectorizes it): not moved,
+    // active when it has a contact (m_byBody.has(i)). In a resting pack that is nearly every body,
+    // and one branch a body was most of this pass at 10^5 floes. Then the bodies that may have
+    // moved, eight flags at a time passed over where none is kMoving.
+    const int stampedEnd = std::max(begin, std::min(end, stamped));
+    for (int i = begin; i < stampedEnd; ++i) movedFlags[i] = 0, activeFlags[i] = stamp[i] == current;
+    for (int i = stampedEnd; i < end; ++i) movedFlags[i] = 0, activeFlags[i] = 0;
+    for (int block = begin; block < end; block += 8) {
+      const int blockEnd = std::min(end, block + 8);
+      if (still && blockEnd - block == 8 && noneMovingOfEight(still + block)) continue;
+      for (int i = block; i < blockEnd; ++i) {
+        if (still && still[i] != kMoving) continue;
+        const bool inContact = activeFlags[i] != 0;
+        if (i < lastSlots && m_lastSlotId[i] != m_world.id[i]) slotsChanged.store(true, std::memory_order_relaxed);
+        // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
+        // vertices from an earlier step are still exact, so only bodies that moved are transformed.
+        const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
+        const bool moved = !(pose == m_vertexPose[i]);
+        movedFlags[i] = moved;
+        activeFlags[i] = moved || inContact;  // a slot that changed hands has moved: its pose holds its id
+        if (!moved) continue;
+        m_vertexPose[i] = pose;
+        Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
+        m_boxes[i] = boundingBox(v, m_world.worldVertices(i, v));
       }
-      if (i < lastSlots && m_lastSlotId[i] != m_world.id[i]) slotsChanged.store(true, std::memory_order_relaxed);
-      // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
-      // vertices from an earlier step are still exact, so only bodies that moved are transformed.
-      const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
-      const bool moved = !(pose == m_vertexPose[i]);
-      movedFlags[i] = moved;
-      activeFlags[i] = moved || inContact;  // a slot that changed hands has moved: its pose holds its id
-      if (!moved) continue;
-      m_vertexPose[i] = pose;
-      Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
-      m_boxes[i] = boundingBox(v, m_world.worldVertices(i, v));
     }
   });
 
@@ -811,11 +853,7 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
   const char* stillness = m_skipStillBodies && m_stillnessKnown ? m_stillness.data() : nullptr;
   std::atomic<int> updated{0};
   forEachBlock(n, [&](int begin, int end) {
-    if (stillness) {
-      int i = begin;
-      while (i < end && stillness[i] == kStill && !m_byBody.has(i)) ++i;
-      if (i == end) return;
-    }
+    if (stillness && blockRestsUntouched(stillness, begin, end)) return;
     // A thread's views of its current block (kBlock bodies at most): cache-sized, made once.
     thread_local std::vector<SoloBody> solo;
     thread_local std::vector<VelocityChange> total;
