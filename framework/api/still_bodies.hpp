@@ -8,6 +8,8 @@
 // mirror, a broadphase called outside a step) stillBodies() is null and every body is checked. Not
 // part of the plugin ABI: nothing here travels in a struct a plugin reads.
 #pragma once
+#include <cstdint>
+#include <cstring>
 
 namespace gem {
 
@@ -27,5 +29,15 @@ class StillBodiesScope {
 };
 
 const char* stillBodies();
+
+// Whether the eight flags at `flags` are all nonzero (all still): one load, a zero byte found by
+// the carry trick. A pack at rest is mostly still, and a flag a branch was most of a pass over
+// 10^5 bodies; the CPU stepper's own flags are zero for a moving body as well.
+inline bool allEightStill(const char* flags) {
+  constexpr std::uint64_t kOnes = 0x0101010101010101ull, kHighs = 0x8080808080808080ull;
+  std::uint64_t word;
+  std::memcpy(&word, flags, sizeof word);
+  return ((word - kOnes) & ~word & kHighs) == 0;
+}
 
 }  // namespace gem

@@ -367,20 +367,6 @@ void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range)
   });
 }
 
-namespace {
-
-// Whether none of the eight stillness flags at `flags` is kMoving: one load, a zero byte found by
-// the carry trick.
-inline bool noneMovingOfEight(const char* flags) {
-  static_assert(CpuStepper::kMovingFlag == 0, "the test looks for zero bytes");
-  constexpr std::uint64_t kOnes = 0x0101010101010101ull, kHighs = 0x8080808080808080ull;
-  std::uint64_t word;
-  std::memcpy(&word, flags, sizeof word);
-  return ((word - kOnes) & ~word & kHighs) == 0;
-}
-
-}  // namespace
-
 // Whether every body of [begin, end) was left kStill by the last body updates and none has a
 // contact now: eight flags a load, then the contacts' stamps in one branch-free pass (the compiler
 // vectorizes it). Tested body by body, this was a tenth of a resting 10^5-floe step.
@@ -397,9 +383,9 @@ bool CpuStepper::blockRestsUntouched(const char* stillness, int begin, int end) 
   const unsigned* stamp = m_byBody.stamp.data();
   const unsigned current = m_byBody.current;
   const int stampedEnd = std::min(end, static_cast<int>(m_byBody.stamp.size()));
-  bool touched = false;
-  for (int j = begin; j < stampedEnd; ++j) touched |= stamp[j] == current;
-  return !touched;
+  int touched = 0;  // a count, not a bool: GCC 12 vectorizes an integer sum, not a bool's |=
+  for (int j = begin; j < stampedEnd; ++j) touched += stamp[j] == current;
+  return touched == 0;
 }
 
 void CpuStepper::narrowphase() {
@@ -429,12 +415,13 @@ void CpuStepper::narrowphase() {
     // active when it has a contact (m_byBody.has(i)). In a resting pack that is nearly every body,
     // and one branch a body was most of this pass at 10^5 floes. Then the bodies that may have
     // moved, eight flags at a time passed over where none is kMoving.
+    static_assert(kMoving == 0, "allEightStill looks for zero flags");
     const int stampedEnd = std::max(begin, std::min(end, stamped));
     for (int i = begin; i < stampedEnd; ++i) movedFlags[i] = 0, activeFlags[i] = stamp[i] == current;
     for (int i = stampedEnd; i < end; ++i) movedFlags[i] = 0, activeFlags[i] = 0;
     for (int block = begin; block < end; block += 8) {
       const int blockEnd = std::min(end, block + 8);
-      if (still && blockEnd - block == 8 && noneMovingOfEight(still + block)) continue;
+      if (still && blockEnd - block == 8 && allEightStill(still + block)) continue;
       for (int i = block; i < blockEnd; ++i) {
         if (still && still[i] != kMoving) continue;
         const bool inContact = activeFlags[i] != 0;

@@ -156,11 +156,6 @@ class CpuStepper final : public Stepper {
   // same state, no contact and the same events give the very same bits, so its update would write
   // nothing.
   enum Stillness : char { kMoving = 0, kStillInContact = 1, kStill = 2 };
-
- public:
-  static constexpr char kMovingFlag = kMoving;  // for the narrowphase's search of the flags
-
- private:
   std::vector<char> m_stillness;
   bool m_stillnessKnown = false;
   bool m_skipStillBodies = false;
