@@ -292,6 +292,18 @@ TEST(CpuTiming, OneLineOfPhasesThatAddUpToTheStep) {
   EXPECT_GE(inRounds, 0);
   EXPECT_GE(between, 0);
   EXPECT_NEAR(inRounds + between, threadedTotal, 1e-3 + 1e-3 * threadedTotal);
+  // And phase by phase: the time each phase spent between rounds, which adds up to the same.
+  const size_t byPhase = lines.find("gem cpu pool, between rounds by phase, ms a step: ");
+  ASSERT_NE(byPhase, std::string::npos) << lines;
+  double phasesBetween = 0;
+  for (const char* phase : {"broadphase", "narrowphase tests", "narrowphase join", "pair views and events", "body updates", "topology"}) {
+    const size_t p = lines.find(std::string(phase) + " ", byPhase);
+    ASSERT_NE(p, std::string::npos) << phase << " missing in: " << lines;
+    const double figure = std::stod(lines.substr(p + std::string(phase).size() + 1));
+    EXPECT_GE(figure, -1e-4) << phase;
+    phasesBetween += figure;
+  }
+  EXPECT_NEAR(phasesBetween, between, 1e-3 + 1e-3 * between);
   // Off, nothing is printed.
   ::testing::internal::CaptureStderr();
   {

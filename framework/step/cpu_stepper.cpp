@@ -211,6 +211,13 @@ CpuStepper::~CpuStepper() {
                m_pool->size(), pool.rounds / steps, pool.tasks / steps, 1e3 * pool.inRounds / steps, 1e3 * pool.tail / steps,
                1e3 * (total - pool.inRounds) / steps, threadSeconds > 0 ? 100 * pool.busy / threadSeconds : 0.0,
                pool.rounds ? 1e3 * pool.longestTask / static_cast<double>(pool.rounds) : 0.0);
+  // The serial part phase by phase: what a phase spent outside its rounds.
+  std::string serial = "gem cpu pool, between rounds by phase, ms a step:";
+  for (int p = 0; p < PhaseClock::kPhases; ++p) {
+    const auto k = static_cast<size_t>(p);
+    serial += fmt::format("{} {} {:.4f}", p ? "," : "", PhaseClock::kNames[k], 1e3 * (m_clock.seconds[k] - m_clock.inRounds[k]) / steps);
+  }
+  std::fprintf(stderr, "%s\n", serial.c_str());
 }
 
 namespace {
@@ -670,6 +677,7 @@ void CpuStepper::step() {
     if (threads > 1) {
       m_pool = std::make_unique<ThreadPool>(threads);
       m_pool->setMeasuring(m_clock.on);
+      m_clock.pool = m_pool.get();
     }
   }
   m_clock.start();

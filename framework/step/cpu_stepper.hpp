@@ -59,7 +59,7 @@ class CpuStepper final : public Stepper {
   const std::vector<EnabledEvent>& events() const { return m_events; }
   Broadphase& broadphase() { return *m_broadphase; }
   void restartPhaseClock() override {
-    m_clock.steps = 0, m_clock.seconds = {};
+    m_clock.steps = 0, m_clock.seconds = {}, m_clock.inRounds = {}, m_clock.poolMark = 0;
     if (m_pool) m_pool->resetStats();
   }
 
@@ -107,15 +107,22 @@ class CpuStepper final : public Stepper {
     bool on = false;
     long steps = 0;
     std::array<double, kPhases> seconds{};
+    // Of each phase, the time inside rounds on the pool (its ThreadPool::Stats::inRounds grew by it).
+    std::array<double, kPhases> inRounds{};
+    const ThreadPool* pool = nullptr;
+    double poolMark = 0;
     std::chrono::steady_clock::time_point mark;
     void start() {
-      if (on) mark = std::chrono::steady_clock::now();
+      if (!on) return;
+      mark = std::chrono::steady_clock::now();
+      if (pool) poolMark = pool->stats().inRounds;
     }
     void lap(Phase phase) {
       if (!on) return;
       const auto now = std::chrono::steady_clock::now();
       seconds[phase] += std::chrono::duration<double>(now - mark).count();
       mark = now;
+      if (pool) inRounds[phase] += pool->stats().inRounds - poolMark, poolMark = pool->stats().inRounds;
     }
   } m_clock;
 
