@@ -275,21 +275,32 @@ void NeighbourList::relistDirect(const World& world) {
   // is within half the skin of its reference, so the square around the floe that reaches its
   // radius, the largest binned radius, the relisting reach and half the skin holds the reference of
   // every body it could list. The direct bodies are the relisted floes and the vessels (never listed).
+  // On the pool over ranges of the relisted floes (a few dozen searches, the serial part of a step
+  // at 10^5 floes that relists nearly every step), each range's pairs into a part of its own; the
+  // parts are joined and sorted, so the list is the same on any thread count.
   const Real margin = kRelistReach * m_skin;
+  const long relistedCount = static_cast<long>(relisted.size());
+  m_relistedParts.resize(static_cast<size_t>(parallelTasks(relistedCount, kRelistGrain)));
+  parallelRanges(relistedCount, kRelistGrain, [&](int t, long first, long last) {
+    std::vector<ListedPair>& part = m_relistedParts[static_cast<size_t>(t)];
+    part.clear();
+    for (long k = first; k < last; ++k) {
+      const int v = relisted[static_cast<size_t>(k)];
+      auto test = [&](int j) {
+        if (j == v || (m_relisting[static_cast<size_t>(j)] && j < v)) return;  // a pair of two relisted floes once
+        // As finish(): wall-wall pairs never interact, vessel pairs are found by the direct pass.
+        if (world.kind[j] == BodyKind::Vessel || (world.kind[v] == BodyKind::Wall && world.kind[j] == BodyKind::Wall)) return;
+        const Real dx = x[v] - x[j], dy = y[v] - y[j], touch = radius[v] + radius[j], reach = touch + margin;
+        if (dx * dx + dy * dy <= reach * reach) part.push_back({j < v ? j : v, j < v ? v : j, touch * touch});
+      };
+      m_grid.near(x[v], y[v], searchReach(x[v], y[v], radius[v], margin), [&](int j) {
+        if (!m_direct[static_cast<size_t>(j)]) test(j);
+      });
+      for (const int j : relisted) test(j);
+    }
+  });
   m_relisted.clear();
-  for (const int v : relisted) {
-    auto test = [&](int j) {
-      if (j == v || (m_relisting[static_cast<size_t>(j)] && j < v)) return;  // a pair of two relisted floes once
-      // As finish(): wall-wall pairs never interact, vessel pairs are found by the direct pass.
-      if (world.kind[j] == BodyKind::Vessel || (world.kind[v] == BodyKind::Wall && world.kind[j] == BodyKind::Wall)) return;
-      const Real dx = x[v] - x[j], dy = y[v] - y[j], touch = radius[v] + radius[j], reach = touch + margin;
-      if (dx * dx + dy * dy <= reach * reach) m_relisted.push_back({j < v ? j : v, j < v ? v : j, touch * touch});
-    };
-    m_grid.near(x[v], y[v], searchReach(x[v], y[v], radius[v], margin), [&](int j) {
-      if (!m_direct[static_cast<size_t>(j)]) test(j);
-    });
-    for (const int j : relisted) test(j);
-  }
+  for (const std::vector<ListedPair>& part : m_relistedParts) m_relisted.insert(m_relisted.end(), part.begin(), part.end());
   auto before = [](const ListedPair& p, const ListedPair& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
   std::sort(m_relisted.begin(), m_relisted.end(), before);
   // The side list without the relisted floes' old pairs, merged with their new ones: relisting runs
@@ -519,6 +530,7 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   const long chunks = (listed + kChunkPairs - 1) / kChunkPairs;
   const bool reuse = m_chunksKnown && m_stillKnown && static_cast<long>(m_chunkCount.size()) == chunks;
   m_chunkCount.resize(static_cast<size_t>(chunks)), m_chunkFirstBlock.resize(static_cast<size_t>(chunks));
+  m_chunkHead.resize(static_cast<size_t>(chunks));
   m_chunkLastBlock.resize(static_cast<size_t>(chunks));
   const int* movingBefore = m_movingBlocksBefore.data();
   parallelRanges(chunks, kPairGrain / kChunkPairs, [&](int, long firstChunk, long endChunk) {
@@ -536,6 +548,7 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
         last = std::max(last, p.b);
       }
       m_chunkCount[chunk] = count;
+      m_chunkHead[chunk] = dst[0];  // its first pair when count > 0, read by the join's walk
       m_chunkFirstBlock[chunk] = m_pairs[static_cast<size_t>(begin)].a / kFlagBlock;  // the pairs are sorted by a, and a < b
       m_chunkLastBlock[chunk] = last / kFlagBlock;
     }
@@ -601,7 +614,7 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   for (size_t c = 0; c < static_cast<size_t>(chunks); ++c) {
     m_chunkOffset[c + 1] = m_chunkOffset[c] + static_cast<size_t>(m_chunkCount[c]);
     if (c == 0 || m_chunkCount[c] == 0) continue;
-    const CandidatePair head = m_filtered[c * kChunkPairs];
+    const CandidatePair head = m_chunkHead[c];
     while (walk < m_directPairs.size() && before(m_directPairs[walk], head)) ++walk;
     m_directFrom[c] = walk;
   }

@@ -144,6 +144,9 @@ class NeighbourList {
   // as a running count.
   bool m_chunksKnown = false, m_stillKnown = false;
   std::vector<int> m_chunkCount, m_chunkFirstBlock, m_chunkLastBlock;
+  // Each chunk's first kept pair, beside its count: the join's walk reads these few kilobytes, where
+  // the chunks' first rows in the scratch were a cache miss each (7 us a step at 10^5 floes).
+  std::vector<CandidatePair> m_chunkHead;
   std::vector<char> m_blockMoving;
   std::vector<int> m_movingBlocksBefore;
   std::vector<size_t> m_chunkOffset, m_directFrom;  // the join's: where each chunk's pairs and its direct pairs go
@@ -171,6 +174,8 @@ class NeighbourList {
   std::vector<char> m_masked;
   std::vector<char> m_relisting;
   std::vector<ListedPair> m_relisted, m_merged;
+  std::vector<std::vector<ListedPair>> m_relistedParts;  // relisting's searches, range by range
+  static constexpr int kRelistGrain = 2;                 // relisted floes a range at least
   std::vector<std::vector<CandidatePair>> m_sideParts;
 };
 
