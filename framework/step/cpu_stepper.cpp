@@ -574,7 +574,11 @@ void CpuStepper::narrowphase() {
   m_clock.lap(PhaseClock::Tests);
 
   joinParts(tasks);
-  if (slotsChanged.load(std::memory_order_relaxed)) m_lastSlotId.assign(m_world.id.begin(), m_world.id.end());
+  if (slotsChanged.load(std::memory_order_relaxed)) {  // after a break or a re-sort: 0.8 MB at 10^5 floes, over ranges
+    m_lastSlotId.resize(static_cast<size_t>(n));
+    forEachRange(
+        n, [&](int begin, int end) { std::copy(m_world.id.begin() + begin, m_world.id.begin() + end, m_lastSlotId.begin() + begin); });
+  }
   m_byBody.build(m_contactA, m_contactB, n);
   m_clock.lap(PhaseClock::Join);
 }
