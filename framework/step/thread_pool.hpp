@@ -68,9 +68,9 @@ class ThreadPool final : public ParallelRunner {
   // The round's tasks in one contiguous group per taking thread: a thread takes its own group's
   // tasks first, in order, then the other groups' (threads that run out help the rest). A phase
   // cuts its work into ranges in order, so the same thread takes the same stretch of the field in
-  // every phase and step, and finds it in its own cache: with one shared counter, which thread took
-  // which range changed every round, and at 16 threads the tasks took 2.4 times the one-thread
-  // time in all (docs/performance.md 3.16).
+  // every phase and step, and can find it in its own cache (with one shared counter, which thread
+  // took which range changed every round). On a 16-thread Xeon it changed the step by less than the
+  // noise (docs/performance.md 3.16).
   struct alignas(64) Group {
     std::atomic<int> next{0};
     int end = 0;
