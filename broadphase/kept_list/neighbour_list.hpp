@@ -149,7 +149,8 @@ class NeighbourList {
   std::vector<CandidatePair> m_chunkHead;
   std::vector<char> m_blockMoving;
   std::vector<int> m_movingBlocksBefore;
-  std::vector<size_t> m_chunkOffset, m_directFrom;  // the join's: where each chunk's pairs and its direct pairs go
+  std::vector<size_t> m_rangeKept;   // the chunks' pass, range by range: its kept pairs (then the sum before each range)
+  std::vector<size_t> m_directFrom;  // the join's: where each chunk's direct pairs start
   // The counting sort's row starts (bodies + 1) and next free places (bodies), and each range's
   // count of the filters' survivors.
   std::vector<int> m_count, m_cursor;
