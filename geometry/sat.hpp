@@ -76,10 +76,19 @@ struct SeparatingEdge {
   int edge;
 };
 
-// True when edge i of p (from p[i] to p[i + 1]) separates q.
+// True when edge i of p (from p[i] to p[i + 1]) separates q: edgeSeparatesFrom's test of every q
+// vertex, the same arithmetic, without its early exit. This is the CPU narrowphase's first try at a
+// pair that was apart last step, and there it nearly always separates, so every vertex is tested
+// anyway: counting the vertices inside, with no branch and no wrap-around, is cheaper than stopping
+// at the first.
 GEM_HD inline bool edgeSeparatesAt(const Vec2* p, int n, int i, const Vec2* q, int m) {
-  int witness = 0;
-  return detail::edgeSeparatesFrom(p, n, i, q, m, witness);
+  const Vec2 a = p[i], e = p[i + 1 == n ? 0 : i + 1] - a;
+  const Vec2 nrm{e.y, -e.x};
+  const Real le = l1Norm(e);
+  const Real tol = kGeomRelTol * le * (le + l1Norm(a));
+  int inside = 0;
+  for (int j = 0; j < m; ++j) inside += dot(nrm, q[j] - a) < -tol;
+  return inside == 0;
 }
 
 // True when `axis` (any side and index; an index out of range is simply not tried) separates p and q.
