@@ -298,9 +298,13 @@ const std::vector<std::pair<std::int64_t, Real>>* CpuStepper::contactForces() co
     m_contactForces.clear();
     // The last gather wrote the forces of the bodies of a contact only: m_byBody lists their slots
     // until the next step's narrowphase.
-    for (const int i : m_byBody.bodies)
-      if (static_cast<size_t>(i) < m_contactForceOfSlot.size() && m_contactForceOfSlot[static_cast<size_t>(i)] > 0)
-        m_contactForces.emplace_back(m_contactForceId[static_cast<size_t>(i)], m_contactForceOfSlot[static_cast<size_t>(i)]);
+    for (const int i : m_byBody.bodies) {
+      if (static_cast<size_t>(i) >= m_contactImpulseOfSlot.size()) continue;
+      const Vec2 onBody = m_contactImpulseOfSlot[static_cast<size_t>(i)];
+      if (onBody.x == 0 && onBody.y == 0) continue;
+      const Real force = norm(onBody) / m_scenario.dt;
+      if (force > 0) m_contactForces.emplace_back(m_contactForceId[static_cast<size_t>(i)], force);
+    }
     std::sort(m_contactForces.begin(), m_contactForces.end());
     m_contactForcesBuilt = true;
   }
@@ -841,7 +845,7 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
   // in contact order, as a = -impulse and b = +impulse (m_byBody: k x 2 + side).
   const int vessel = m_vesselId >= 0 ? vesselSlot() : -1;
   Vec2 vesselImpulse{0, 0};
-  m_contactForceOfSlot.resize(n);
+  m_contactImpulseOfSlot.resize(n);
   m_contactForceId.resize(n);
   // A block whose bodies the last updates all left still, none with a contact now, is left out
   // while the run's solo and motion events are time invariant (m_stillness): most of a pack rests
@@ -894,7 +898,7 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
         if (i == vessel) vesselImpulse = onBody;
         // Kept for contactForces() by the slot the body has now (a break or a re-sort after the
         // gather moves bodies between slots), for the bodies of a contact only: m_byBody lists them.
-        m_contactForceOfSlot[i] = onBody.x == 0 && onBody.y == 0 ? Real(0) : norm(onBody) / m_scenario.dt;
+        m_contactImpulseOfSlot[i] = onBody;
         m_contactForceId[i] = m_world.id[i];
       }
       motion[q] = MotionBody{
