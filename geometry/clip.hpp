@@ -21,6 +21,28 @@ struct ClipVertex {
   signed char outEdge;
 };
 
+// A polygon's length scales for the merge tolerance of clipConvex: its bounding box's largest side
+// and its largest |coordinate|.
+struct ClipScale {
+  Real extent, magnitude;
+};
+
+// The scales from the polygon's bounding box (x0, y0) to (x1, y1), for a caller that keeps each
+// body's box (the CPU narrowphase's m_boxes, from boundingBox in geometry/polygon.hpp): the values
+// clipConvex finds from the vertices themselves. (The two minima differ at most in which of two
+// equal zeros they keep, which changes neither scale.)
+GEM_HD inline ClipScale clipScaleOfBox(Real x0, Real y0, Real x1, Real y1) {
+  using detail::maxR;
+  return {maxR(x1 - x0, y1 - y0), maxR(maxR(std::fabs(x0), std::fabs(x1)), maxR(std::fabs(y0), std::fabs(y1)))};
+}
+
+// The merge tolerance of clipConvex for polygons of scales p and q: vertices closer than this are
+// one vertex. Relative to the smaller body (the overlap's scale) and to the coordinate magnitude
+// (the rounding of world coordinates).
+GEM_HD inline Real clipToleranceOf(ClipScale p, ClipScale q) {
+  return kGeomRelTol * (detail::minR(p.extent, q.extent) + detail::maxR(p.magnitude, q.magnitude));
+}
+
 namespace detail {
 
 // Largest bounding-box side and largest |coordinate| of a polygon: the length scales of the
@@ -31,8 +53,8 @@ GEM_HD inline void extentAndMagnitude(const Vec2* v, int n, Real* extent, Real* 
     x0 = minR(x0, v[i].x), x1 = maxR(x1, v[i].x);
     y0 = minR(y0, v[i].y), y1 = maxR(y1, v[i].y);
   }
-  *extent = maxR(x1 - x0, y1 - y0);
-  *magnitude = maxR(maxR(std::fabs(x0), std::fabs(x1)), maxR(std::fabs(y0), std::fabs(y1)));
+  const ClipScale scale = clipScaleOfBox(x0, y0, x1, y1);
+  *extent = scale.extent, *magnitude = scale.magnitude;
 }
 
 GEM_HD inline bool nearPoint(Vec2 a, Vec2 b, Real tol) { return std::fabs(a.x - b.x) <= tol && std::fabs(a.y - b.y) <= tol; }
@@ -80,14 +102,13 @@ struct ClipWriter {
   }
 };
 
-// The merge tolerance of clipConvex for polygons p (n vertices) and q (m): vertices closer than
-// this are one vertex. Relative to the smaller body (the overlap's scale) and to the coordinate
-// magnitude (the rounding of world coordinates).
+// The merge tolerance of clipConvex for polygons p (n vertices) and q (m): clipToleranceOf their
+// scales.
 GEM_HD inline Real clipTolerance(const Vec2* p, int n, const Vec2* q, int m) {
-  Real extP, magP, extQ, magQ;
-  extentAndMagnitude(p, n, &extP, &magP);
-  extentAndMagnitude(q, m, &extQ, &magQ);
-  return kGeomRelTol * (minR(extP, extQ) + maxR(magP, magQ));
+  ClipScale scaleP, scaleQ;
+  extentAndMagnitude(p, n, &scaleP.extent, &scaleP.magnitude);
+  extentAndMagnitude(q, m, &scaleQ.extent, &scaleQ.magnitude);
+  return clipToleranceOf(scaleP, scaleQ);
 }
 
 // Which side of the clip line through a along e the point x lies on: >= 0 is inside (left of a
@@ -114,9 +135,10 @@ GEM_HD inline int closeRing(ClipVertex* v, int k, Real tol) {
 // empty or has collapsed to fewer than 3 vertices (touching at a point or along an edge).
 // A point exactly on a clip line counts as inside, so an edge of P lying along an edge of Q stays
 // tagged 0 and the crossings are where the other boundary leaves it.
-GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVertex* out) {
+// tol is the merge tolerance, detail::clipTolerance(p, n, q, m) (the overload below), or
+// clipToleranceOf the scales of the polygons' bounding boxes where the caller keeps them.
+GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVertex* out, Real tol) {
   if (n < 3 || m < 3) return 0;
-  const Real tol = detail::clipTolerance(p, n, q, m);
 
   ClipVertex tmp[kMaxClipVertices];
   ClipVertex* src = out;
@@ -164,6 +186,11 @@ GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVer
   if (src != out)
     for (int i = 0; i < k; ++i) out[i] = src[i];
   return k;
+}
+
+GEM_HD inline int clipConvex(const Vec2* p, int n, const Vec2* q, int m, ClipVertex* out) {
+  if (n < 3 || m < 3) return 0;
+  return clipConvex(p, n, q, m, out, detail::clipTolerance(p, n, q, m));
 }
 
 // Area of a clipped polygon (shoelace about its first vertex, for precision far from the origin).

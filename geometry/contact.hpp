@@ -75,15 +75,27 @@ GEM_HD inline Contact contactOfOverlap(const ClipVertex* v, int k, const Vec2* p
 
 // computeContact's second half, for a caller that has already found no separating edge (the CPU
 // narrowphase's findSeparatingEdge): the clipping and the contact, without the test again.
+// clipTol is clipConvex's merge tolerance (clip.hpp), when the caller has it from the bodies' boxes.
+GEM_HD inline Contact contactOfOverlapping(const Vec2* p, int n, Vec2 centroidP, const Vec2* q, int m, Vec2 centroidQ, Real clipTol) {
+  ClipVertex v[kMaxClipVertices];
+  const int k = clipConvex(p, n, q, m, v, clipTol);
+  return contactOfOverlap(v, k, p, n, centroidP, q, m, centroidQ);
+}
+
 GEM_HD inline Contact contactOfOverlapping(const Vec2* p, int n, Vec2 centroidP, const Vec2* q, int m, Vec2 centroidQ) {
   ClipVertex v[kMaxClipVertices];
   const int k = clipConvex(p, n, q, m, v);
   return contactOfOverlap(v, k, p, n, centroidP, q, m, centroidQ);
 }
 
-GEM_HD inline Contact computeContact(const Vec2* p, int n, Vec2 centroidP, const Vec2* q, int m, Vec2 centroidQ) {
+GEM_HD inline Contact computeContact(const Vec2* p, int n, Vec2 centroidP, const Vec2* q, int m, Vec2 centroidQ, Real clipTol) {
   // Most candidate pairs from a broadphase are apart: the separating-axis test rejects them
   // faster than the clipping does.
+  if (!convexOverlap(p, n, q, m)) return contactOfOverlap(nullptr, 0, p, n, centroidP, q, m, centroidQ);
+  return contactOfOverlapping(p, n, centroidP, q, m, centroidQ, clipTol);
+}
+
+GEM_HD inline Contact computeContact(const Vec2* p, int n, Vec2 centroidP, const Vec2* q, int m, Vec2 centroidQ) {
   if (!convexOverlap(p, n, q, m)) return contactOfOverlap(nullptr, 0, p, n, centroidP, q, m, centroidQ);
   return contactOfOverlapping(p, n, centroidP, q, m, centroidQ);
 }

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -576,4 +578,44 @@ TEST(Geometry, WitnessSearchGivesThePlainSearchsAnswer) {
   }
   EXPECT_GT(overlapping, 4000);
   EXPECT_GT(apart, 4000);
+}
+
+// The CPU narrowphase gives clipConvex its merge tolerance from the bodies' bounding boxes
+// (boundingBox) rather than letting it scan the vertices again: the overlap must be the same, bit
+// for bit, vertex by vertex and tag by tag. Polygons near the origin, a kilometre away, and with a
+// vertex on an axis (a zero coordinate, where the two scans may keep zeros of different signs).
+TEST(Geometry, ClipToleranceFromTheBoxesGivesTheSameOverlap) {
+  std::mt19937 rng(20261206);
+  std::uniform_real_distribution<Real> unit(0, 1);
+  int clipped = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Vec2 origin = trial % 3 == 1 ? Vec2{1000 * unit(rng), -700 * unit(rng)} : Vec2{0, 0};
+    const Real r = 0.5 + 5 * unit(rng);
+    Poly p = randomConvex(rng, origin, r);
+    if (trial % 3 == 2) {  // a rectangle whose left side lies on x = 0, its ends at -0 and +0
+      const Real w = r * (0.5 + unit(rng)), h = r * (0.5 + unit(rng));
+      p = {{-Real(0), -Real(0)}, {w, Real(0)}, {w, h}, {Real(0), h}};
+    }
+    const Poly q = randomConvex(rng, origin + 2 * r * Vec2{unit(rng) - 0.5, unit(rng) - 0.5}, 0.5 + 5 * unit(rng));
+    const int n = static_cast<int>(p.size()), m = static_cast<int>(q.size());
+    const Box boxP = boundingBox(p.data(), n), boxQ = boundingBox(q.data(), m);
+    const Real tol =
+        clipToleranceOf(clipScaleOfBox(boxP.x0, boxP.y0, boxP.x1, boxP.y1), clipScaleOfBox(boxQ.x0, boxQ.y0, boxQ.x1, boxQ.y1));
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(static_cast<double>(tol)),
+              std::bit_cast<std::uint64_t>(static_cast<double>(detail::clipTolerance(p.data(), n, q.data(), m))))
+        << "trial " << trial;
+    ClipVertex plain[kMaxClipVertices], fromBoxes[kMaxClipVertices];
+    const int k = clipConvex(p.data(), n, q.data(), m, plain);
+    ASSERT_EQ(clipConvex(p.data(), n, q.data(), m, fromBoxes, tol), k) << "trial " << trial;
+    for (int i = 0; i < k; ++i) {
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(static_cast<double>(fromBoxes[i].p.x)),
+                std::bit_cast<std::uint64_t>(static_cast<double>(plain[i].p.x)));
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(static_cast<double>(fromBoxes[i].p.y)),
+                std::bit_cast<std::uint64_t>(static_cast<double>(plain[i].p.y)));
+      ASSERT_EQ(fromBoxes[i].inEdge, plain[i].inEdge);
+      ASSERT_EQ(fromBoxes[i].outEdge, plain[i].outEdge);
+    }
+    clipped += k >= 3;
+  }
+  EXPECT_GT(clipped, 4000);  // plenty of real overlaps among the pairs
 }

@@ -525,9 +525,14 @@ void CpuStepper::narrowphase() {
           continue;
         }
       }
-      // A pair apart last step that no edge separates now overlaps: only the clipping is left.
-      const Contact c = touchedBefore ? computeContact(pa, na, m_world.position(a), pb, nb, m_world.position(b))
-                                      : contactOfOverlapping(pa, na, m_world.position(a), pb, nb, m_world.position(b));
+      // A pair apart last step that no edge separates now overlaps: only the clipping is left. Its
+      // merge tolerance comes from the boxes above, the values the clipping would find again.
+      const Box& boxA = m_boxes[static_cast<size_t>(a)];
+      const Box& boxB = m_boxes[static_cast<size_t>(b)];
+      const Real clipTol =
+          clipToleranceOf(clipScaleOfBox(boxA.x0, boxA.y0, boxA.x1, boxA.y1), clipScaleOfBox(boxB.x0, boxB.y0, boxB.x1, boxB.y1));
+      const Contact c = touchedBefore ? computeContact(pa, na, m_world.position(a), pb, nb, m_world.position(b), clipTol)
+                                      : contactOfOverlapping(pa, na, m_world.position(a), pb, nb, m_world.position(b), clipTol);
       if (!c.touching) continue;
       part.a.push_back(a);
       part.b.push_back(b);
