@@ -526,7 +526,7 @@ void CpuStepper::narrowphase() {
         }
       }
       // A pair apart last step that no edge separates now overlaps: only the clipping is left. Its
-      // merge tolerance comes from the boxes above, the values the clipping would find again.
+      // merge tolerance comes from the boxes the pose pass made: the scan clipConvex would repeat.
       const Box& boxA = m_boxes[static_cast<size_t>(a)];
       const Box& boxB = m_boxes[static_cast<size_t>(b)];
       const Real clipTol =

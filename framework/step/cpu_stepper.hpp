@@ -239,8 +239,8 @@ class CpuStepper final : public Stepper {
   Vec2 m_vesselIceForce{0, 0};
   // The sum of a body's contact impulses (N s) and the body's id, by the slots of the gather (the
   // breaks and re-sorts after it move bodies between slots). Its force, |sum| / dt, is taken when
-  // contactForces() is asked: a square root and a division a body in contact, every step, were a
-  // tenth of the body updates on the 824-floe field for a figure read only when a frame is written.
+  // contactForces() is asked, not with a square root and a division for every body in contact every
+  // step: only a frame reads it.
   std::vector<Vec2> m_contactImpulseOfSlot;
   std::vector<std::int64_t> m_contactForceId;
   // The non-zero ones by id, built when contactForces() is asked (a frame is written), not every step.
