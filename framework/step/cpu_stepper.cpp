@@ -399,57 +399,49 @@ bool CpuStepper::blockRestsUntouched(const char* stillness, int begin, int end) 
   return touched == 0;
 }
 
+// Body i's flags for the coming narrowphase, from its pose now: moved when the pose is not the one
+// its world vertices and box were made for (a slot that changed hands has moved: the pose holds
+// the id), and then the vertices and box are made again, or when `movedBefore` says the body moved
+// since the last narrowphase though its vertices already follow; active when moved or in a contact
+// of the last narrowphase. Most floes of a pack rest untouched (drag keeps a resting floe exactly
+// at rest): their world vertices from an earlier step are still exact.
+void CpuStepper::refreshPose(int i, bool inContact, bool movedBefore) {
+  const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
+  const bool changed = !(pose == m_vertexPose[static_cast<size_t>(i)]);
+  const bool moved = changed || movedBefore;
+  m_moved[static_cast<size_t>(i)] = moved;
+  m_active[static_cast<size_t>(i)] = moved || inContact;
+  if (!changed) return;
+  m_vertexPose[static_cast<size_t>(i)] = pose;
+  Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
+  m_boxes[static_cast<size_t>(i)] = boundingBox(v, m_world.worldVertices(i, v));
+}
+
 void CpuStepper::narrowphase() {
   const int n = m_world.size();
   m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
   m_boxes.resize(n);
   m_vertexPose.resize(n, Pose{-1, 0, 0, 0});
-  m_moved.resize(n), m_active.resize(n);  // each body's flags are set in the pass below
+  m_moved.resize(n), m_active.resize(n);  // each body's flags are set below, or were by the body updates
   // Whether a slot changed hands since the last narrowphase (a re-sort, a break, a restored state),
-  // seen in this pass over the bodies rather than in a serial one of its own.
+  // seen in the pass over the bodies below rather than in a serial one of its own.
   const int lastSlots = static_cast<int>(m_lastSlotId.size());
   std::atomic<bool> slotsChanged{n != lastSlots};
-  // A body the last body updates left still is where it was at the last narrowphase, which set
-  // m_vertexPose to that pose (no slot has changed hands since, or the flags would not be known):
-  // one byte read in place of its id, pose and the pose kept, in a pass bound by memory.
-  const char* stillness = m_stillnessKnown && static_cast<int>(m_stillness.size()) == n ? m_stillness.data() : nullptr;
-  forEachRange(n, [&](int begin, int end) {
-    // The flags through locals: a char store may alias anything, so through the members every
-    // store made the compiler load the arrays' addresses again (a third of this pass, 10^5 floes).
-    char* const movedFlags = m_moved.data();
-    char* const activeFlags = m_active.data();
-    const char* const still = stillness;
-    const unsigned* const stamp = m_byBody.stamp.data();
-    const int stamped = static_cast<int>(m_byBody.stamp.size());
-    const unsigned current = m_byBody.current;
-    // First every body as if it were still, branch-free (the compiler vectorizes it): not moved,
-    // active when it has a contact (m_byBody.has(i)). In a resting pack that is nearly every body,
-    // and one branch a body was most of this pass at 10^5 floes. Then the bodies that may have
-    // moved, eight flags at a time passed over where none is kMoving.
-    static_assert(kMoving == 0, "allEightStill looks for zero flags");
-    const int stampedEnd = std::max(begin, std::min(end, stamped));
-    for (int i = begin; i < stampedEnd; ++i) movedFlags[i] = 0, activeFlags[i] = stamp[i] == current;
-    for (int i = stampedEnd; i < end; ++i) movedFlags[i] = 0, activeFlags[i] = 0;
-    for (int block = begin; block < end; block += 8) {
-      const int blockEnd = std::min(end, block + 8);
-      if (still && blockEnd - block == 8 && allEightStill(still + block)) continue;
-      for (int i = block; i < blockEnd; ++i) {
-        if (still && still[i] != kMoving) continue;
-        const bool inContact = activeFlags[i] != 0;
+  // While the still flags are known (m_stillness), the last body updates left every body's pose
+  // flags, world vertices and box ready for this narrowphase (refreshPose, called as they wrote each
+  // pose back), and no slot has changed hands since: nothing is left to do here. After a re-sort, a
+  // break, an edit or a restored state every body is looked at afresh. A body whose slot kept it
+  // keeps the body updates' "moved" too: they made its vertices for the pose it has now, so the
+  // pose alone no longer tells that it moved (a slot that changed hands has moved anyway).
+  const bool posesReady = m_stillnessKnown && static_cast<int>(m_stillness.size()) == n;
+  if (!posesReady) {
+    forEachRange(n, [&](int begin, int end) {
+      for (int i = begin; i < end; ++i) {
         if (i < lastSlots && m_lastSlotId[i] != m_world.id[i]) slotsChanged.store(true, std::memory_order_relaxed);
-        // Most floes of a pack rest untouched (drag keeps a resting floe exactly at rest): their world
-        // vertices from an earlier step are still exact, so only bodies that moved are transformed.
-        const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
-        const bool moved = !(pose == m_vertexPose[i]);
-        movedFlags[i] = moved;
-        activeFlags[i] = moved || inContact;  // a slot that changed hands has moved: its pose holds its id
-        if (!moved) continue;
-        m_vertexPose[i] = pose;
-        Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
-        m_boxes[i] = boundingBox(v, m_world.worldVertices(i, v));
+        refreshPose(i, m_byBody.has(i), m_moved[static_cast<size_t>(i)] != 0);
       }
-    }
-  });
+    });
+  }
 
   // touchedAtLastStep searches the last step's contacts only for a pair whose two slots have both
   // changed hands since (a re-sort, a break, a restored state): only then are they sorted.
@@ -925,14 +917,16 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
       const Bits changed = differ(m_world.x[i], b.position.x) | differ(m_world.y[i], b.position.y) | differ(m_world.angle[i], b.angle) |
                            differ(m_world.vx[i], b.velocity.x) | differ(m_world.vy[i], b.velocity.y) | differ(m_world.omega[i], b.omega);
       char& flag = m_stillness[static_cast<size_t>(i)];
+      const bool inContact = m_byBody.has(i);
       if (changed) {
         m_world.x[i] = b.position.x, m_world.y[i] = b.position.y, m_world.angle[i] = b.angle;
         m_world.vx[i] = b.velocity.x, m_world.vy[i] = b.velocity.y, m_world.omega[i] = b.omega;
         if (flag != kMoving) flag = kMoving;
-        continue;
+      } else {
+        const char now = inContact ? kStillInContact : kStill;
+        if (flag != now) flag = now;
       }
-      const char now = m_byBody.has(i) ? kStillInContact : kStill;
-      if (flag != now) flag = now;
+      refreshPose(i, inContact, false);
     }
   });
   m_stillnessKnown = true;

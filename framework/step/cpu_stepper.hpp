@@ -152,8 +152,11 @@ class CpuStepper final : public Stepper {
   };
   World::PermuteRoom m_permuteRoom;  // the re-sort's arrays, kept from one re-sort to the next
   std::vector<Pose> m_vertexPose;    // the pose m_worldVertices and m_boxes were computed for, by slot
-  std::vector<char> m_moved;         // this step: the body's pose differs from the last step's
-  std::vector<char> m_active;        // this step: moved, or in a contact at the last step
+  // Set for the coming narrowphase by the body updates (or by the narrowphase itself after a
+  // re-sort, a break, an edit or a restored state), through refreshPose.
+  std::vector<char> m_moved;                                  // this step: the body's pose differs from the last step's
+  std::vector<char> m_active;                                 // this step: moved, or in a contact at the last step
+  void refreshPose(int i, bool inContact, bool movedBefore);  // body i's m_moved, m_active, and vertices and box where moved
   // By slot, what the last body updates did to each body (docs/performance.md 3.12): kMoving (a bit
   // of its position, angle or velocities changed), kStillInContact (none did, but it had contacts)
   // or kStill (neither). Known while no slot has changed hands and nothing has edited the world
