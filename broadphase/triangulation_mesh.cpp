@@ -54,6 +54,7 @@ class TriangulationMesh final : public KeptListBroadphase {
       m_epoch = 1;
     }
     // The kept list's candidates (bounding circles overlap, direct bodies included), then triangles.
+    // Its resting ranges (framework/api/still_bodies.hpp) would not be ranges of this output.
     m_list.filterByCircles(world, m_circles);
     const Real* x = world.x.data();
     const Real* y = world.y.data();

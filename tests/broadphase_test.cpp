@@ -717,6 +717,73 @@ TEST(Broadphase, KeptListsToldWhichBodiesAreStillGiveTheSameCandidates) {
   }
 }
 
+// Told which bodies rest (kRestingBody: still and in no contact), a kept list also tells the
+// stepper the ranges of its output that hold pairs of two resting bodies only
+// (RestingPairsScope), which the narrowphase then passes over unread. A vessel's wake crosses a
+// field kept in curve order: the floes within 12 m of a point moving along the field drift, those
+// within 18 m are still but said to be in contact (still, not resting), the rest rest. On one
+// thread and on a pool of three. Every pair in a range must be of two resting bodies, the ranges
+// in order and disjoint, and over 6,000 floes they must cover most of the pairs: a list that named
+// a pair of a moving body would have the narrowphase miss a contact, one that named none would
+// save nothing.
+// triangulation_mesh filters the circles' list further, so its output has no such ranges.
+TEST(Broadphase, KeptListsNameTheRangesOfRestingPairs) {
+  for (const int floes : {400, 6000}) {
+    const Real side = floes == 400 ? Real(130) : Real(500);
+    World w = randomWorld(29, floes, side);
+    w.permute(w.curveOrder());  // as the stepper keeps them: neighbours in space are neighbours in slots
+    ThreadPool pool(3);
+    const ParallelScope lend(floes == 400 ? nullptr : &pool);
+    BroadphaseSettings s;
+    s.skin = 2;
+    std::vector<std::unique_ptr<Broadphase>> lists;
+    for (const char* name : {"variable_radius", "fixed_radius", "triangulation_mesh"}) lists.push_back(make(name, s));
+    std::mt19937 rng(37);
+    std::uniform_real_distribution<Real> u(-1, 1);
+    std::vector<char> still(static_cast<size_t>(w.size()), 0);
+    std::vector<CandidatePair> pairs;
+    std::vector<CandidateRange> resting;
+    long covered = 0, listed = 0;
+    for (int step = 0; step < 40; ++step) {
+      const Real bowX = side * static_cast<Real>(step) / 40, bowY = side / 2;
+      for (int i = 0; i < w.size(); ++i) {
+        const Real d = std::hypot(w.x[i] - bowX, w.y[i] - bowY);
+        const bool moves = w.kind[i] != BodyKind::Wall && d < 12;
+        still[static_cast<size_t>(i)] = moves ? 0 : d < 18 ? 1 : kRestingBody;  // 1: still, in contact
+        if (moves) w.x[i] += Real(0.15) + Real(0.02) * u(rng), w.y[i] += Real(0.05) * u(rng);
+      }
+      for (auto& list : lists) {
+        resting.clear();
+        {
+          const StillBodiesScope tell(step > 0 ? still.data() : nullptr);
+          const RestingPairsScope ask(&resting);
+          list->findCandidates(w, pairs);
+        }
+        if (step == 0 || list->name() == "triangulation_mesh") {
+          EXPECT_TRUE(resting.empty()) << list->name() << " step " << step << ": ranges named without still flags, or of another list";
+          continue;
+        }
+        long end = 0;
+        for (const CandidateRange& r : resting) {
+          ASSERT_LE(end, r.begin) << list->name() << " step " << step << ": ranges out of order or overlapping";
+          ASSERT_LT(r.begin, r.end);
+          ASSERT_LE(r.end, static_cast<long>(pairs.size()));
+          for (long k = r.begin; k < r.end; ++k) {
+            const CandidatePair p = pairs[static_cast<size_t>(k)];
+            ASSERT_TRUE(still[static_cast<size_t>(p.a)] == kRestingBody && still[static_cast<size_t>(p.b)] == kRestingBody)
+                << list->name() << " step " << step << ": pair " << p.a << "-" << p.b << " named resting";
+          }
+          covered += r.end - r.begin;
+          end = r.end;
+        }
+        listed += static_cast<long>(pairs.size());
+      }
+    }
+    // 400 floes make four chunks of 256 pairs, each a quarter of the field: the wake is in most.
+    if (floes == 6000) EXPECT_GT(covered, listed / 2) << "the ranges should cover most pairs of a resting field";
+  }
+}
+
 // The kept list's grid of references (reference_grid.hpp): near() visits every body whose
 // reference lies in the square, each once, and every body in no cell; after bodies move to other
 // cells (move) and are binned again by new slots (bin), and for squares and references outside the

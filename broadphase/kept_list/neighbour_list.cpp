@@ -37,7 +37,7 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   // is not known to be still: the filter keeps the last answer of a chunk of pairs none of whose
   // bodies lies in such a block.
   const long blocks = (n + kFlagBlock - 1) / kFlagBlock;
-  m_blockMoving.resize(static_cast<size_t>(blocks));
+  m_blockMoving.resize(static_cast<size_t>(blocks)), m_blockRestless.resize(static_cast<size_t>(blocks));
   const int tasks = parallelTasks(blocks, kBodyGrain / kFlagBlock);
   m_newlyDirect.resize(static_cast<size_t>(tasks));
   std::vector<char> renamed(static_cast<size_t>(tasks), 0);
@@ -47,6 +47,10 @@ NeighbourList::Need NeighbourList::update(const World& world) {
     for (long block = firstBlock; block < endBlock; ++block) {
       const long begin = block * kFlagBlock, end = std::min<long>(n, begin + kFlagBlock);
       char moving = still ? 0 : 1;
+      int restless = 0;  // bodies not resting (restingPairs), counted without a branch
+      if (still)
+        for (long i = begin; i < end; ++i) restless += still[i] != kRestingBody;
+      m_blockRestless[static_cast<size_t>(block)] = restless != 0;
       for (long i = begin; i < end; ++i) {
         if (still && (i - begin) % 8 == 0 && i + 8 <= end && allEightStill(still + i)) {
           i += 7;  // eight still bodies at once
@@ -78,10 +82,13 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   for (char r : renamed)
     if (r) return Need::Rebuild;
   m_movingBlocksBefore.resize(static_cast<size_t>(blocks) + 1);
-  m_movingBlocksBefore[0] = 0;
-  for (long block = 0; block < blocks; ++block)
-    m_movingBlocksBefore[static_cast<size_t>(block) + 1] =
-        m_movingBlocksBefore[static_cast<size_t>(block)] + m_blockMoving[static_cast<size_t>(block)];
+  m_restlessBlocksBefore.resize(static_cast<size_t>(blocks) + 1);
+  m_movingBlocksBefore[0] = 0, m_restlessBlocksBefore[0] = 0;
+  for (long block = 0; block < blocks; ++block) {
+    const auto k = static_cast<size_t>(block);
+    m_movingBlocksBefore[k + 1] = m_movingBlocksBefore[k] + m_blockMoving[k];
+    m_restlessBlocksBefore[k + 1] = m_restlessBlocksBefore[k] + m_blockRestless[k];
+  }
   for (const std::vector<int>& part : m_newlyDirect) {
     m_directList.insert(m_directList.end(), part.begin(), part.end());
     for (const int i : part) m_maskedBodies += !m_masked[static_cast<size_t>(i)], m_masked[static_cast<size_t>(i)] = 1;
@@ -508,7 +515,7 @@ void NeighbourList::finish(const World& world) {
   ++m_rebuilds;
 }
 
-void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePair>& out) {
+void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePair>& out, std::vector<CandidateRange>* resting) {
   // Branch-free: every listed pair is written to a scratch row and kept by advancing the count;
   // about a third pass, so a branch would mispredict often. The scratch never shrinks. Pairs of a
   // direct body are skipped here: the direct pass below finds them; so are those of a relisted
@@ -519,8 +526,10 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   // stretch still holds: the answer depends on the pairs (the same until a build or a rename, which
   // forget every chunk), the bodies' x and y, and their masks (which change only when a body moves
   // past half the skin, or at a build). Whether its bodies are still is told by update(), block by
-  // block of kFlagBlock slots; a chunk spans the slots from its first pair's first body to the
-  // largest second body it names. Most of a resting pack is skipped without reading its pairs.
+  // block of kFlagBlock slots; a chunk's bodies lie in two spans of blocks, its first bodies' (the
+  // pairs are sorted by them) and its second bodies' (ChunkSpan: a wall's row names floes far from
+  // the wall's own slot, and one span over both covered the field between them). Most of a
+  // resting pack is skipped without reading its pairs.
   const long listed = static_cast<long>(m_pairs.size());
   if (m_filtered.size() < m_pairs.size()) m_filtered.resize(m_pairs.size());
   const Real* x = world.x.data();
@@ -529,29 +538,28 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   const char* masked = m_masked.data();
   const long chunks = (listed + kChunkPairs - 1) / kChunkPairs;
   const bool reuse = m_chunksKnown && m_stillKnown && static_cast<long>(m_chunkCount.size()) == chunks;
-  m_chunkCount.resize(static_cast<size_t>(chunks)), m_chunkFirstBlock.resize(static_cast<size_t>(chunks));
+  m_chunkCount.resize(static_cast<size_t>(chunks)), m_chunkSpan.resize(static_cast<size_t>(chunks));
   m_chunkHead.resize(static_cast<size_t>(chunks));
-  m_chunkLastBlock.resize(static_cast<size_t>(chunks));
   const int* movingBefore = m_movingBlocksBefore.data();
   m_rangeKept.resize(static_cast<size_t>(parallelTasks(chunks, kPairGrain / kChunkPairs)) + 1);
   parallelRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {
     for (long c = firstChunk; c < endChunk; ++c) {
       const size_t chunk = static_cast<size_t>(c);
-      if (reuse && movingBefore[m_chunkLastBlock[chunk] + 1] == movingBefore[m_chunkFirstBlock[chunk]]) continue;
+      if (reuse && m_chunkSpan[chunk].quiet(movingBefore)) continue;
       const long begin = c * kChunkPairs, end = std::min(listed, begin + kChunkPairs);
       CandidatePair* dst = m_filtered.data() + begin;
-      int count = 0, last = 0;
+      int count = 0, firstB = m_pairs[static_cast<size_t>(begin)].b, lastB = firstB;
       for (long k = begin; k < end; ++k) {
         const ListedPair& p = m_pairs[static_cast<size_t>(k)];
         const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
         dst[count] = {p.a, p.b};
         count += (dx * dx + dy * dy <= p.reach2) & !(masked[p.a] | masked[p.b]);
-        last = std::max(last, p.b);
+        firstB = std::min(firstB, p.b), lastB = std::max(lastB, p.b);
       }
       m_chunkCount[chunk] = count;
       m_chunkHead[chunk] = dst[0];  // its first pair when count > 0, read by the join's walk
-      m_chunkFirstBlock[chunk] = m_pairs[static_cast<size_t>(begin)].a / kFlagBlock;  // the pairs are sorted by a, and a < b
-      m_chunkLastBlock[chunk] = last / kFlagBlock;
+      m_chunkSpan[chunk] = ChunkSpan{m_pairs[static_cast<size_t>(begin)].a / kFlagBlock,  // the pairs are sorted by a
+                                     m_pairs[static_cast<size_t>(end - 1)].a / kFlagBlock, firstB / kFlagBlock, lastB / kFlagBlock};
     }
     size_t kept = 0;  // the range's pairs, reused chunks' included: the join places the ranges with them
     for (long c = firstChunk; c < endChunk; ++c) kept += static_cast<size_t>(m_chunkCount[static_cast<size_t>(c)]);
@@ -611,6 +619,10 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   // part), and a chunk's direct pairs start at the first one not before its first pair (a search
   // of the few direct pairs). The serial walk along every chunk this replaced read what the other
   // threads had just written, a cache miss every few chunks: 11 us a step at 10^5 floes.
+  // Where the caller asks (restingPairs, framework/api/still_bodies.hpp), the join also notes the
+  // stretches of the output that are a chunk's pairs alone, every body of the chunk resting.
+  if (resting) resting->clear();
+  if (!m_stillKnown) resting = nullptr;
   if (chunks == 0) {
     out.assign(m_directPairs.begin(), m_directPairs.end());
     return;
@@ -626,6 +638,8 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
                                m_directPairs.begin());
   };
   m_directFrom.resize(static_cast<size_t>(chunks));
+  m_restingParts.resize(m_rangeKept.size() - 1);
+  const int* restlessBefore = m_restlessBlocksBefore.data();
   parallelRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {
     const size_t first = static_cast<size_t>(firstChunk), end = static_cast<size_t>(endChunk), all = static_cast<size_t>(chunks);
     size_t next = end;  // the first non-empty chunk after the range: where the range's direct pairs end
@@ -637,14 +651,35 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
       startOfNext = m_directFrom[c];
     }
     size_t kept = m_rangeKept[static_cast<size_t>(t)];
+    std::vector<CandidateRange>& restingPart = m_restingParts[static_cast<size_t>(t)];
+    restingPart.clear();
     for (size_t c = first; c < end; ++c) {
       const auto from = m_filtered.begin() + static_cast<std::ptrdiff_t>(c * kChunkPairs);
+      const size_t directEnd = c + 1 < end ? m_directFrom[c + 1] : afterRange;
       const auto direct0 = m_directPairs.begin() + static_cast<std::ptrdiff_t>(m_directFrom[c]);
-      const auto direct1 = m_directPairs.begin() + static_cast<std::ptrdiff_t>(c + 1 < end ? m_directFrom[c + 1] : afterRange);
-      std::merge(from, from + m_chunkCount[c], direct0, direct1, out.begin() + static_cast<std::ptrdiff_t>(kept + m_directFrom[c]), before);
+      const auto direct1 = m_directPairs.begin() + static_cast<std::ptrdiff_t>(directEnd);
+      const size_t at = kept + m_directFrom[c];
+      std::merge(from, from + m_chunkCount[c], direct0, direct1, out.begin() + static_cast<std::ptrdiff_t>(at), before);
+      // No body restless in the chunk's blocks, and no direct pair merged in: its stretch of the
+      // output is pairs of resting bodies only.
+      if (resting && m_chunkCount[c] > 0 && directEnd == m_directFrom[c] && m_chunkSpan[c].quiet(restlessBefore)) {
+        const long begin = static_cast<long>(at), stop = begin + m_chunkCount[c];
+        if (!restingPart.empty() && restingPart.back().end == begin)
+          restingPart.back().end = stop;
+        else
+          restingPart.push_back({begin, stop});
+      }
       kept += static_cast<size_t>(m_chunkCount[c]);
     }
   });
+  if (!resting) return;
+  for (const std::vector<CandidateRange>& part : m_restingParts)
+    for (const CandidateRange& r : part) {
+      if (!resting->empty() && resting->back().end == r.begin)
+        resting->back().end = r.end;
+      else
+        resting->push_back(r);
+    }
 }
 
 void KeptListBroadphase::findCandidates(const World& world, std::vector<CandidatePair>& pairs) {

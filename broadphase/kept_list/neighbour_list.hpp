@@ -41,6 +41,7 @@
 
 #include "broadphase/kept_list/reference_grid.hpp"
 #include "framework/api/broadphase.hpp"
+#include "framework/api/still_bodies.hpp"
 
 namespace gem {
 
@@ -107,8 +108,10 @@ class NeighbourList {
 
   // This step's candidates: the listed pairs whose bounding circles overlap now, in list order
   // (sorted), with the direct and side lists' pairs merged in. Clears out first. A chunk of listed
-  // pairs whose bodies update() was told are all still keeps its last answer unread.
-  void filterByCircles(const World& world, std::vector<CandidatePair>& out);
+  // pairs whose bodies update() was told are all still keeps its last answer unread. Where
+  // `resting` is given and update() was told which bodies rest, it gets the ranges of `out` that
+  // hold pairs of two resting bodies only (framework/api/still_bodies.hpp), else it is emptied.
+  void filterByCircles(const World& world, std::vector<CandidatePair>& out, std::vector<CandidateRange>* resting = nullptr);
   const std::vector<ListedPair>& pairs() const { return m_pairs; }
   const std::vector<ListedPair>& sidePairs() const { return m_sidePairs; }  // those of the relisted floes
 
@@ -143,12 +146,24 @@ class NeighbourList {
   // was told which bodies are still (m_stillKnown), and then, block by block, whether one is not,
   // as a running count.
   bool m_chunksKnown = false, m_stillKnown = false;
-  std::vector<int> m_chunkCount, m_chunkFirstBlock, m_chunkLastBlock;
+  std::vector<int> m_chunkCount;
+  // The blocks a chunk's bodies lie in: its first bodies' and its second bodies'. quiet(before):
+  // none of them holds a body a running count of flagged blocks counts.
+  struct ChunkSpan {
+    int firstA, lastA, firstB, lastB;
+    bool quiet(const int* before) const { return before[lastA + 1] == before[firstA] && before[lastB + 1] == before[firstB]; }
+  };
+  std::vector<ChunkSpan> m_chunkSpan;
   // Each chunk's first kept pair, beside its count: the join's walk reads these few kilobytes, where
   // the chunks' first rows in the scratch were a cache miss each (7 us a step at 10^5 floes).
   std::vector<CandidatePair> m_chunkHead;
   std::vector<char> m_blockMoving;
   std::vector<int> m_movingBlocksBefore;
+  // Likewise whether a block holds a body not flagged kRestingBody, and each range of the join's
+  // resting stretches of the output (restingPairs, framework/api/still_bodies.hpp).
+  std::vector<char> m_blockRestless;
+  std::vector<int> m_restlessBlocksBefore;
+  std::vector<std::vector<CandidateRange>> m_restingParts;
   std::vector<size_t> m_rangeKept;   // the chunks' pass, range by range: its kept pairs (then the sum before each range)
   std::vector<size_t> m_directFrom;  // the join's: where each chunk's direct pairs start
   // The counting sort's row starts (bodies + 1) and next free places (bodies), and each range's
@@ -195,7 +210,9 @@ class KeptListBroadphase : public Broadphase {
  protected:
   // Adds every pair the strategy lists between m_list.begin() and m_list.finish(), which the base calls.
   virtual void build(const World& world, NeighbourList& list) = 0;
-  virtual void filter(const World& world, std::vector<CandidatePair>& pairs) { m_list.filterByCircles(world, pairs); }
+  // The default hands the stepper the resting ranges of its output (restingPairs); a strategy
+  // that filters the circles' list further must not.
+  virtual void filter(const World& world, std::vector<CandidatePair>& pairs) { m_list.filterByCircles(world, pairs, restingPairs()); }
   NeighbourList m_list;
 };
 

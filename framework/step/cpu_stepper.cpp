@@ -405,16 +405,17 @@ bool CpuStepper::blockRestsUntouched(const char* stillness, int begin, int end) 
 // since the last narrowphase though its vertices already follow; active when moved or in a contact
 // of the last narrowphase. Most floes of a pack rest untouched (drag keeps a resting floe exactly
 // at rest): their world vertices from an earlier step are still exact.
-void CpuStepper::refreshPose(int i, bool inContact, bool movedBefore) {
+bool CpuStepper::refreshPose(int i, bool inContact, bool movedBefore) {
   const Pose pose{m_world.id[i], m_world.x[i], m_world.y[i], m_world.angle[i]};
   const bool changed = !(pose == m_vertexPose[static_cast<size_t>(i)]);
   const bool moved = changed || movedBefore;
   m_moved[static_cast<size_t>(i)] = moved;
   m_active[static_cast<size_t>(i)] = moved || inContact;
-  if (!changed) return;
+  if (!changed) return moved;
   m_vertexPose[static_cast<size_t>(i)] = pose;
   Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
   m_boxes[static_cast<size_t>(i)] = boundingBox(v, m_world.worldVertices(i, v));
+  return true;
 }
 
 void CpuStepper::narrowphase() {
@@ -472,16 +473,29 @@ void CpuStepper::narrowphase() {
     int survivors = 0;
     const Box* boxes = m_boxes.data();
     const char* active = m_active.data();
-    for (int p = begin; p < end; ++p) {
-      const CandidatePair pair = m_pairs[static_cast<size_t>(p)];
-      // Two bodies that have not moved since the last step and touched nothing then do not touch
-      // now (the test after mayTouch below): skipped before their boxes are read. In a pack most
-      // pairs rest, and reading the boxes was the loop's main cost.
-      if (!(active[pair.a] | active[pair.b])) continue;
-      const Box& boxA = boxes[pair.a];
-      const Box& boxB = boxes[pair.b];
-      survivor[survivors] = p;
-      survivors += !(boxA.x0 > boxB.x1) & !(boxB.x0 > boxA.x1) & !(boxA.y0 > boxB.y1) & !(boxB.y0 > boxA.y1);
+    auto scan = [&](int from, int to) {
+      for (int p = from; p < to; ++p) {
+        const CandidatePair pair = m_pairs[static_cast<size_t>(p)];
+        // Two bodies that have not moved since the last step and touched nothing then do not touch
+        // now (the test after mayTouch below): skipped before their boxes are read. In a pack most
+        // pairs rest, and reading the boxes was the loop's main cost.
+        if (!(active[pair.a] | active[pair.b])) continue;
+        const Box& boxA = boxes[pair.a];
+        const Box& boxB = boxes[pair.b];
+        survivor[survivors] = p;
+        survivors += !(boxA.x0 > boxB.x1) & !(boxB.x0 > boxA.x1) & !(boxA.y0 > boxB.y1) & !(boxB.y0 > boxA.y1);
+      }
+    };
+    // The stretches between the broadphase's resting ranges (pairs of two kStill bodies, which
+    // the scan would pass over one by one).
+    auto rest = std::upper_bound(m_restingPairs.begin(), m_restingPairs.end(), static_cast<long>(begin),
+                                 [](long at, const CandidateRange& r) { return at < r.end; });
+    for (int from = begin; from < end; ++rest) {
+      const bool inside = rest != m_restingPairs.end() && rest->begin < end;
+      const int to = inside ? static_cast<int>(std::max<long>(from, rest->begin)) : end;
+      scan(from, to);
+      if (!inside) break;
+      from = static_cast<int>(std::min<long>(end, rest->end));
     }
     part.survivors = survivors;  // the scratch keeps its size: grown again, it would be zeroed every step
   };
@@ -693,14 +707,19 @@ void CpuStepper::step() {
   // 1-2. Candidates, then contacts. The broadphase may borrow the pool (framework/api/parallel.hpp):
   // the kept lists' build and filter run over ranges joined in order. It is told which bodies the
   // last step left still (framework/api/still_bodies.hpp): the flags hold while no slot has changed
-  // hands and nothing has edited the world since the last body updates.
+  // hands and nothing has edited the world since the last body updates. A kStill body (the
+  // broadphase's kRestingBody) is also inactive in the narrowphase, which passes over the ranges of
+  // candidates the broadphase finds to be pairs of two of them (m_restingPairs).
+  static_assert(kStill == kRestingBody, "the narrowphase tests no pair of two kStill bodies");
+  m_restingPairs.clear();
   {
     const ParallelScope lend(m_pool.get());
     const bool stillKnown = m_stillnessKnown && static_cast<int>(m_stillness.size()) == n;
     const StillBodiesScope still(stillKnown ? m_stillness.data() : nullptr);
+    const RestingPairsScope resting(stillKnown ? &m_restingPairs : nullptr);
     m_broadphase->findCandidates(m_world, m_pairs);
   }
-  if (m_broadphaseFromPlugin) normalizeCandidatePairs(m_pairs);
+  if (m_broadphaseFromPlugin) normalizeCandidatePairs(m_pairs), m_restingPairs.clear();
   m_clock.lap(PhaseClock::Broadphase);
   narrowphase();
 
@@ -916,17 +935,18 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
       const MotionBody& b = motion[q];
       const Bits changed = differ(m_world.x[i], b.position.x) | differ(m_world.y[i], b.position.y) | differ(m_world.angle[i], b.angle) |
                            differ(m_world.vx[i], b.velocity.x) | differ(m_world.vy[i], b.velocity.y) | differ(m_world.omega[i], b.omega);
-      char& flag = m_stillness[static_cast<size_t>(i)];
-      const bool inContact = m_byBody.has(i);
       if (changed) {
         m_world.x[i] = b.position.x, m_world.y[i] = b.position.y, m_world.angle[i] = b.angle;
         m_world.vx[i] = b.velocity.x, m_world.vy[i] = b.velocity.y, m_world.omega[i] = b.omega;
-        if (flag != kMoving) flag = kMoving;
-      } else {
-        const char now = inContact ? kStillInContact : kStill;
-        if (flag != now) flag = now;
       }
-      refreshPose(i, inContact, false);
+      // A body whose bits stay is still, and kStill (inactive in the next narrowphase) without a
+      // contact, unless its pose differs from the one its vertices were made for: a NaN pose, which
+      // equals nothing, is then taken for moving, as the narrowphase takes it.
+      const bool inContact = m_byBody.has(i);
+      const bool moved = refreshPose(i, inContact, false);
+      const char now = changed || moved ? kMoving : inContact ? kStillInContact : kStill;
+      char& flag = m_stillness[static_cast<size_t>(i)];
+      if (flag != now) flag = now;
     }
   });
   m_stillnessKnown = true;

@@ -12,6 +12,7 @@
 #include "framework/step/thread_pool.hpp"
 #include "framework/api/broadphase.hpp"
 #include "framework/api/registry.hpp"
+#include "framework/api/still_bodies.hpp"
 #include "framework/scenario/scenario.hpp"
 #include "framework/step/stepper.hpp"
 #include "framework/world/world.hpp"
@@ -156,7 +157,7 @@ class CpuStepper final : public Stepper {
   // re-sort, a break, an edit or a restored state), through refreshPose.
   std::vector<char> m_moved;                                  // this step: the body's pose differs from the last step's
   std::vector<char> m_active;                                 // this step: moved, or in a contact at the last step
-  void refreshPose(int i, bool inContact, bool movedBefore);  // body i's m_moved, m_active, and vertices and box where moved
+  bool refreshPose(int i, bool inContact, bool movedBefore);  // body i's m_moved (returned), m_active, and vertices and box
   // By slot, what the last body updates did to each body (docs/performance.md 3.12): kMoving (a bit
   // of its position, angle or velocities changed), kStillInContact (none did, but it had contacts)
   // or kStill (neither). Known while no slot has changed hands and nothing has edited the world
@@ -171,6 +172,7 @@ class CpuStepper final : public Stepper {
   bool m_skipStillBodies = false;
   int m_updatedBodies = 0;
   std::vector<CandidatePair> m_pairs;
+  std::vector<CandidateRange> m_restingPairs;  // ranges of m_pairs that hold pairs of two kStill bodies only
   std::vector<int> m_contactA, m_contactB;
   std::vector<PairContact> m_contacts;
   std::vector<PairSlot> m_slots;
