@@ -160,12 +160,13 @@ class CpuStepper final : public Stepper {
   bool refreshPose(int i, bool inContact, bool movedBefore);  // body i's m_moved (returned), m_active, and vertices and box
   // By slot, what the last body updates did to each body (docs/performance.md 3.12): kMoving (a bit
   // of its position, angle or velocities changed), kStillInContact (none did, but it had contacts)
-  // or kStill (neither). Known while no slot has changed hands and nothing has edited the world
-  // since (m_stillnessKnown). The narrowphase takes a still body's pose for unchanged without
-  // reading it. The body updates leave out a block of kStill bodies none of which has a contact
-  // now, while every solo and motion event of the run is time invariant (m_skipStillBodies): the
-  // same state, no contact and the same events give the very same bits, so its update would write
-  // nothing.
+  // or kStill (neither; and its pose is the one its vertices were made for). Known while no slot
+  // has changed hands and nothing has edited the world since (m_stillnessKnown); the poses'
+  // flags, vertices and boxes the body updates left (refreshPose) hold as long, and the
+  // narrowphase then takes them as they are. The body updates leave out a block of kStill bodies
+  // none of which has a contact now, while every solo and motion event of the run is time
+  // invariant (m_skipStillBodies): the same state, no contact and the same events give the very
+  // same bits, so its update would write nothing.
   enum Stillness : char { kMoving = 0, kStillInContact = 1, kStill = 2 };
   std::vector<char> m_stillness;
   bool m_stillnessKnown = false;
