@@ -35,6 +35,9 @@ struct ThreadedRun {
   std::vector<std::int32_t> tags;
   int candidates = 0;  // the last step's
   long rebuilds = 0;   // the broadphase's
+  // Over the run: candidates passed over in resting ranges, and the steps that passed over some
+  // and still read enough for the box pass to be split over the pool.
+  long resting = 0, splitAroundRest = 0;
 };
 
 // rebuildEvery: the broadphase is invalidated every that many steps (0: never), so that its
@@ -48,6 +51,8 @@ ThreadedRun runWithThreads(const Scenario& base, int threads, int steps, int reb
     if (rebuildEvery > 0 && k > 0 && k % rebuildEvery == 0) sim.broadphase().invalidate();
     sim.step();
     r.contacts += sim.contactCount();
+    r.resting += sim.restingCandidates();
+    r.splitAroundRest += sim.restingCandidates() > 0 && sim.candidateCount() - sim.restingCandidates() >= CpuStepper::kParallelPairs;
     r.mostContacts = std::max(r.mostContacts, sim.contactCount());
     for (int q = 0; q < sim.records().streams().count(); ++q) {
       r.impactRows += sim.records().rowCount(q);
@@ -79,7 +84,8 @@ void expectSame(const ThreadedRun& one, const ThreadedRun& many, int threads) {
   EXPECT_EQ(one.rebuilds, many.rebuilds);
 }
 
-// A field large enough that every parallel phase runs on the pool (CpuStepper::kParallelBodies).
+// A field large enough that every parallel phase runs on the pool (CpuStepper::kParallelBodies),
+// most of it resting, so that the box pass reads only the stretches between the resting ranges.
 TEST(Threads, ALargeFieldStepsBitForBitOnOneTwoAndFourThreads) {
   const int steps = 120;
   test::TempDir dir;
@@ -91,6 +97,8 @@ TEST(Threads, ALargeFieldStepsBitForBitOnOneTwoAndFourThreads) {
   EXPECT_GT(one.contacts, 500) << "the scene must touch a lot, or it guards nothing";
   EXPECT_GT(one.impactRows, 0);
   EXPECT_GE(one.rebuilds, 3) << "the kept list was not rebuilt mid-run: its parallel build went untested";
+  EXPECT_GT(one.resting, 0) << "no candidate was passed over: the resting ranges went untested";
+  EXPECT_GT(one.splitAroundRest, 10) << "the box pass never split the stretches between resting ranges over the pool";
   for (int threads : {2, 4}) expectSame(one, runWithThreads(s, threads, steps, 50), threads);
 }
 

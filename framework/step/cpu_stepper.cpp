@@ -451,24 +451,34 @@ void CpuStepper::narrowphase() {
     m_previousSorted = true;
   }
 
-  // The candidates in two passes. The box pass keeps, part by part over contiguous ranges of the
-  // candidates, those whose boxes overlap; the exact pass tests the survivors, cut into parts of
-  // equal counts of survivors. The survivors crowd around the vessel, which the curve order keeps
-  // in a few slots, so ranges of candidates can give one task nearly all the exact tests while the
-  // other threads wait. The parts' contacts, joined in order, are the contacts of one pass over
-  // all the pairs.
+  // The candidates in two passes. The box pass keeps, part by part, the candidates whose boxes
+  // overlap; the exact pass tests the survivors, cut into parts of equal counts of survivors. The
+  // box pass reads only the stretches between the broadphase's resting ranges (m_toScan), cut
+  // into parts of equal counts of candidates to read: at 10^5 floes they are an eighth of the
+  // candidates, around the vessel, and ranges of all the candidates gave one task nearly all of
+  // them. The survivors crowd there too, so ranges of candidates can give one task nearly all the
+  // exact tests while the other threads wait. The parts' contacts, joined in order, are the
+  // contacts of one pass over all the pairs.
   const int pairs = static_cast<int>(m_pairs.size());
-  const int tasks = m_pool && pairs >= kParallelPairs ? std::min(pairs / kGrain, kTasksPerThread * m_pool->size()) : 1;
+  m_toScan.clear(), m_scanBefore.assign(1, 0);
+  long scanned = 0;
+  for (const CandidateRange& r : m_restingPairs) {
+    if (r.begin > scanned) m_toScan.push_back({scanned, r.begin}), m_scanBefore.push_back(m_scanBefore.back() + r.begin - scanned);
+    scanned = r.end;
+  }
+  if (scanned < pairs) m_toScan.push_back({scanned, pairs}), m_scanBefore.push_back(m_scanBefore.back() + pairs - scanned);
+  const long toScan = m_scanBefore.back();
+  const int tasks =
+      m_pool && toScan >= kParallelPairs ? static_cast<int>(std::min<long>(toScan / kGrain, kTasksPerThread * m_pool->size())) : 1;
   m_parts.resize(static_cast<size_t>(tasks));
   auto boxPass = [&](int t) {
     NarrowphasePart& part = m_parts[static_cast<size_t>(t)];
-    const int begin = static_cast<int>(static_cast<long>(pairs) * t / tasks);
-    const int end = static_cast<int>(static_cast<long>(pairs) * (t + 1) / tasks);
+    const long shareBegin = toScan * t / tasks, shareEnd = toScan * (t + 1) / tasks;
     // Most candidates are near misses: the world-aligned boxes reject them in four comparisons.
     // About one in four passes, so a branch would mispredict often: every candidate is written
     // to the scratch list and kept by advancing the count (boxesOverlap's test, without its
     // short-circuits), and only the survivors take the branches of mayTouch and after.
-    part.boxSurvivors.resize(static_cast<size_t>(end - begin));
+    part.boxSurvivors.resize(static_cast<size_t>(shareEnd - shareBegin));
     int* survivor = part.boxSurvivors.data();
     int survivors = 0;
     const Box* boxes = m_boxes.data();
@@ -486,16 +496,13 @@ void CpuStepper::narrowphase() {
         survivors += !(boxA.x0 > boxB.x1) & !(boxB.x0 > boxA.x1) & !(boxA.y0 > boxB.y1) & !(boxB.y0 > boxA.y1);
       }
     };
-    // The stretches between the broadphase's resting ranges (pairs of two kStill bodies, which
-    // the scan would pass over one by one).
-    auto rest = std::upper_bound(m_restingPairs.begin(), m_restingPairs.end(), static_cast<long>(begin),
-                                 [](long at, const CandidateRange& r) { return at < r.end; });
-    for (int from = begin; from < end; ++rest) {
-      const bool inside = rest != m_restingPairs.end() && rest->begin < end;
-      const int to = inside ? static_cast<int>(std::max<long>(from, rest->begin)) : end;
-      scan(from, to);
-      if (!inside) break;
-      from = static_cast<int>(std::min<long>(end, rest->end));
+    // The task's share of the stretches to read, stretch by stretch from the one holding its first.
+    size_t k = static_cast<size_t>(std::upper_bound(m_scanBefore.begin(), m_scanBefore.end(), shareBegin) - m_scanBefore.begin()) - 1;
+    for (long at = shareBegin; at < shareEnd; ++k) {
+      const long stretchEnd = std::min(shareEnd, m_scanBefore[k + 1]);
+      const long offset = m_toScan[k].begin - m_scanBefore[k];  // candidate number = share position + offset
+      scan(static_cast<int>(at + offset), static_cast<int>(stretchEnd + offset));
+      at = stretchEnd;
     }
     part.survivors = survivors;  // the scratch keeps its size: grown again, it would be zeroed every step
   };

@@ -69,6 +69,12 @@ class CpuStepper final : public Stepper {
   const RecordStreams& recordStreams() const { return m_streams; }
   int contactCount() const override { return static_cast<int>(m_contacts.size()); }
   int candidateCount() const { return static_cast<int>(m_pairs.size()); }
+  // Of the last step's candidates, those in the broadphase's resting ranges, passed over unread.
+  long restingCandidates() const {
+    long resting = 0;
+    for (const CandidateRange& r : m_restingPairs) resting += r.end - r.begin;
+    return resting;
+  }
   // Pairs whose boxes overlap that an edge separated (those tested: a pair at rest is not).
   int separatedCount() const { return static_cast<int>(m_lastSeparated.size()); }
   int threads() const { return m_pool ? m_pool->size() : 1; }  // after the first step
@@ -174,6 +180,8 @@ class CpuStepper final : public Stepper {
   int m_updatedBodies = 0;
   std::vector<CandidatePair> m_pairs;
   std::vector<CandidateRange> m_restingPairs;  // ranges of m_pairs that hold pairs of two kStill bodies only
+  std::vector<CandidateRange> m_toScan;        // the narrowphase's: the stretches between them
+  std::vector<long> m_scanBefore;              // the candidates in the stretches before each, and all of them last
   std::vector<int> m_contactA, m_contactB;
   std::vector<PairContact> m_contacts;
   std::vector<PairSlot> m_slots;
