@@ -97,6 +97,49 @@ TEST(StillBodies, LeavingThemOutChangesNoBitOfARun) {
   }
 }
 
+// After a break (bodies removed and added, the later slots shifted) and the re-sort at step 200
+// (nearly every slot changed), what the last body updates left follows each body to its new slot
+// (CpuStepper::followBodiesToNewSlots), so the next step leaves the resting floes out as any step
+// does. The run must be, bit for bit, the run whose stepper reads every body afresh every step (an
+// edit through world() before each step), on one thread and on three.
+TEST(StillBodies, FlagsFollowTheirBodiesThroughBreaksAndReSorts) {
+  test::TempDir dir;
+  const Scenario s0 =
+      test::scenarioFromToml(dir, test::kBusyScene, {"simulation.steps=230", "domain.x=[0.0, 700.0]", "domain.y=[-200.0, 200.0]"});
+  auto runIt = [&](int threads, bool afresh, int* renames, int* keptAfterRename) {
+    Scenario s = s0;
+    s.threads = threads;
+    CpuStepper sim(s);
+    long broken = 0;
+    bool renamed = false;
+    for (int k = 0; k < 230; ++k) {
+      if (afresh) sim.world();  // takes nothing for still: every body read afresh
+      sim.step();
+      if (renamed && renames) {
+        ++*renames;
+        *keptAfterRename += sim.updatedBodies() < sim.hostWorld().size() / 2;
+      }
+      renamed = sim.floesBroken() != broken || sim.stepIndex() == 200;
+      broken = sim.floesBroken();
+    }
+    StillRun r;
+    const World& w = sim.hostWorld();
+    r.ids = w.id;
+    for (const std::vector<Real>* v : {&w.x, &w.y, &w.angle, &w.vx, &w.vy, &w.omega}) r.state.insert(r.state.end(), v->begin(), v->end());
+    r.contacts = sim.contactCount();
+    return r;
+  };
+  const StillRun afresh = runIt(1, true, nullptr, nullptr);
+  for (int threads : {1, 3}) {
+    SCOPED_TRACE(::testing::Message() << threads << " threads");
+    int renames = 0, kept = 0;
+    const StillRun followed = runIt(threads, false, &renames, &kept);
+    EXPECT_GE(renames, 2) << "the run must break floes and re-sort, or it guards little";
+    EXPECT_EQ(kept, renames) << "a step after a break or a re-sort updated most bodies: the still flags did not follow them";
+    expectSameBits(afresh, followed);
+  }
+}
+
 // A resting pack, no vessel: a solo event that reads the step, not declared time invariant, must
 // still reach every floe at its step, though none of them moved before it.
 TEST(StillBodies, AnEventThatReadsTheStepReachesEveryRestingFloe) {

@@ -332,7 +332,7 @@ void CpuStepper::restoreState(const StepperState& state) {
   m_lastSlotId.clear();  // "touched before" then comes from state.touching
   m_lastSeparated.clear();
   m_broadphase->invalidate();
-  m_stillnessKnown = false;
+  m_stillnessKnown = false, m_slotsRenamed = false;
   m_vesselId = -1;
   for (int i = 0; i < m_world.size(); ++i)
     if (m_world.kind[i] == BodyKind::Vessel) m_vesselId = m_world.id[i];
@@ -362,7 +362,7 @@ void CpuStepper::reorderAlongCurve() {
   if (m_pool) onThePool = [this](int count, const std::function<void(int)>& task) { m_pool->run(count, task); };
   m_world.permute(m_world.curveOrder(), onThePool, &m_permuteRoom);
   m_broadphase->bodiesRenamed();
-  m_stillnessKnown = false;  // the flags are by slot
+  followBodiesToNewSlots();
 }
 
 void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range) {
@@ -413,25 +413,115 @@ bool CpuStepper::refreshPose(int i, bool inContact, bool movedBefore) {
   m_active[static_cast<size_t>(i)] = moved || inContact;
   if (!changed) return moved;
   m_vertexPose[static_cast<size_t>(i)] = pose;
-  Vec2* v = &m_worldVertices[static_cast<size_t>(i) * kMaxVertices];
+  Vec2* v = worldVerticesOf(i);
   m_boxes[static_cast<size_t>(i)] = boundingBox(v, m_world.worldVertices(i, v));
   return true;
 }
 
+// A re-sort or a break leaves every body's state as it was (TopologyData: an event changes the
+// bodies only through World::removeBodies and World::addBody) but puts most bodies in other slots:
+// a break shifts every slot after the broken floe's, a re-sort nearly every slot. What the last
+// body updates left by slot (the still flags, the poses' flags, boxes and vertex rows) moves with
+// its body, found by id (a body keeps its shape while it keeps its id, as the kept lists assume),
+// so that the next step passes over the bodies that did not move, as any step does. Taken afresh
+// instead, every body counted as moved: at 10^5 floes on one core the step after a re-sort or a
+// break took 20 to 30 ms (every body's vertices made again, every pair whose boxes overlap tested
+// from scratch, every body updated), more in all than the plain steps between re-sorts.
+// A new body, or one whose pose is not the one its vertices were made for (an event that broke
+// the contract above), is moving, its vertices made here in a free row. The trajectories are the
+// same: what follows a body is what the next step would compute for it (the same pose gives the
+// same vertices), and the pairs it lets the narrowphase pass over are those of two bodies that did
+// not move and did not touch, as in any step.
+void CpuStepper::followBodiesToNewSlots() {
+  const int n = m_world.size();
+  const size_t before = m_vertexPose.size();
+  const bool known = m_stillnessKnown && m_stillness.size() == before && m_moved.size() == before && m_active.size() == before &&
+                     m_boxes.size() == before && m_vertexRow.size() == before;
+  m_stillnessKnown = false;  // unless the flags follow their bodies below
+  if (!known) return;
+  // Each id's slot before, in a table by id; ids too sparse for one (or negative: a world built by
+  // hand) leave the next step to read every body afresh.
+  std::int64_t largest = -1;
+  for (const Pose& pose : m_vertexPose) largest = std::max(largest, pose.id);
+  for (const std::int64_t id : m_world.id) {
+    if (id < 0) return;
+    largest = std::max(largest, id);
+  }
+  if (largest >= 4 * (static_cast<std::int64_t>(n) + static_cast<std::int64_t>(before)) + 1024) return;
+  m_oldSlotOfId.assign(static_cast<size_t>(largest) + 1, -1);
+  const int slotsBefore = static_cast<int>(before);
+  forEachRange(slotsBefore, [&](int begin, int end) {  // relaxed atomic stores: a repeated id races only over which slot
+    for (int j = begin; j < end; ++j)
+      if (const std::int64_t id = m_vertexPose[static_cast<size_t>(j)].id; id >= 0)
+        std::atomic_ref<int>(m_oldSlotOfId[static_cast<size_t>(id)]).store(j, std::memory_order_relaxed);
+  });
+  // Each new slot takes what its body's old slot holds, and notes that it did (m_takenBy); a body
+  // that is new, or not at the pose its vertices were made for, or whose old slot another new slot
+  // took (a repeated id), gets a free row below.
+  const size_t bodies = static_cast<size_t>(n);
+  m_nextVertexRow.resize(bodies), m_nextBoxes.resize(bodies), m_nextVertexPose.resize(bodies);
+  m_nextMoved.resize(bodies), m_nextActive.resize(bodies), m_nextStillness.resize(bodies), m_oldSlot.resize(bodies);
+  m_takenBy.assign(before, -1);
+  forEachRange(n, [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      const Pose pose{m_world.id[k], m_world.x[k], m_world.y[k], m_world.angle[k]};
+      int old = std::atomic_ref<int>(m_oldSlotOfId[static_cast<size_t>(pose.id)]).load(std::memory_order_relaxed);
+      if (old >= 0 && !(m_vertexPose[static_cast<size_t>(old)] == pose)) old = -1;
+      m_oldSlot[k] = old;
+      if (old < 0) continue;
+      std::atomic_ref<int>(m_takenBy[static_cast<size_t>(old)]).store(i, std::memory_order_relaxed);
+      const size_t j = static_cast<size_t>(old);
+      m_nextVertexRow[k] = m_vertexRow[j], m_nextBoxes[k] = m_boxes[j], m_nextVertexPose[k] = pose;
+      m_nextMoved[k] = m_moved[j], m_nextActive[k] = m_active[j], m_nextStillness[k] = m_stillness[j];
+    }
+  });
+  // The rows of the bodies that went are free (on one thread, as the few new bodies' rows below).
+  for (size_t j = 0; j < before; ++j)
+    if (m_takenBy[j] < 0) m_freeRows.push_back(m_vertexRow[j]);
+  m_vertexRow.swap(m_nextVertexRow), m_boxes.swap(m_nextBoxes), m_vertexPose.swap(m_nextVertexPose);
+  m_moved.swap(m_nextMoved), m_active.swap(m_nextActive), m_stillness.swap(m_nextStillness);
+  for (int i = 0; i < n; ++i) {
+    const int old = m_oldSlot[static_cast<size_t>(i)];
+    if (old >= 0 && m_takenBy[static_cast<size_t>(old)] == i) continue;
+    if (m_freeRows.empty()) {
+      m_freeRows.push_back(m_rowCount++);
+      m_worldVertices.resize(static_cast<size_t>(m_rowCount) * kMaxVertices);
+    }
+    m_vertexRow[static_cast<size_t>(i)] = m_freeRows.back();
+    m_freeRows.pop_back();
+    m_vertexPose[static_cast<size_t>(i)] = Pose{-1, 0, 0, 0};  // made afresh: refreshPose
+    m_stillness[static_cast<size_t>(i)] = kMoving;
+    refreshPose(i, false, true);
+  }
+  m_stillnessKnown = true;
+  m_slotsRenamed = true;
+}
+
 void CpuStepper::narrowphase() {
   const int n = m_world.size();
-  m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
   m_boxes.resize(n);
+  // Every slot's own row: those followBodiesToNewSlots left, or, after an edit that changed the
+  // slots, each slot's row its own again, its vertices to be made afresh.
+  if (m_vertexRow.size() != static_cast<size_t>(n)) {
+    m_vertexRow.resize(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) m_vertexRow[static_cast<size_t>(i)] = i;
+    m_freeRows.clear(), m_rowCount = n;
+    m_worldVertices.resize(static_cast<size_t>(n) * kMaxVertices);
+    m_vertexPose.assign(static_cast<size_t>(n), Pose{-1, 0, 0, 0});
+  }
   m_vertexPose.resize(n, Pose{-1, 0, 0, 0});
   m_moved.resize(n), m_active.resize(n);  // each body's flags are set below, or were by the body updates
   // Whether a slot changed hands since the last narrowphase (a re-sort, a break, a restored state),
   // seen in the pass over the bodies below rather than in a serial one of its own.
   const int lastSlots = static_cast<int>(m_lastSlotId.size());
-  std::atomic<bool> slotsChanged{n != lastSlots};
+  std::atomic<bool> slotsChanged{n != lastSlots || m_slotsRenamed};
+  m_slotsRenamed = false;
   // While the still flags are known (m_stillness), the last body updates left every body's pose
   // flags, world vertices and box ready for this narrowphase (refreshPose, called as they wrote each
-  // pose back), and no slot has changed hands since: nothing is left to do here. After a re-sort, a
-  // break, an edit or a restored state every body is looked at afresh. A body whose slot kept it
+  // pose back), by the slots the bodies hold now (a re-sort or a break moved them along:
+  // followBodiesToNewSlots): nothing is left to do here. After an edit or a restored state every
+  // body is looked at afresh. A body whose slot kept it
   // keeps the body updates' "moved" too: they made its vertices for the pose it has now, so the
   // pose alone no longer tells that it moved (a slot that changed hands has moved anyway).
   const bool posesReady = m_stillnessKnown && static_cast<int>(m_stillness.size()) == n;
@@ -511,6 +601,7 @@ void CpuStepper::narrowphase() {
   // (a, b) order as the candidates, alongside: a broadphase that lists its pairs out of order only
   // finds fewer of them.
   using SeparatedCursor = std::vector<SeparatedPair>::const_iterator;
+  const int* vertexRow = m_vertexRow.data();
   auto exactTests = [&](NarrowphasePart& part, const int* survivor, int count, SeparatedCursor& cached) {
     for (int s = 0; s < count; ++s) {
       const int p = survivor[s];
@@ -522,8 +613,8 @@ void CpuStepper::narrowphase() {
       // (A touching pair is always a candidate, whatever the broadphase, so "did not touch then"
       // is exactly "not among the last step's contacts".)
       if (!m_moved[a] && !m_moved[b] && !touchedBefore) continue;
-      const Vec2* pa = &m_worldVertices[static_cast<size_t>(a) * kMaxVertices];
-      const Vec2* pb = &m_worldVertices[static_cast<size_t>(b) * kMaxVertices];
+      const Vec2* pa = &m_worldVertices[static_cast<size_t>(vertexRow[a]) * kMaxVertices];
+      const Vec2* pb = &m_worldVertices[static_cast<size_t>(vertexRow[b]) * kMaxVertices];
       const int na = m_world.vertexCount[a], nb = m_world.vertexCount[b];
       if (!touchedBefore) {
         // Apart last step, most likely apart now, and most likely along the same edge: try it
@@ -721,7 +812,9 @@ void CpuStepper::step() {
   m_restingPairs.clear();
   {
     const ParallelScope lend(m_pool.get());
-    const bool stillKnown = m_stillnessKnown && static_cast<int>(m_stillness.size()) == n;
+    // After a re-sort or a break the flags follow the bodies (followBodiesToNewSlots), but a
+    // broadphase's promise is by slot since its last call: it is told none then.
+    const bool stillKnown = m_stillnessKnown && !m_slotsRenamed && static_cast<int>(m_stillness.size()) == n;
     const StillBodiesScope still(stillKnown ? m_stillness.data() : nullptr);
     const RestingPairsScope resting(stillKnown ? &m_restingPairs : nullptr);
     m_broadphase->findCandidates(m_world, m_pairs);
@@ -738,8 +831,7 @@ void CpuStepper::step() {
   forEachRange(static_cast<int>(m_byBody.bodies.size()), [&](int begin, int end) {
     for (int q = begin; q < end; ++q) {
       const int i = m_byBody.bodies[static_cast<size_t>(q)];
-      m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof),
-                                   &m_worldVertices[static_cast<size_t>(i) * kMaxVertices], m_world.vertexCount[i]);
+      m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof), worldVerticesOf(i), m_world.vertexCount[i]);
     }
   });
   m_slots.assign(contacts, PairSlot{{0, 0}});
@@ -841,7 +933,7 @@ void CpuStepper::step() {
   m_rubbleMass += topology.rubbleMass;
   m_floesBroken += topology.floesBroken;
   if (topology.changed) m_broadphase->bodiesRenamed();  // removeBodies and addBody only (TopologyData)
-  if (topology.changed || m_world.size() != n) m_stillnessKnown = false;
+  if (topology.changed || m_world.size() != n) followBodiesToNewSlots();
 
   ++m_step;
   m_time = stepTime(m_step, m_scenario.dt);
