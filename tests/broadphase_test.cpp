@@ -722,10 +722,11 @@ TEST(Broadphase, KeptListsToldWhichBodiesAreStillGiveTheSameCandidates) {
 // (RestingPairsScope), which the narrowphase then passes over unread. A vessel's wake crosses a
 // field kept in curve order: the floes within 12 m of a point moving along the field drift, those
 // within 18 m are still but said to be in contact (still, not resting), the rest rest. On one
-// thread and on a pool of three. Every pair in a range must be of two resting bodies, the ranges
-// in order and disjoint, and over 6,000 floes they must cover most of the pairs: a list that named
-// a pair of a moving body would have the narrowphase miss a contact, one that named none would
-// save nothing.
+// thread and on a pool of three. Against a twin of each list told the same flags but asked for no
+// ranges: the output must be the twin's outside the ranges (inside, it may be left unwritten),
+// every pair of the twin's in a range must be of two resting bodies, the ranges in order and
+// disjoint, and over 6,000 floes they must cover most of the pairs: a list that named a pair of a
+// moving body would have the narrowphase miss a contact, one that named none would save nothing.
 // triangulation_mesh filters the circles' list further, so its output has no such ranges.
 TEST(Broadphase, KeptListsNameTheRangesOfRestingPairs) {
   for (const int floes : {400, 6000}) {
@@ -736,12 +737,14 @@ TEST(Broadphase, KeptListsNameTheRangesOfRestingPairs) {
     const ParallelScope lend(floes == 400 ? nullptr : &pool);
     BroadphaseSettings s;
     s.skin = 2;
-    std::vector<std::unique_ptr<Broadphase>> lists;
-    for (const char* name : {"variable_radius", "fixed_radius", "triangulation_mesh"}) lists.push_back(make(name, s));
+    // Each list, and its twin told the same flags but asked for no ranges: the whole output.
+    std::vector<std::unique_ptr<Broadphase>> lists, twins;
+    for (const char* name : {"variable_radius", "fixed_radius", "triangulation_mesh"})
+      lists.push_back(make(name, s)), twins.push_back(make(name, s));
     std::mt19937 rng(37);
     std::uniform_real_distribution<Real> u(-1, 1);
     std::vector<char> still(static_cast<size_t>(w.size()), 0);
-    std::vector<CandidatePair> pairs;
+    std::vector<CandidatePair> pairs, whole;
     std::vector<CandidateRange> resting;
     long covered = 0, listed = 0;
     for (int step = 0; step < 40; ++step) {
@@ -752,30 +755,44 @@ TEST(Broadphase, KeptListsNameTheRangesOfRestingPairs) {
         still[static_cast<size_t>(i)] = moves ? 0 : d < 18 ? 1 : kRestingBody;  // 1: still, in contact
         if (moves) w.x[i] += Real(0.15) + Real(0.02) * u(rng), w.y[i] += Real(0.05) * u(rng);
       }
-      for (auto& list : lists) {
+      for (size_t l = 0; l < lists.size(); ++l) {
+        const std::unique_ptr<Broadphase>& list = lists[l];
         resting.clear();
         {
           const StillBodiesScope tell(step > 0 ? still.data() : nullptr);
-          const RestingPairsScope ask(&resting);
-          list->findCandidates(w, pairs);
+          {
+            const RestingPairsScope ask(&resting);
+            list->findCandidates(w, pairs);
+          }
+          twins[l]->findCandidates(w, whole);
         }
+        // Outside the ranges the output is the whole list; inside, it may be left unwritten.
+        ASSERT_EQ(pairs.size(), whole.size()) << list->name() << " step " << step;
         if (step == 0 || list->name() == "triangulation_mesh") {
           EXPECT_TRUE(resting.empty()) << list->name() << " step " << step << ": ranges named without still flags, or of another list";
           continue;
         }
         long end = 0;
+        auto sameOutside = [&](long from, long to) {
+          for (long k = from; k < to; ++k)
+            ASSERT_TRUE(pairs[static_cast<size_t>(k)].a == whole[static_cast<size_t>(k)].a &&
+                        pairs[static_cast<size_t>(k)].b == whole[static_cast<size_t>(k)].b)
+                << list->name() << " step " << step << ": candidate " << k << " differs outside the ranges";
+        };
         for (const CandidateRange& r : resting) {
           ASSERT_LE(end, r.begin) << list->name() << " step " << step << ": ranges out of order or overlapping";
           ASSERT_LT(r.begin, r.end);
           ASSERT_LE(r.end, static_cast<long>(pairs.size()));
+          sameOutside(end, r.begin);
           for (long k = r.begin; k < r.end; ++k) {
-            const CandidatePair p = pairs[static_cast<size_t>(k)];
+            const CandidatePair p = whole[static_cast<size_t>(k)];
             ASSERT_TRUE(still[static_cast<size_t>(p.a)] == kRestingBody && still[static_cast<size_t>(p.b)] == kRestingBody)
                 << list->name() << " step " << step << ": pair " << p.a << "-" << p.b << " named resting";
           }
           covered += r.end - r.begin;
           end = r.end;
         }
+        sameOutside(end, static_cast<long>(pairs.size()));
         listed += static_cast<long>(pairs.size());
       }
     }

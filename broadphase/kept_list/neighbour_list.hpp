@@ -110,7 +110,8 @@ class NeighbourList {
   // (sorted), with the direct and side lists' pairs merged in. Clears out first. A chunk of listed
   // pairs whose bodies update() was told are all still keeps its last answer unread. Where
   // `resting` is given and update() was told which bodies rest, it gets the ranges of `out` that
-  // hold pairs of two resting bodies only (framework/api/still_bodies.hpp), else it is emptied.
+  // hold pairs of two resting bodies only, left unwritten (framework/api/still_bodies.hpp), else
+  // it is emptied.
   void filterByCircles(const World& world, std::vector<CandidatePair>& out, std::vector<CandidateRange>* resting = nullptr);
   const std::vector<ListedPair>& pairs() const { return m_pairs; }
   const std::vector<ListedPair>& sidePairs() const { return m_sidePairs; }  // those of the relisted floes

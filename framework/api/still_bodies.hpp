@@ -46,7 +46,10 @@ struct CandidateRange {
 // flags may put there ranges of its output in which every pair is of two bodies flagged
 // kRestingBody, in increasing order and disjoint: the CPU narrowphase passes over them unread. At
 // 10^5 floes those are nearly all of the 155,000 candidates a step, and reading each one's two
-// flags was a tenth of the step. A broadphase that puts nothing there loses nothing.
+// flags was a tenth of the step. The broadphase may leave the elements inside a range unwritten
+// (they then hold whatever the vector held there): the output is the full candidate list, the
+// same pairs in the same order as without the scope, everywhere outside the ranges, and its size
+// is the full list's. A broadphase that puts nothing there loses nothing.
 class RestingPairsScope {
  public:
   explicit RestingPairsScope(std::vector<CandidateRange>* ranges);
