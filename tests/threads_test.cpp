@@ -250,7 +250,8 @@ TEST(Threads, AFieldMovedWholeByACurrentJoinsItsNarrowphaseOnThePool) {
 }
 
 // GEM_CPU_TIMING=1 (docs/performance.md 1.4): one line on stderr when the stepper goes, its steps
-// and each phase's milliseconds a step, which add up to the total it states.
+// and each phase's milliseconds a step, which add up to the total it states, and one of the steps
+// by kind.
 TEST(CpuTiming, OneLineOfPhasesThatAddUpToTheStep) {
   test::TempDir dir;
   const Scenario s = test::scenarioFromToml(dir, test::kBusyScene, {"simulation.steps=20"});
@@ -276,6 +277,21 @@ TEST(CpuTiming, OneLineOfPhasesThatAddUpToTheStep) {
   }
   EXPECT_GT(total, 0);
   EXPECT_NEAR(sum, total, 1e-3 + 1e-3 * total);  // each figure is rounded to 0.1 us
+  // The steps by kind (plain, breaking or re-sorting, right after those): their counts are the
+  // steps timed, and their shares of the mean step add up to it.
+  const size_t kinds = line.find("gem cpu steps by kind: ");
+  ASSERT_NE(kinds, std::string::npos) << line;
+  long counted = 0;
+  double shares = 0;
+  for (const char* kind : {" plain at ", " breaking or re-sorting at ", " right after those at "}) {
+    const size_t k = line.find(kind, kinds);
+    ASSERT_NE(k, std::string::npos) << kind << " missing in: " << line;
+    counted += std::stol(line.substr(line.rfind(' ', k - 1) + 1));
+    const size_t share = line.find(" ms, ", k);
+    shares += std::stod(line.substr(share + 5));
+  }
+  EXPECT_EQ(counted, 12);
+  EXPECT_NEAR(shares, total, 2e-3 + 1e-2 * total);
   // On several threads a second line tells where the pool's time went: the rounds and the calling
   // thread's time between them add up to the step.
   Scenario threaded = s;

@@ -197,6 +197,16 @@ CpuStepper::~CpuStepper() {
     line += fmt::format("{} {} {:.4f}", p ? "," : "", PhaseClock::kNames[static_cast<size_t>(p)],
                         1e3 * m_clock.seconds[static_cast<size_t>(p)] / static_cast<double>(m_clock.steps));
   std::fprintf(stderr, "%s\n", line.c_str());
+  const std::array<const char*, PhaseClock::kStepKinds> kinds{"plain", "breaking or re-sorting", "right after those"};
+  std::string byKind = "gem cpu steps by kind:";
+  for (int k = 0; k < PhaseClock::kStepKinds; ++k) {
+    const auto q = static_cast<size_t>(k);
+    const long count = m_clock.stepCount[q];
+    byKind += fmt::format("{} {} {} at {:.4f} ms, {:.4f} ms a step of all", k ? ";" : "", count, kinds[q],
+                          count ? 1e3 * m_clock.stepSeconds[q] / static_cast<double>(count) : 0.0,
+                          1e3 * m_clock.stepSeconds[q] / static_cast<double>(m_clock.steps));
+  }
+  std::fprintf(stderr, "%s\n", byKind.c_str());
   if (!m_pool) return;
   // Where the threads' time goes: a step is its rounds on the pool and the calling thread's work
   // between them; a round ends when its last task does, so "waiting on the last tasks" is the
@@ -798,6 +808,7 @@ void CpuStepper::step() {
     }
   }
   m_clock.start();
+  const bool afterRenaming = m_slotsRenamed;
   const StepContext ctx{m_scenario.dt, m_time, m_step};
   const int n = m_world.size();
   const int vesselDof = m_scenario.vessel.dof;
@@ -937,11 +948,11 @@ void CpuStepper::step() {
 
   ++m_step;
   m_time = stepTime(m_step, m_scenario.dt);
-  if (m_scenario.mortonSort && isResortStep(m_step)) {
-    reorderAlongCurve();
-  }
+  const bool reSort = m_scenario.mortonSort && isResortStep(m_step);
+  if (reSort) reorderAlongCurve();
   m_clock.lap(PhaseClock::Topology);
   ++m_clock.steps;
+  m_clock.endStep(topology.changed || reSort ? PhaseClock::Renaming : afterRenaming ? PhaseClock::AfterRenaming : PhaseClock::Plain);
 }
 
 // Phases 4 and 5 of the step (docs/architecture.md "The step") for one block of bodies after

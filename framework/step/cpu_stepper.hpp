@@ -61,6 +61,7 @@ class CpuStepper final : public Stepper {
   Broadphase& broadphase() { return *m_broadphase; }
   void restartPhaseClock() override {
     m_clock.steps = 0, m_clock.seconds = {}, m_clock.inRounds = {}, m_clock.poolMark = 0;
+    m_clock.stepSeconds = {}, m_clock.stepCount = {};
     if (m_pool) m_pool->resetStats();
   }
 
@@ -119,10 +120,22 @@ class CpuStepper final : public Stepper {
     const ThreadPool* pool = nullptr;
     double poolMark = 0;
     std::chrono::steady_clock::time_point mark;
+    // The steps by kind: plain, those that broke floes or re-sorted the bodies (bodies changed
+    // slots), and those right after such a step. At 10^5 floes the few of the last two kinds took
+    // as much time as all the plain ones (docs/performance.md 3.19).
+    enum StepKind { Plain, Renaming, AfterRenaming, kStepKinds };
+    std::array<double, kStepKinds> stepSeconds{};
+    std::array<long, kStepKinds> stepCount{};
+    std::chrono::steady_clock::time_point stepMark;
     void start() {
       if (!on) return;
-      mark = std::chrono::steady_clock::now();
+      mark = stepMark = std::chrono::steady_clock::now();
       if (pool) poolMark = pool->stats().inRounds;
+    }
+    void endStep(StepKind kind) {
+      if (!on) return;
+      stepSeconds[kind] += std::chrono::duration<double>(std::chrono::steady_clock::now() - stepMark).count();
+      ++stepCount[kind];
     }
     void lap(Phase phase) {
       if (!on) return;
