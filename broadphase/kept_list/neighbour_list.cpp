@@ -193,12 +193,17 @@ bool NeighbourList::followRenamed(const World& world) {
   std::vector<char> partSorted(m_raw.size(), 1);
   parallelRanges(listed, kPairGrain, [&](int t, long first, long last) {
     std::vector<ListedPair>& part = m_raw[static_cast<size_t>(t)];
+    // Whether the part is in order, kept here and stored once: after a re-sort nearly no pair is,
+    // and a store a pair into the flags the other ranges write made their cache line travel
+    // between the threads.
+    bool sorted = true;
     for (long k = first; k < last; ++k) {
       ListedPair q;
       if (!renamed(m_pairs[static_cast<size_t>(k)], q)) continue;
-      if (!part.empty() && !before(part.back(), q)) partSorted[static_cast<size_t>(t)] = 0;
+      sorted = sorted && (part.empty() || before(part.back(), q));
       part.push_back(q);
     }
+    partSorted[static_cast<size_t>(t)] = sorted;
   });
   if (partsInOrder(partSorted))
     joinRaw();
