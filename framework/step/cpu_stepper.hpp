@@ -149,7 +149,7 @@ class CpuStepper final : public Stepper {
   void setUp();
   void narrowphase();
   void bodyUpdates(const StepContext& ctx);
-  bool blockRestsUntouched(const char* stillness, int begin, int end) const;
+  void noteBlockStill(int b);  // m_blockStill[b] from block b's flags in m_stillness
   void reorderAlongCurve();
 
   Scenario m_scenario;
@@ -267,15 +267,13 @@ class CpuStepper final : public Stepper {
   // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads; body(i) for
   // every i likewise.
   void forEachRange(int n, const std::function<void(int, int)>& range);
-  // block(begin, end) over every slot: forEachRange's ranges cut into blocks of at most kBlock
-  // bodies, in order (a phase that makes several passes over its views makes them block by block).
+  // The body updates' blocks: slots [b kBlock, (b + 1) kBlock), each updated whole (its views made
+  // once and kept in the cache) or left out whole. By block: whether every body holds kStill
+  // (m_blockStill, kept with m_stillness), whether one has a contact this step, and this step's
+  // blocks to update.
   static constexpr int kBlock = 256;
-  template <class Block>
-  void forEachBlock(int n, Block&& block) {
-    forEachRange(n, [&](int begin, int end) {
-      for (int b = begin; b < end; b += kBlock) block(b, std::min(end, b + kBlock));
-    });
-  }
+  std::vector<char> m_blockStill, m_blockTouched;
+  std::vector<int> m_blocksToUpdate;
   RecordStreams m_streams;  // opened by the events as their Params are parsed
   StepRecords m_records;    // the last step's rows
   bool m_deliverLogs = true;
