@@ -158,6 +158,11 @@ class NeighbourList {
   // Each chunk's first kept pair, beside its count: the join's walk reads these few kilobytes, where
   // the chunks' first rows in the scratch were a cache miss each (7 us a step at 10^5 floes).
   std::vector<CandidatePair> m_chunkHead;
+  // Each chunk's last answers, a bit a pair (kept or not), and the still flags this step's update()
+  // was told (valid while the broadphase's caller holds its scope: within findCandidates).
+  static constexpr int kAnswerWords = kChunkPairs / 64;
+  std::vector<std::uint64_t> m_chunkAnswers;
+  const char* m_still = nullptr;
   std::vector<char> m_blockMoving;
   std::vector<int> m_movingBlocksBefore;
   // Likewise whether a block holds a body not flagged kRestingBody, and each range of the join's
