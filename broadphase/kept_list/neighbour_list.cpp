@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <utility>
 
@@ -11,6 +12,23 @@
 #include "framework/api/still_bodies.hpp"
 
 namespace gem {
+
+namespace {
+
+// Whether the kFlagBlock flags at `flags` all say kRestingBody: eight at a load.
+static_assert(NeighbourList::kFlagBlock % 8 == 0, "a block is whole words of flags");
+bool allResting(const char* flags) {
+  constexpr std::uint64_t kAllResting = 0x0101010101010101ull * static_cast<unsigned char>(kRestingBody);
+  std::uint64_t differ = 0;
+  for (int k = 0; k < NeighbourList::kFlagBlock; k += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, flags + k, sizeof word);
+    differ |= word ^ kAllResting;
+  }
+  return differ == 0;
+}
+
+}  // namespace
 
 NeighbourList::Need NeighbourList::update(const World& world) {
   m_stillKnown = false, m_still = nullptr;
@@ -48,6 +66,13 @@ NeighbourList::Need NeighbourList::update(const World& world) {
     for (long block = firstBlock; block < endBlock; ++block) {
       const long begin = block * kFlagBlock, end = std::min<long>(n, begin + kFlagBlock);
       char moving = still ? 0 : 1;
+      // A whole block of resting bodies, most of a resting pack, in a load of eight flags at a
+      // time: neither moving nor restless. Body by body, the two flags were an eighth of the
+      // steps' instructions at 10^5 floes.
+      if (still && end - begin == kFlagBlock && allResting(still + begin)) {
+        m_blockRestless[static_cast<size_t>(block)] = 0, m_blockMoving[static_cast<size_t>(block)] = 0;
+        continue;
+      }
       int restless = 0;  // bodies not resting (restingPairs), counted without a branch
       if (still)
         for (long i = begin; i < end; ++i) restless += still[i] != kRestingBody;
