@@ -581,51 +581,52 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
       const long begin = c * kChunkPairs, end = std::min(listed, begin + kChunkPairs);
       CandidatePair* dst = m_filtered.data() + begin;
       std::uint64_t* answers = &m_chunkAnswers[chunk * kAnswerWords];
-      std::uint64_t fresh[kAnswerWords] = {};
-      int count = 0;
       if (reuse) {
         // A chunk with a body that moved: a pair of two still bodies keeps its last answer (its
-        // bodies, and so its masks, are as they were), the others are judged afresh. Where the
-        // vessel passes, the bodies that moved are a tenth of the chunks' bodies at 10^5 floes,
-        // and every pair was judged afresh: a quarter of a step's instructions.
-        const ListedPair* pairs = m_pairs.data() + begin;
-        const int size = static_cast<int>(end - begin);
-        for (int w = 0; w * 64 < size; ++w) {
-          const std::uint64_t last = answers[w];
-          std::uint64_t now = 0;
-          const int first = w * 64, stop = std::min(size, first + 64);
-          for (int q = first; q < stop; ++q) {
-            const ListedPair& p = pairs[q];
-            std::uint64_t keep = last >> (q - first) & 1;
-            if (!(still[p.a] && still[p.b])) {
-              const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
-              keep = (dx * dx + dy * dy <= p.reach2) & !(masked[p.a] | masked[p.b]);
-            }
-            now |= keep << (q - first);
-            dst[count] = {p.a, p.b};
-            count += static_cast<int>(keep);
-          }
-          fresh[w] = now;
-        }
-      } else {
-        int firstB = m_pairs[static_cast<size_t>(begin)].b, lastB = firstB;
+        // bodies, and so its masks, are as they were), the others are judged afresh, and the
+        // chunk's stretch is written again only if an answer changed. Where the vessel passes at
+        // 10^5 floes, 99 % of these chunks' pairs are of two still bodies (25,000 a step), and
+        // judging every pair afresh was a quarter of a step's instructions.
+        bool changed = false;
         for (long k = begin; k < end; ++k) {
           const ListedPair& p = m_pairs[static_cast<size_t>(k)];
-          const int q = static_cast<int>(k - begin);
+          if (still[p.a] && still[p.b]) continue;
           const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
           const std::uint64_t keep = (dx * dx + dy * dy <= p.reach2) & !(masked[p.a] | masked[p.b]);
-          fresh[q / 64] |= keep << (q % 64);
-          dst[count] = {p.a, p.b};
-          count += static_cast<int>(keep);
-          firstB = std::min(firstB, p.b), lastB = std::max(lastB, p.b);
+          const auto q = static_cast<size_t>(k - begin);
+          const std::uint64_t bit = std::uint64_t{1} << (q % 64), last = answers[q / 64] & bit;
+          if ((last != 0) != (keep != 0)) answers[q / 64] ^= bit, changed = true;
         }
-        // The blocks its bodies lie in change only with the pairs (a build or a rename).
-        m_chunkSpan[chunk] = ChunkSpan{m_pairs[static_cast<size_t>(begin)].a / kFlagBlock,  // the pairs are sorted by a
-                                       m_pairs[static_cast<size_t>(end - 1)].a / kFlagBlock, firstB / kFlagBlock, lastB / kFlagBlock};
+        if (!changed) continue;  // the stretch, its count and its head hold
+        int count = 0;
+        for (long k = begin; k < end; ++k) {
+          const auto q = static_cast<size_t>(k - begin);
+          const ListedPair& p = m_pairs[static_cast<size_t>(k)];
+          dst[count] = {p.a, p.b};
+          count += static_cast<int>(answers[q / 64] >> (q % 64) & 1);
+        }
+        m_chunkCount[chunk] = count;
+        m_chunkHead[chunk] = dst[0];
+        continue;
+      }
+      std::uint64_t fresh[kAnswerWords] = {};
+      int count = 0, firstB = m_pairs[static_cast<size_t>(begin)].b, lastB = firstB;
+      for (long k = begin; k < end; ++k) {
+        const ListedPair& p = m_pairs[static_cast<size_t>(k)];
+        const auto q = static_cast<size_t>(k - begin);
+        const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
+        const std::uint64_t keep = (dx * dx + dy * dy <= p.reach2) & !(masked[p.a] | masked[p.b]);
+        fresh[q / 64] |= keep << (q % 64);
+        dst[count] = {p.a, p.b};
+        count += static_cast<int>(keep);
+        firstB = std::min(firstB, p.b), lastB = std::max(lastB, p.b);
       }
       std::copy(fresh, fresh + kAnswerWords, answers);
       m_chunkCount[chunk] = count;
       m_chunkHead[chunk] = dst[0];  // its first pair when count > 0, read by the join's walk
+      // The blocks its bodies lie in: they change only with the pairs (a build or a rename).
+      m_chunkSpan[chunk] = ChunkSpan{m_pairs[static_cast<size_t>(begin)].a / kFlagBlock,  // the pairs are sorted by a
+                                     m_pairs[static_cast<size_t>(end - 1)].a / kFlagBlock, firstB / kFlagBlock, lastB / kFlagBlock};
     }
     size_t kept = 0;  // the range's pairs, reused chunks' included: the join places the ranges with them
     for (long c = firstChunk; c < endChunk; ++c) kept += static_cast<size_t>(m_chunkCount[static_cast<size_t>(c)]);
