@@ -15,9 +15,10 @@
 namespace gem {
 
 // While one is alive on this thread, stillBodies() there returns `flags` (null: none known).
-// flags[i] != 0 promises that slot i holds the same body, with the same bits of position, angle
-// and velocities, as at this thread's previous findCandidates call, and that the world has had no
-// body added, removed or moved to another slot since.
+// flags[i] != 0 promises that the body in slot i has the same bits of position, angle and
+// velocities as at this thread's previous findCandidates call, and that since then bodies were
+// added, removed or moved to other slots only as the broadphase was told by bodiesRenamed(): the
+// flags are by the slots the bodies hold now (a re-sort or a break moves them with their bodies).
 class StillBodiesScope {
  public:
   explicit StillBodiesScope(const char* flags);

@@ -817,9 +817,9 @@ void CpuStepper::step() {
   m_restingPairs.clear();
   {
     const ParallelScope lend(m_pool.get());
-    // After a re-sort or a break the flags follow the bodies (followBodiesToNewSlots), but a
-    // broadphase's promise is by slot since its last call: it is told none then.
-    const bool stillKnown = m_stillnessKnown && !m_slotsRenamed && static_cast<int>(m_stillness.size()) == n;
+    // After a re-sort or a break the flags follow the bodies (followBodiesToNewSlots), which is
+    // what they promise a broadphase that was told of the renaming (bodiesRenamed).
+    const bool stillKnown = m_stillnessKnown && static_cast<int>(m_stillness.size()) == n;
     const StillBodiesScope still(stillKnown ? m_stillness.data() : nullptr);
     const RestingPairsScope resting(stillKnown ? &m_restingPairs : nullptr);
     m_broadphase->findCandidates(m_world, m_pairs);

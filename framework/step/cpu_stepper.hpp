@@ -185,8 +185,8 @@ class CpuStepper final : public Stepper {
   std::vector<char> m_active;                                 // this step: moved, or in a contact at the last step
   bool refreshPose(int i, bool inContact, bool movedBefore);  // body i's m_moved (returned), m_active, and vertices and box
   // After a re-sort or a break: what the last body updates left by slot follows each body, by its
-  // id, to its new slot (followBodiesToNewSlots), and the next step's narrowphase and broadphase
-  // learn that the slots changed hands (m_slotsRenamed).
+  // id, to its new slot (followBodiesToNewSlots), and the next narrowphase learns that the slots
+  // changed hands (m_slotsRenamed: "touched before" then searches the last contacts by id).
   void followBodiesToNewSlots();
   bool m_slotsRenamed = false;
   std::vector<int> m_oldSlotOfId;  // followBodiesToNewSlots' table: each id's slot before, -1 for none
