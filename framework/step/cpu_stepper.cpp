@@ -439,20 +439,16 @@ void CpuStepper::followBodiesToNewSlots() {
                      m_boxes.size() == before && m_vertexRow.size() == before;
   m_stillnessKnown = false;  // unless the flags follow their bodies below
   if (!known) return;
-  // Each id's slot before, in a table by id; ids too sparse for one (or negative: a world built by
-  // hand) leave the next step to read every body afresh.
-  std::int64_t largest = -1;
-  for (const Pose& pose : m_vertexPose) largest = std::max(largest, pose.id);
-  for (const std::int64_t id : m_world.id) {
-    if (id < 0) return;
-    largest = std::max(largest, id);
-  }
-  if (largest >= 4 * (static_cast<std::int64_t>(n) + static_cast<std::int64_t>(before)) + 1024) return;
-  m_oldSlotOfId.assign(static_cast<size_t>(largest) + 1, -1);
+  // Each id's slot before, in a table by id up to the world's next id (an id outside it, negative
+  // or set by hand past it, is a body taken for new); ids too sparse for a table leave the next
+  // step to read every body afresh.
+  const std::int64_t ids = m_world.nextId;
+  if (ids > 4 * (static_cast<std::int64_t>(n) + static_cast<std::int64_t>(before)) + 1024) return;
+  m_oldSlotOfId.assign(static_cast<size_t>(std::max<std::int64_t>(ids, 0)), -1);
   const int slotsBefore = static_cast<int>(before);
   forEachRange(slotsBefore, [&](int begin, int end) {  // relaxed atomic stores: a repeated id races only over which slot
     for (int j = begin; j < end; ++j)
-      if (const std::int64_t id = m_vertexPose[static_cast<size_t>(j)].id; id >= 0)
+      if (const std::int64_t id = m_vertexPose[static_cast<size_t>(j)].id; id >= 0 && id < ids)
         std::atomic_ref<int>(m_oldSlotOfId[static_cast<size_t>(id)]).store(j, std::memory_order_relaxed);
   });
   // Each new slot takes what its body's old slot holds, and notes that it did (m_takenBy); a body
@@ -466,7 +462,9 @@ void CpuStepper::followBodiesToNewSlots() {
     for (int i = begin; i < end; ++i) {
       const size_t k = static_cast<size_t>(i);
       const Pose pose{m_world.id[k], m_world.x[k], m_world.y[k], m_world.angle[k]};
-      int old = std::atomic_ref<int>(m_oldSlotOfId[static_cast<size_t>(pose.id)]).load(std::memory_order_relaxed);
+      int old = pose.id >= 0 && pose.id < ids
+                    ? std::atomic_ref<int>(m_oldSlotOfId[static_cast<size_t>(pose.id)]).load(std::memory_order_relaxed)
+                    : -1;
       if (old >= 0 && !(m_vertexPose[static_cast<size_t>(old)] == pose)) old = -1;
       m_oldSlot[k] = old;
       if (old < 0) continue;
