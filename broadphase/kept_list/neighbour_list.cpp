@@ -57,10 +57,12 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   // bodies lies in such a block.
   const long blocks = (n + kFlagBlock - 1) / kFlagBlock;
   m_blockMoving.resize(static_cast<size_t>(blocks)), m_blockRestless.resize(static_cast<size_t>(blocks));
-  const int tasks = parallelTasks(blocks, kBodyGrain / kFlagBlock);
+  const int tasks = parallelTasks(blocks, kBodyGrain / kFlagBlock, kCrowdedTasksPerThread);
   m_newlyDirect.resize(static_cast<size_t>(tasks));
   std::vector<char> renamed(static_cast<size_t>(tasks), 0);
-  parallelRanges(blocks, kBodyGrain / kFlagBlock, [&](int t, long firstBlock, long endBlock) {
+  // Finer ranges than most passes: the moving bodies, whose checks are the work, crowd around the
+  // vessel.
+  parallelCrowdedRanges(blocks, kBodyGrain / kFlagBlock, [&](int t, long firstBlock, long endBlock) {
     std::vector<int>& part = m_newlyDirect[static_cast<size_t>(t)];
     part.clear();
     for (long block = firstBlock; block < endBlock; ++block) {
@@ -573,8 +575,9 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   m_chunkHead.resize(static_cast<size_t>(chunks)), m_chunkAnswers.resize(static_cast<size_t>(chunks) * kAnswerWords);
   const int* movingBefore = m_movingBlocksBefore.data();
   const char* still = m_still;
-  m_rangeKept.resize(static_cast<size_t>(parallelTasks(chunks, kPairGrain / kChunkPairs)) + 1);
-  parallelRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {
+  // Finer ranges than most passes: the chunks to judge crowd around the vessel.
+  m_rangeKept.resize(static_cast<size_t>(parallelTasks(chunks, kPairGrain / kChunkPairs, kCrowdedTasksPerThread)) + 1);
+  parallelCrowdedRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {
     for (long c = firstChunk; c < endChunk; ++c) {
       const size_t chunk = static_cast<size_t>(c);
       if (reuse && m_chunkSpan[chunk].quiet(movingBefore)) continue;
@@ -708,7 +711,7 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   m_directFrom.resize(static_cast<size_t>(chunks));
   m_restingParts.resize(m_rangeKept.size() - 1);
   const int* restlessBefore = m_restlessBlocksBefore.data();
-  parallelRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {
+  parallelCrowdedRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {  // the ranges above
     const size_t first = static_cast<size_t>(firstChunk), end = static_cast<size_t>(endChunk), all = static_cast<size_t>(chunks);
     size_t next = end;  // the first non-empty chunk after the range: where the range's direct pairs end
     while (next < all && m_chunkCount[next] == 0) ++next;

@@ -12,9 +12,9 @@ ParallelScope::ParallelScope(ParallelRunner* runner) : m_previous(t_runner) { t_
 
 ParallelScope::~ParallelScope() { t_runner = m_previous; }
 
-int parallelTasks(long n, int grain) {
+int parallelTasks(long n, int grain, int perThread) {
   if (!t_runner || t_runner->size() <= 1 || n < 4L * grain) return 1;
-  return static_cast<int>(std::min<long>(n / grain, static_cast<long>(kTasksPerThread) * t_runner->size()));
+  return static_cast<int>(std::min<long>(n / grain, static_cast<long>(perThread) * t_runner->size()));
 }
 
 void parallelEach(int tasks, const std::function<void(int)>& task) {
@@ -27,8 +27,8 @@ void parallelEach(int tasks, const std::function<void(int)>& task) {
   runner->run(tasks, task);
 }
 
-int parallelRanges(long n, int grain, const std::function<void(int, long, long)>& range) {
-  const int tasks = parallelTasks(n, grain);
+int parallelRanges(long n, int grain, const std::function<void(int, long, long)>& range, int perThread) {
+  const int tasks = parallelTasks(n, grain, perThread);
   if (tasks <= 1) {
     range(0, 0, n);
     return 1;

@@ -39,14 +39,23 @@ class ParallelScope {
 // floes on the development machine's 2 (docs/performance.md 3.10).
 constexpr int kTasksPerThread = 4;
 
+// Tasks a thread for a pass whose work crowds into a few stretches of its items (a resting pack's
+// few moving bodies around the vessel): finer ranges let the threads share those stretches out.
+constexpr int kCrowdedTasksPerThread = 16;
+
 // How many ranges parallelRanges(n, grain, ...) cuts [0, n) into: 1 without a runner or when n is
-// under 4 grains (then waking threads costs more than the work), else at most kTasksPerThread per
+// under 4 grains (then waking threads costs more than the work), else at most `perThread` per
 // thread and at least `grain` items each. A caller sizes its per-range buffers with it.
-int parallelTasks(long n, int grain);
+int parallelTasks(long n, int grain, int perThread = kTasksPerThread);
 
 // range(task, begin, end) for task 0 .. tasks - 1, over contiguous ranges that cover [0, n) in
-// order, on the runner's threads; tasks is parallelTasks(n, grain). Returns tasks.
-int parallelRanges(long n, int grain, const std::function<void(int, long, long)>& range);
+// order, on the runner's threads; tasks is parallelTasks(n, grain, perThread). Returns tasks.
+int parallelRanges(long n, int grain, const std::function<void(int, long, long)>& range, int perThread = kTasksPerThread);
+// parallelRanges with kCrowdedTasksPerThread ranges a thread at most (parallelTasks(n, grain,
+// kCrowdedTasksPerThread) of them).
+inline int parallelCrowdedRanges(long n, int grain, const std::function<void(int, long, long)>& range) {
+  return parallelRanges(n, grain, range, kCrowdedTasksPerThread);
+}
 
 // task(0 .. tasks - 1) on the runner's threads, however few the tasks (a pass over parts that
 // parallelRanges made earlier).

@@ -1063,7 +1063,9 @@ void CpuStepper::bodyUpdates(const StepContext& ctx) {
     }
     noteBlockStill(block);
   };
-  const int tasks = m_pool && toUpdate * kBlock >= kParallelBodies ? std::min(toUpdate, kTasksPerThread * m_pool->size()) : 1;
+  // A block to update is a few microseconds of work (256 bodies' events, gather and write-back),
+  // more than a round on the pool costs: two of them are worth sharing.
+  const int tasks = m_pool && toUpdate >= 2 ? std::min(toUpdate, kTasksPerThread * m_pool->size()) : 1;
   auto updateShare = [&](int t) {
     for (int q = toUpdate * t / tasks; q < toUpdate * (t + 1) / tasks; ++q) updateBlock(m_blocksToUpdate[static_cast<size_t>(q)]);
   };
