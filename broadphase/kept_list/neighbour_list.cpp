@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "framework/api/errors.hpp"
@@ -573,8 +574,15 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   const bool reuse = m_chunksKnown && m_stillKnown && static_cast<long>(m_chunkCount.size()) == chunks;
   m_chunkCount.resize(static_cast<size_t>(chunks)), m_chunkSpan.resize(static_cast<size_t>(chunks));
   m_chunkHead.resize(static_cast<size_t>(chunks)), m_chunkAnswers.resize(static_cast<size_t>(chunks) * kAnswerWords);
+  m_answersKnown.resize(static_cast<size_t>(chunks), 0);
   const int* movingBefore = m_movingBlocksBefore.data();
   const char* still = m_still;
+  // Whether few blocks hold a body that moved (under an eighth): then a chunk to judge has few
+  // pairs of a moving body, and its pairs of two still bodies keep their answers below. Where
+  // many moved (the 824-floe field's channel), judging every pair of the chunk is cheaper than
+  // telling them apart first.
+  const long flagBlocks = static_cast<long>(m_movingBlocksBefore.size()) - 1;
+  const bool fewMoved = flagBlocks > 0 && 8L * m_movingBlocksBefore.back() < flagBlocks;
   // Finer ranges than most passes: the chunks to judge crowd around the vessel.
   m_rangeKept.resize(static_cast<size_t>(parallelTasks(chunks, kPairGrain / kChunkPairs, kCrowdedTasksPerThread)) + 1);
   parallelCrowdedRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {
@@ -584,7 +592,7 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
       const long begin = c * kChunkPairs, end = std::min(listed, begin + kChunkPairs);
       CandidatePair* dst = m_filtered.data() + begin;
       std::uint64_t* answers = &m_chunkAnswers[chunk * kAnswerWords];
-      if (reuse) {
+      if (reuse && fewMoved && m_answersKnown[chunk]) {
         // A chunk with a body that moved: a pair of two still bodies keeps its last answer (its
         // bodies, and so its masks, are as they were), the others are judged afresh, and the
         // chunk's stretch is written again only if an answer changed. Where the vessel passes at
@@ -612,24 +620,38 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
         m_chunkHead[chunk] = dst[0];
         continue;
       }
-      std::uint64_t fresh[kAnswerWords] = {};
-      int count = 0, firstB = m_pairs[static_cast<size_t>(begin)].b, lastB = firstB;
-      for (long k = begin; k < end; ++k) {
-        const ListedPair& p = m_pairs[static_cast<size_t>(k)];
-        const auto q = static_cast<size_t>(k - begin);
-        const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
-        const std::uint64_t keep = (dx * dx + dy * dy <= p.reach2) & !(masked[p.a] | masked[p.b]);
-        fresh[q / 64] |= keep << (q % 64);
-        dst[count] = {p.a, p.b};
-        count += static_cast<int>(keep);
-        firstB = std::min(firstB, p.b), lastB = std::max(lastB, p.b);
-      }
-      std::copy(fresh, fresh + kAnswerWords, answers);
-      m_chunkCount[chunk] = count;
-      m_chunkHead[chunk] = dst[0];  // its first pair when count > 0, read by the join's walk
-      // The blocks its bodies lie in: they change only with the pairs (a build or a rename).
-      m_chunkSpan[chunk] = ChunkSpan{m_pairs[static_cast<size_t>(begin)].a / kFlagBlock,  // the pairs are sorted by a
-                                     m_pairs[static_cast<size_t>(end - 1)].a / kFlagBlock, firstB / kFlagBlock, lastB / kFlagBlock};
+      // Every pair judged: keeping the answers only where few bodies moved (they cost 2 % of the
+      // 824-floe field's instructions, where many do), and finding the chunk's blocks only when
+      // the pairs are new (a build or a rename).
+      auto judgeAll = [&](auto keepAnswers, auto findSpan) {
+        std::uint64_t fresh[kAnswerWords] = {};
+        int count = 0, firstB = m_pairs[static_cast<size_t>(begin)].b, lastB = firstB;
+        for (long k = begin; k < end; ++k) {
+          const ListedPair& p = m_pairs[static_cast<size_t>(k)];
+          const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
+          const std::uint64_t keep = (dx * dx + dy * dy <= p.reach2) & !(masked[p.a] | masked[p.b]);
+          if constexpr (keepAnswers) {
+            const auto q = static_cast<size_t>(k - begin);
+            fresh[q / 64] |= keep << (q % 64);
+          }
+          dst[count] = {p.a, p.b};
+          count += static_cast<int>(keep);
+          if constexpr (findSpan) firstB = std::min(firstB, p.b), lastB = std::max(lastB, p.b);
+        }
+        if constexpr (keepAnswers) std::copy(fresh, fresh + kAnswerWords, answers);
+        m_answersKnown[chunk] = keepAnswers;
+        m_chunkCount[chunk] = count;
+        m_chunkHead[chunk] = dst[0];  // its first pair when count > 0, read by the join's walk
+        if constexpr (findSpan)
+          m_chunkSpan[chunk] = ChunkSpan{m_pairs[static_cast<size_t>(begin)].a / kFlagBlock,  // the pairs are sorted by a
+                                         m_pairs[static_cast<size_t>(end - 1)].a / kFlagBlock, firstB / kFlagBlock, lastB / kFlagBlock};
+      };
+      using Yes = std::true_type;
+      using No = std::false_type;
+      if (!reuse)
+        fewMoved ? judgeAll(Yes{}, Yes{}) : judgeAll(No{}, Yes{});
+      else
+        fewMoved ? judgeAll(Yes{}, No{}) : judgeAll(No{}, No{});
     }
     size_t kept = 0;  // the range's pairs, reused chunks' included: the join places the ranges with them
     for (long c = firstChunk; c < endChunk; ++c) kept += static_cast<size_t>(m_chunkCount[static_cast<size_t>(c)]);

@@ -162,6 +162,7 @@ class NeighbourList {
   // was told (valid while the broadphase's caller holds its scope: within findCandidates).
   static constexpr int kAnswerWords = kChunkPairs / 64;
   std::vector<std::uint64_t> m_chunkAnswers;
+  std::vector<char> m_answersKnown;  // by chunk: whether its bits hold its answers
   const char* m_still = nullptr;
   std::vector<char> m_blockMoving;
   std::vector<int> m_movingBlocksBefore;
