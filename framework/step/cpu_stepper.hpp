@@ -202,10 +202,10 @@ class CpuStepper final : public Stepper {
   // or kStill (neither; and its pose is the one its vertices were made for). Known while nothing has
   // edited the world since (m_stillnessKnown), through re-sorts and breaks, which move the flags
   // with their bodies; the poses' flags, vertices and boxes the body updates left (refreshPose)
-  // hold as long, and the narrowphase then takes them as they are. The body updates leave out a block of kStill bodies
-  // none of which has a contact now, while every solo and motion event of the run is time
-  // invariant (m_skipStillBodies): the same state, no contact and the same events give the very
-  // same bits, so its update would write nothing.
+  // hold as long, and the narrowphase then takes them as they are. The body updates leave out a
+  // block of kStill bodies none of which has a contact now, while every solo and motion event of
+  // the run is time invariant (m_skipStillBodies): the same state, no contact and the same events
+  // give the very same bits, so its update would write nothing.
   enum Stillness : char { kMoving = 0, kStillInContact = 1, kStill = 2 };
   std::vector<char> m_stillness;
   bool m_stillnessKnown = false;
