@@ -808,7 +808,9 @@ TEST(Broadphase, KeptListsNameTheRangesOfRestingPairs) {
       }
     }
     // 400 floes make four chunks of 256 pairs, each a quarter of the field: the wake is in most.
-    if (floes == 6000) EXPECT_GT(covered, listed / 2) << "the ranges should cover most pairs of a resting field";
+    if (floes == 6000) {
+      EXPECT_GT(covered, listed / 2) << "the ranges should cover most pairs of a resting field";
+    }
   }
 }
 

@@ -75,8 +75,9 @@ TEST(World, RemoveBodiesFromALargeWorldUsesHelpersAndKeepsEveryArray) {
 }
 
 // The re-sort (CpuStepper's every 200 steps): World::curveOrder is the slots sorted by their
-// Morton key, ties in slot order, and World::permute moves every array's row k to order[k]'s,
-// on one thread or as tasks on a runner (past 16,384 bodies the vertices go in ranges too).
+// Morton key, ties in slot order, on one thread or as tasks on a runner, and World::permute moves
+// every array's row k to order[k]'s, on one thread or as tasks (past 16,384 bodies the vertices go
+// in ranges too).
 TEST(World, CurveOrderAndPermuteOnOneThreadOrAsTasks) {
   World before = squares(40000);
   // Positions scattered so that the order changes, several bodies on one spot so that keys tie.
@@ -99,6 +100,13 @@ TEST(World, CurveOrderAndPermuteOnOneThreadOrAsTasks) {
     ties += k > 0 && keys[k].first == keys[k - 1].first;
   }
   EXPECT_GT(ties, 1000) << "no tied keys: the slot order of ties went untested";
+  int orderTasks = 0;
+  const std::vector<int> pooledOrder = before.curveOrder([&](int count, const std::function<void(int)>& task) {
+    orderTasks = count;
+    for (int t = count - 1; t >= 0; --t) task(t);  // any order of the tasks gives the same order
+  });
+  EXPECT_GT(orderTasks, 1) << "the curve order was not split into ranges";
+  EXPECT_EQ(pooledOrder, order) << "the curve order differs as tasks";
 
   World alone = before;
   alone.x.reserve(2 * alone.x.size()), alone.localVertices.reserve(2 * alone.localVertices.size());

@@ -58,7 +58,7 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   // bodies lies in such a block.
   const long blocks = (n + kFlagBlock - 1) / kFlagBlock;
   m_blockMoving.resize(static_cast<size_t>(blocks)), m_blockRestless.resize(static_cast<size_t>(blocks));
-  const int tasks = parallelTasks(blocks, kBodyGrain / kFlagBlock, kCrowdedTasksPerThread);
+  const int tasks = parallelCrowdedTasks(blocks, kBodyGrain / kFlagBlock);
   m_newlyDirect.resize(static_cast<size_t>(tasks));
   std::vector<char> renamed(static_cast<size_t>(tasks), 0);
   // Finer ranges than most passes: the moving bodies, whose checks are the work, crowd around the
@@ -584,7 +584,7 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   const long flagBlocks = static_cast<long>(m_movingBlocksBefore.size()) - 1;
   const bool fewMoved = flagBlocks > 0 && 8L * m_movingBlocksBefore.back() < flagBlocks;
   // Finer ranges than most passes: the chunks to judge crowd around the vessel.
-  m_rangeKept.resize(static_cast<size_t>(parallelTasks(chunks, kPairGrain / kChunkPairs, kCrowdedTasksPerThread)) + 1);
+  m_rangeKept.resize(static_cast<size_t>(parallelCrowdedTasks(chunks, kPairGrain / kChunkPairs)) + 1);
   parallelCrowdedRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {
     for (long c = firstChunk; c < endChunk; ++c) {
       const size_t chunk = static_cast<size_t>(c);

@@ -51,8 +51,9 @@ int parallelTasks(long n, int grain, int perThread = kTasksPerThread);
 // range(task, begin, end) for task 0 .. tasks - 1, over contiguous ranges that cover [0, n) in
 // order, on the runner's threads; tasks is parallelTasks(n, grain, perThread). Returns tasks.
 int parallelRanges(long n, int grain, const std::function<void(int, long, long)>& range, int perThread = kTasksPerThread);
-// parallelRanges with kCrowdedTasksPerThread ranges a thread at most (parallelTasks(n, grain,
-// kCrowdedTasksPerThread) of them).
+// The same two for a crowded pass: kCrowdedTasksPerThread ranges a thread at most. A caller that
+// sizes buffers for parallelCrowdedRanges sizes them with parallelCrowdedTasks.
+inline int parallelCrowdedTasks(long n, int grain) { return parallelTasks(n, grain, kCrowdedTasksPerThread); }
 inline int parallelCrowdedRanges(long n, int grain, const std::function<void(int, long, long)>& range) {
   return parallelRanges(n, grain, range, kCrowdedTasksPerThread);
 }

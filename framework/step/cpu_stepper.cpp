@@ -370,22 +370,30 @@ void CpuStepper::reorderAlongCurve() {
   if (m_world.size() < 2) return;
   World::TaskRunner onThePool;
   if (m_pool) onThePool = [this](int count, const std::function<void(int)>& task) { m_pool->run(count, task); };
-  m_world.permute(m_world.curveOrder(), onThePool, &m_permuteRoom);
+  m_world.permute(m_world.curveOrder(onThePool), onThePool, &m_permuteRoom);
   m_broadphase->bodiesRenamed();
   followBodiesToNewSlots();
 }
 
-void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range) {
+int CpuStepper::rangesFor(int n) const {
   // Small fields stay on one thread: waking the pool costs more than their work (on 2 cores the
   // 456-hexagon field took 0.116 ms a step on 2 threads against 0.079 ms on one).
-  const int tasks = m_pool && n >= kParallelBodies ? std::min(n / kGrain, kTasksPerThread * m_pool->size()) : 1;
+  return m_pool && n >= kParallelBodies ? std::max(1, std::min(n / kGrain, kTasksPerThread * m_pool->size())) : 1;
+}
+
+void CpuStepper::forEachPart(int n, const std::function<void(int, int, int)>& range) {
+  const int tasks = rangesFor(n);
   if (tasks <= 1) {
-    range(0, n);
+    range(0, 0, n);
     return;
   }
   m_pool->run(tasks, [&](int t) {
-    range(static_cast<int>(static_cast<long>(n) * t / tasks), static_cast<int>(static_cast<long>(n) * (t + 1) / tasks));
+    range(t, static_cast<int>(static_cast<long>(n) * t / tasks), static_cast<int>(static_cast<long>(n) * (t + 1) / tasks));
   });
+}
+
+void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range) {
+  forEachPart(n, [&](int, int begin, int end) { range(begin, end); });
 }
 
 // Whether block b's bodies all hold kStill in m_stillness: one flag a block, kept with the flags
@@ -443,13 +451,20 @@ void CpuStepper::followBodiesToNewSlots() {
   // or set by hand past it, is a body taken for new); ids too sparse for a table leave the next
   // step to read every body afresh.
   const std::int64_t ids = m_world.nextId;
+  // The table is not cleared: an entry this pass did not write may name any slot, and a new slot
+  // takes an old one only if that slot held the body's id at the body's pose (below), which a
+  // stale entry never does (the slot holding that id would have written the entry). Clearing it
+  // was a serial pass over every id, a tenth of a rename's serial time on 16 threads.
   if (ids > 4 * (static_cast<std::int64_t>(n) + static_cast<std::int64_t>(before)) + 1024) return;
-  m_oldSlotOfId.assign(static_cast<size_t>(std::max<std::int64_t>(ids, 0)), -1);
+  if (m_oldSlotOfId.size() < static_cast<size_t>(std::max<std::int64_t>(ids, 0))) m_oldSlotOfId.resize(static_cast<size_t>(ids));
   const int slotsBefore = static_cast<int>(before);
+  m_takenBy.resize(before);
   forEachRange(slotsBefore, [&](int begin, int end) {  // relaxed atomic stores: a repeated id races only over which slot
-    for (int j = begin; j < end; ++j)
+    for (int j = begin; j < end; ++j) {
+      m_takenBy[static_cast<size_t>(j)] = -1;
       if (const std::int64_t id = m_vertexPose[static_cast<size_t>(j)].id; id >= 0 && id < ids)
         std::atomic_ref<int>(m_oldSlotOfId[static_cast<size_t>(id)]).store(j, std::memory_order_relaxed);
+    }
   });
   // Each new slot takes what its body's old slot holds, and notes that it did (m_takenBy); a body
   // that is new, or not at the pose its vertices were made for, or whose old slot another new slot
@@ -457,7 +472,6 @@ void CpuStepper::followBodiesToNewSlots() {
   const size_t bodies = static_cast<size_t>(n);
   m_nextVertexRow.resize(bodies), m_nextBoxes.resize(bodies), m_nextVertexPose.resize(bodies);
   m_nextMoved.resize(bodies), m_nextActive.resize(bodies), m_nextStillness.resize(bodies), m_oldSlot.resize(bodies);
-  m_takenBy.assign(before, -1);
   forEachRange(n, [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       const size_t k = static_cast<size_t>(i);
@@ -465,7 +479,7 @@ void CpuStepper::followBodiesToNewSlots() {
       int old = pose.id >= 0 && pose.id < ids
                     ? std::atomic_ref<int>(m_oldSlotOfId[static_cast<size_t>(pose.id)]).load(std::memory_order_relaxed)
                     : -1;
-      if (old >= 0 && !(m_vertexPose[static_cast<size_t>(old)] == pose)) old = -1;
+      if (old >= 0 && (old >= slotsBefore || !(m_vertexPose[static_cast<size_t>(old)] == pose))) old = -1;
       m_oldSlot[k] = old;
       if (old < 0) continue;
       std::atomic_ref<int>(m_takenBy[static_cast<size_t>(old)]).store(i, std::memory_order_relaxed);
@@ -474,24 +488,37 @@ void CpuStepper::followBodiesToNewSlots() {
       m_nextMoved[k] = m_moved[j], m_nextActive[k] = m_active[j], m_nextStillness[k] = m_stillness[j];
     }
   });
-  // The rows of the bodies that went are free (on one thread, as the few new bodies' rows below).
-  for (size_t j = 0; j < before; ++j)
-    if (m_takenBy[j] < 0) m_freeRows.push_back(m_vertexRow[j]);
+  // Over ranges of the old slots and the new, each range's part lists, in order, the rows of the
+  // bodies that went (free now) and the new slots whose body took no old slot (a row each below,
+  // on one thread: they are the few new bodies of a break). The parts joined in order give the
+  // lists one pass over the slots would: on 16 threads these two serial passes over every slot
+  // were most of a rename's serial time.
+  const int slots = std::max(slotsBefore, n);
+  m_followParts.resize(static_cast<size_t>(rangesFor(slots)));
+  forEachPart(slots, [&](int part, int begin, int end) {
+    FollowPart& mine = m_followParts[static_cast<size_t>(part)];
+    mine.freeRows.clear(), mine.newSlots.clear();
+    for (int j = begin; j < std::min(end, slotsBefore); ++j)
+      if (m_takenBy[static_cast<size_t>(j)] < 0) mine.freeRows.push_back(m_vertexRow[static_cast<size_t>(j)]);
+    for (int i = begin; i < std::min(end, n); ++i)
+      if (const int old = m_oldSlot[static_cast<size_t>(i)]; old < 0 || m_takenBy[static_cast<size_t>(old)] != i)
+        mine.newSlots.push_back(i);
+  });
+  for (const FollowPart& part : m_followParts) m_freeRows.insert(m_freeRows.end(), part.freeRows.begin(), part.freeRows.end());
   m_vertexRow.swap(m_nextVertexRow), m_boxes.swap(m_nextBoxes), m_vertexPose.swap(m_nextVertexPose);
   m_moved.swap(m_nextMoved), m_active.swap(m_nextActive), m_stillness.swap(m_nextStillness);
-  for (int i = 0; i < n; ++i) {
-    const int old = m_oldSlot[static_cast<size_t>(i)];
-    if (old >= 0 && m_takenBy[static_cast<size_t>(old)] == i) continue;
-    if (m_freeRows.empty()) {
-      m_freeRows.push_back(m_rowCount++);
-      m_worldVertices.resize(static_cast<size_t>(m_rowCount) * kMaxVertices);
+  for (const FollowPart& part : m_followParts)
+    for (const int i : part.newSlots) {
+      if (m_freeRows.empty()) {
+        m_freeRows.push_back(m_rowCount++);
+        m_worldVertices.resize(static_cast<size_t>(m_rowCount) * kMaxVertices);
+      }
+      m_vertexRow[static_cast<size_t>(i)] = m_freeRows.back();
+      m_freeRows.pop_back();
+      m_vertexPose[static_cast<size_t>(i)] = Pose{-1, 0, 0, 0};  // made afresh: refreshPose
+      m_stillness[static_cast<size_t>(i)] = kMoving;
+      refreshPose(i, false, true);
     }
-    m_vertexRow[static_cast<size_t>(i)] = m_freeRows.back();
-    m_freeRows.pop_back();
-    m_vertexPose[static_cast<size_t>(i)] = Pose{-1, 0, 0, 0};  // made afresh: refreshPose
-    m_stillness[static_cast<size_t>(i)] = kMoving;
-    refreshPose(i, false, true);
-  }
   m_blockStill.resize(static_cast<size_t>((n + kBlock - 1) / kBlock));
   forEachRange(static_cast<int>(m_blockStill.size()), [&](int begin, int end) {
     for (int b = begin; b < end; ++b) noteBlockStill(b);

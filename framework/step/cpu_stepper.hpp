@@ -189,11 +189,15 @@ class CpuStepper final : public Stepper {
   // changed hands (m_slotsRenamed: "touched before" then searches the last contacts by id).
   void followBodiesToNewSlots();
   bool m_slotsRenamed = false;
-  std::vector<int> m_oldSlotOfId;  // followBodiesToNewSlots' table: each id's slot before, -1 for none
+  std::vector<int> m_oldSlotOfId;  // followBodiesToNewSlots' table: each id's slot before (stale where no slot held the id)
   // Its buffers, by the new slots, swapped in: they keep their memory from one rename to the next.
   // m_oldSlot: by new slot, the old slot its body came from (-1: none); m_takenBy: by old slot, the
   // new slot that took its body (a repeated id, against the World's rule, takes it once).
   std::vector<int> m_nextVertexRow, m_oldSlot, m_takenBy;
+  struct FollowPart {  // a range's rows freed and new slots without a row, in slot order
+    std::vector<int> freeRows, newSlots;
+  };
+  std::vector<FollowPart> m_followParts;
   std::vector<Box> m_nextBoxes;
   std::vector<Pose> m_nextVertexPose;
   std::vector<char> m_nextMoved, m_nextActive, m_nextStillness;
@@ -264,9 +268,12 @@ class CpuStepper final : public Stepper {
   std::vector<long> m_survivorsBefore;              // the box survivors of the parts before each part, and all of them last
   std::vector<std::pair<size_t, size_t>> m_joinAt;  // each part's first contact and separated pair in the join
   void joinParts(int tasks);
-  // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads; body(i) for
-  // every i likewise.
+  // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads.
   void forEachRange(int n, const std::function<void(int, int)>& range);
+  // The same with each range's index, 0 .. rangesFor(n) - 1 in the order of the ranges, for ranges
+  // that fill a part of their own to be joined in order.
+  void forEachPart(int n, const std::function<void(int, int, int)>& range);
+  int rangesFor(int n) const;
   // The body updates' blocks: slots [b kBlock, (b + 1) kBlock), each updated whole (its views made
   // once and kept in the cache) or left out whole. By block: whether every body holds kStill
   // (m_blockStill, kept with m_stillness), whether one has a contact this step, and this step's

@@ -1,6 +1,7 @@
 #include "framework/world/world.hpp"
 
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <thread>
 #include <cmath>
@@ -242,28 +243,78 @@ void World::permute(const std::vector<int>& order, const TaskRunner& forEachTask
   localVertices.swap(vertices);
 }
 
-std::vector<int> World::curveOrder() const {
+std::vector<int> World::curveOrder(const TaskRunner& forEachTask) const {
+  // With a runner, the bounds, the keys and each pass of the sort over 16 ranges of slots: on one
+  // thread this was most of a re-sort's serial time on 16 threads (docs/performance.md 3.20).
   const int n = size();
-  std::vector<int> order(n);
+  std::vector<int> order(static_cast<size_t>(n));
   if (n == 0) return order;
-  Real x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (int i = 0; i < n; ++i) {
-    x0 = std::min(x0, x[i]), x1 = std::max(x1, x[i]);
-    y0 = std::min(y0, y[i]), y1 = std::max(y1, y[i]);
-  }
-  const Real scale = curveScale(x0, y0, x1, y1);
+  const int ranges = forEachTask && n >= 16384 ? 16 : 1;
+  auto rangeOf = [&](int r) {
+    return std::pair{static_cast<int>(static_cast<long>(n) * r / ranges), static_cast<int>(static_cast<long>(n) * (r + 1) / ranges)};
+  };
+  auto overRanges = [&](const std::function<void(int)>& task) {
+    if (ranges > 1)
+      forEachTask(ranges, task);
+    else
+      task(0);
+  };
+  // The box of all centroids: each range's, then theirs (min and max give the same whatever the
+  // grouping, a NaN skipped either way).
+  struct Bounds {
+    Real x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  };
+  std::vector<Bounds> part(static_cast<size_t>(ranges));
+  overRanges([&](int r) {
+    Bounds b;
+    const auto [begin, end] = rangeOf(r);
+    for (int i = begin; i < end; ++i) {
+      b.x0 = std::min(b.x0, x[i]), b.x1 = std::max(b.x1, x[i]);
+      b.y0 = std::min(b.y0, y[i]), b.y1 = std::max(b.y1, y[i]);
+    }
+    part[static_cast<size_t>(r)] = b;
+  });
+  Bounds all;
+  for (const Bounds& b : part)
+    all.x0 = std::min(all.x0, b.x0), all.x1 = std::max(all.x1, b.x1), all.y0 = std::min(all.y0, b.y0), all.y1 = std::max(all.y1, b.y1);
+  const Real scale = curveScale(all.x0, all.y0, all.x1, all.y1);
   std::vector<std::uint32_t> key(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) key[static_cast<size_t>(i)] = curveKey(x[i], y[i], x0, y0, scale);
-  // A stable sort by key of the slots in slot order, so ties stay in slot order: two passes of a
-  // counting sort on 16 bits each (at 10^5 bodies about a tenth of std::sort's time).
+  overRanges([&](int r) {
+    const auto [begin, end] = rangeOf(r);
+    for (int i = begin; i < end; ++i) key[static_cast<size_t>(i)] = curveKey(x[i], y[i], all.x0, all.y0, scale);
+  });
+  // A stable sort by key of the slots in slot order, so ties stay in slot order: three passes of a
+  // counting sort on 11 bits each (a least-significant-digit radix sort; at 10^5 bodies a tenth of
+  // std::sort's time). A pass counts each range's digits, places each range's share of a digit
+  // after the earlier digits' and the earlier ranges' share of its own, and each range then moves
+  // its slots in order: the same places as one pass over all the slots.
+  constexpr int kDigitBits = 11, kDigits = 1 << kDigitBits;
   std::vector<int> from(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) from[static_cast<size_t>(i)] = i;
-  std::vector<int> start(65537);
-  for (const int shift : {0, 16}) {
-    std::fill(start.begin(), start.end(), 0);
-    for (int i = 0; i < n; ++i) ++start[((key[static_cast<size_t>(i)] >> shift) & 0xffffu) + 1];
-    for (size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
-    for (const int i : from) order[static_cast<size_t>(start[(key[static_cast<size_t>(i)] >> shift) & 0xffffu]++)] = i;
+  std::vector<std::array<int, kDigits>> start(static_cast<size_t>(ranges));
+  for (const int shift : {0, kDigitBits, 2 * kDigitBits}) {
+    auto digitOf = [&](int i) { return static_cast<int>((key[static_cast<size_t>(i)] >> shift) & (kDigits - 1)); };
+    overRanges([&](int r) {
+      std::array<int, kDigits>& count = start[static_cast<size_t>(r)];
+      count.fill(0);
+      const auto [begin, end] = rangeOf(r);
+      for (int k = begin; k < end; ++k) ++count[static_cast<size_t>(digitOf(from[static_cast<size_t>(k)]))];
+    });
+    int placed = 0;
+    for (int d = 0; d < kDigits; ++d)
+      for (std::array<int, kDigits>& count : start) {
+        const int c = count[static_cast<size_t>(d)];
+        count[static_cast<size_t>(d)] = placed;
+        placed += c;
+      }
+    overRanges([&](int r) {
+      std::array<int, kDigits>& at = start[static_cast<size_t>(r)];
+      const auto [begin, end] = rangeOf(r);
+      for (int k = begin; k < end; ++k) {
+        const int i = from[static_cast<size_t>(k)];
+        order[static_cast<size_t>(at[static_cast<size_t>(digitOf(i))]++)] = i;
+      }
+    });
     from.swap(order);
   }
   return from;

@@ -114,7 +114,8 @@ struct World {
   void permute(const std::vector<int>& order, const TaskRunner& forEachTask = nullptr, PermuteRoom* room = nullptr);
   // The order of the bodies along a Morton (Z-order) curve through their centroids: neighbours in
   // space become neighbours in memory (docs/architecture.md "Speed habits"). Ties keep slot order.
-  std::vector<int> curveOrder() const;  // sorted by curveKey, ties by slot
+  // forEachTask as for removeBodies (then ranges of slots are tasks); the same order either way.
+  std::vector<int> curveOrder(const TaskRunner& forEachTask = nullptr) const;  // sorted by curveKey, ties by slot
   // Total mass of the floes, kg.
   double floeMass() const;
   int count(BodyKind k) const;
