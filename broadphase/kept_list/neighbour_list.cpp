@@ -730,6 +730,16 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
     return static_cast<size_t>(std::lower_bound(m_directPairs.begin(), m_directPairs.end(), m_chunkHead[c], before) -
                                m_directPairs.begin());
   };
+  // The same from a place not after the answer: steps of 1, 2, 4, ... over the pairs before the
+  // head, then a search inside the last step.
+  auto gallopFrom = [&](size_t from, CandidatePair head) {
+    size_t lo = from, step = 1;
+    while (lo + step <= directCount && before(m_directPairs[lo + step - 1], head)) lo += step, step *= 2;
+    const size_t hi = std::min(lo + step - 1, directCount);
+    return static_cast<size_t>(std::lower_bound(m_directPairs.begin() + static_cast<std::ptrdiff_t>(lo),
+                                                m_directPairs.begin() + static_cast<std::ptrdiff_t>(hi), head, before) -
+                               m_directPairs.begin());
+  };
   m_directFrom.resize(static_cast<size_t>(chunks));
   m_restingParts.resize(m_rangeKept.size() - 1);
   const int* restlessBefore = m_restlessBlocksBefore.data();
@@ -738,9 +748,18 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
     size_t next = end;  // the first non-empty chunk after the range: where the range's direct pairs end
     while (next < all && m_chunkCount[next] == 0) ++next;
     const size_t afterRange = next == all ? directCount : directBefore(next);
+    // The range's non-empty chunks in order (their heads in pair order, as the direct pairs are):
+    // a search for the first, then a gallop on from the last answer. A search of all the direct
+    // pairs for every chunk was a third of this pass at 10^5 floes (906 chunks a step).
+    size_t found = directCount + 1;  // none yet
+    for (size_t c = first; c < end; ++c)
+      if (c == 0)
+        m_directFrom[c] = found = 0;
+      else if (m_chunkCount[c] > 0)
+        m_directFrom[c] = found = found > directCount ? directBefore(c) : gallopFrom(found, m_chunkHead[c]);
     size_t startOfNext = afterRange;
     for (size_t c = end; c-- > first;) {
-      m_directFrom[c] = c == 0 ? 0 : m_chunkCount[c] > 0 ? directBefore(c) : startOfNext;
+      if (c != 0 && m_chunkCount[c] == 0) m_directFrom[c] = startOfNext;
       startOfNext = m_directFrom[c];
     }
     size_t kept = m_rangeKept[static_cast<size_t>(t)];
