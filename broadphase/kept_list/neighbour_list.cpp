@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <type_traits>
@@ -415,6 +417,38 @@ void NeighbourList::begin(int parts) {
 // integer atomics: the counts are exact, and the order in which parts claim places in a row is
 // undone by the row's sort. (Counts kept part by part made the pass over the rows cost bodies x
 // parts, strided through memory: with 64 parts on 16 threads it was 6 % of a 10^5-floe run.)
+// A long row (a wall's: its bounding circle covers much of the field, 22,000 to 45,000 floes of
+// 10^5) sorted by b in O(bodies): each pair's place noted by its b in a bitmap of the slots, the
+// row read back in slot order. After a re-sort every wall's row is out of order, and std::sort of
+// it, inside one task, held the whole pool for milliseconds. The b of a row are distinct (a pair
+// is listed once), so the order is the one std::sort gives; a repeated b (a build's raw rows may
+// hold a pair twice) returns false, and the caller sorts the row as before.
+bool NeighbourList::placeLongRowBySlot(int begin, int end, size_t bodyCount) {
+  thread_local std::vector<std::uint64_t> taken;  // a bit a slot, all clear between calls
+  thread_local std::vector<int> placeOfSlot;
+  thread_local std::vector<ListedPair> row;
+  taken.resize((bodyCount + 63) / 64, 0), placeOfSlot.resize(bodyCount);
+  row.assign(m_pairs.begin() + begin, m_pairs.begin() + end);
+  bool repeated = false;
+  for (size_t k = 0; k < row.size(); ++k) {
+    const auto b = static_cast<size_t>(row[k].b);
+    if (b >= bodyCount) {  // not a slot: left to std::sort
+      repeated = true;
+      break;
+    }
+    const std::uint64_t bit = std::uint64_t{1} << (b % 64);
+    repeated |= (taken[b / 64] & bit) != 0;
+    taken[b / 64] |= bit, placeOfSlot[b] = static_cast<int>(k);
+  }
+  auto out = static_cast<size_t>(begin);
+  for (size_t w = 0; w < taken.size(); ++w)
+    for (std::uint64_t bits = taken[w]; bits != 0; bits &= bits - 1) {
+      if (!repeated) m_pairs[out++] = row[static_cast<size_t>(placeOfSlot[w * 64 + static_cast<size_t>(std::countr_zero(bits))])];
+      taken[w] = 0;
+    }
+  return !repeated;
+}
+
 void NeighbourList::sortRaw(int bodyCount) {
   const int parts = static_cast<int>(m_raw.size());
   const size_t n = static_cast<size_t>(bodyCount);
@@ -462,7 +496,8 @@ void NeighbourList::sortRaw(int bodyCount) {
     for (long a = first; a < last; ++a) {
       const int begin = m_count[static_cast<size_t>(a)], end = m_count[static_cast<size_t>(a) + 1];
       if (end - begin > kShortRow) {
-        std::sort(m_pairs.begin() + begin, m_pairs.begin() + end, [](const ListedPair& p, const ListedPair& q) { return p.b < q.b; });
+        if (!(static_cast<size_t>(end - begin) > n / 32 && placeLongRowBySlot(begin, end, n)))
+          std::sort(m_pairs.begin() + begin, m_pairs.begin() + end, [](const ListedPair& p, const ListedPair& q) { return p.b < q.b; });
         continue;
       }
       for (int k = begin + 1; k < end; ++k) {

@@ -118,6 +118,7 @@ class NeighbourList {
 
  private:
   void sortRaw(int bodyCount);
+  bool placeLongRowBySlot(int begin, int end, size_t bodyCount);  // sortRaw's long rows; false: left as they were
   bool followRenamed(const World& world);
   bool partsInOrder(const std::vector<char>& partSorted) const;
   void joinRaw();
