@@ -640,8 +640,9 @@ TEST(Broadphase, KeptListsFollowRenamedBodiesWithoutARebuild) {
     const std::vector<ListedPair>& pairs = list->pairs();
     int longest = 0;
     for (size_t k = 0, rowStart = 0; k < pairs.size(); ++k) {
-      if (k > 0) ASSERT_TRUE(pairs[k - 1].a < pairs[k].a || (pairs[k - 1].a == pairs[k].a && pairs[k - 1].b < pairs[k].b)) << "pair " << k;
-      if (k > 0 && pairs[k - 1].a != pairs[k].a) rowStart = k;
+      if (k == 0) continue;
+      ASSERT_TRUE(pairs[k - 1].a < pairs[k].a || (pairs[k - 1].a == pairs[k].a && pairs[k - 1].b < pairs[k].b)) << "pair " << k;
+      if (pairs[k - 1].a != pairs[k].a) rowStart = k;
       longest = std::max(longest, static_cast<int>(k + 1 - rowStart));
     }
     EXPECT_GT(longest, std::max(32, w.size() / 32)) << "no row long enough to be put in order by slot";

@@ -59,7 +59,7 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   // is not known to be still: the filter keeps the last answer of a chunk of pairs none of whose
   // bodies lies in such a block.
   const long blocks = (n + kFlagBlock - 1) / kFlagBlock;
-  m_blockMoving.resize(static_cast<size_t>(blocks)), m_blockRestless.resize(static_cast<size_t>(blocks));
+  m_movingBlocks.clear(blocks), m_restlessBlocks.clear(blocks);
   const int tasks = parallelCrowdedTasks(blocks, kBodyGrain / kFlagBlock);
   m_newlyDirect.resize(static_cast<size_t>(tasks));
   std::vector<char> renamed(static_cast<size_t>(tasks), 0);
@@ -68,27 +68,37 @@ NeighbourList::Need NeighbourList::update(const World& world) {
   parallelCrowdedRanges(blocks, kBodyGrain / kFlagBlock, [&](int t, long firstBlock, long endBlock) {
     std::vector<int>& part = m_newlyDirect[static_cast<size_t>(t)];
     part.clear();
+    // The range's flags for the word of blocks it is in, ORed into the shared word when it moves
+    // on to the next word and at its end: a few atomic operations a range, and nothing for a
+    // resting block.
+    auto word = static_cast<unsigned long>(firstBlock) / 64;
+    std::uint64_t movingBits = 0, restlessBits = 0;
+    auto flush = [&] {
+      m_movingBlocks.orWord(static_cast<long>(word), movingBits), m_restlessBlocks.orWord(static_cast<long>(word), restlessBits);
+    };
+    auto note = [&](long block, bool moving, bool restless) {
+      const auto b = static_cast<unsigned long>(block);
+      if (b / 64 != word) flush(), word = b / 64, movingBits = restlessBits = 0;
+      movingBits |= std::uint64_t{moving} << (b % 64), restlessBits |= std::uint64_t{restless} << (b % 64);
+    };
     for (long block = firstBlock; block < endBlock; ++block) {
       const long begin = block * kFlagBlock, end = std::min<long>(n, begin + kFlagBlock);
-      char moving = still ? 0 : 1;
+      bool moving = still == nullptr;
       // A whole block of resting bodies, most of a resting pack, in a load of eight flags at a
       // time: neither moving nor restless. Body by body, the two flags were an eighth of the
       // steps' instructions at 10^5 floes.
-      if (still && end - begin == kFlagBlock && allResting(still + begin)) {
-        m_blockRestless[static_cast<size_t>(block)] = 0, m_blockMoving[static_cast<size_t>(block)] = 0;
-        continue;
-      }
+      if (still && end - begin == kFlagBlock && allResting(still + begin)) continue;
       int restless = 0;  // bodies not resting (restingPairs), counted without a branch
       if (still)
         for (long i = begin; i < end; ++i) restless += still[i] != kRestingBody;
-      m_blockRestless[static_cast<size_t>(block)] = restless != 0;
+      const bool restlessBlock = restless != 0 || !still;
       for (long i = begin; i < end; ++i) {
         if (still && (i - begin) % 8 == 0 && i + 8 <= end && allEightStill(still + i)) {
           i += 7;  // eight still bodies at once
           continue;
         }
         if (still && still[i]) continue;
-        moving = 1;
+        moving = true;
         // A reorder or an in-place replacement without invalidate() would make the list point at the
         // wrong bodies: the ids guard against it for the price of one load per body.
         if (id[i] != m_id0[static_cast<size_t>(i)]) {
@@ -107,19 +117,15 @@ NeighbourList::Need NeighbourList::update(const World& world) {
           part.push_back(static_cast<int>(i));
         }
       }
-      m_blockMoving[static_cast<size_t>(block)] = moving;
+      note(block, moving, restlessBlock);
     }
+    flush();
   });
   for (char r : renamed)
-    if (r) return Need::Rebuild;
-  m_movingBlocksBefore.resize(static_cast<size_t>(blocks) + 1);
-  m_restlessBlocksBefore.resize(static_cast<size_t>(blocks) + 1);
-  m_movingBlocksBefore[0] = 0, m_restlessBlocksBefore[0] = 0;
-  for (long block = 0; block < blocks; ++block) {
-    const auto k = static_cast<size_t>(block);
-    m_movingBlocksBefore[k + 1] = m_movingBlocksBefore[k] + m_blockMoving[k];
-    m_restlessBlocksBefore[k + 1] = m_restlessBlocksBefore[k] + m_blockRestless[k];
-  }
+    if (r) {
+      m_stillKnown = false;  // the block flags are unfinished: no still chunk is reused, no resting range named
+      return Need::Rebuild;
+    }
   for (const std::vector<int>& part : m_newlyDirect) {
     m_directList.insert(m_directList.end(), part.begin(), part.end());
     for (const int i : part) m_maskedBodies += !m_masked[static_cast<size_t>(i)], m_masked[static_cast<size_t>(i)] = 1;
@@ -610,20 +616,19 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   m_chunkCount.resize(static_cast<size_t>(chunks)), m_chunkSpan.resize(static_cast<size_t>(chunks));
   m_chunkHead.resize(static_cast<size_t>(chunks)), m_chunkAnswers.resize(static_cast<size_t>(chunks) * kAnswerWords);
   m_answersKnown.resize(static_cast<size_t>(chunks), 0);
-  const int* movingBefore = m_movingBlocksBefore.data();
   const char* still = m_still;
   // Whether few blocks hold a body that moved (under an eighth): then a chunk to judge has few
   // pairs of a moving body, and its pairs of two still bodies keep their answers below. Where
   // many moved (the 824-floe field's channel), judging every pair of the chunk is cheaper than
   // telling them apart first.
-  const long flagBlocks = static_cast<long>(m_movingBlocksBefore.size()) - 1;
-  const bool fewMoved = flagBlocks > 0 && 8L * m_movingBlocksBefore.back() < flagBlocks;
+  const long flagBlocks = m_movingBlocks.blocks;
+  const bool fewMoved = flagBlocks > 0 && 8L * m_movingBlocks.count() < flagBlocks;
   // Finer ranges than most passes: the chunks to judge crowd around the vessel.
   m_rangeKept.resize(static_cast<size_t>(parallelCrowdedTasks(chunks, kPairGrain / kChunkPairs)) + 1);
   parallelCrowdedRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {
     for (long c = firstChunk; c < endChunk; ++c) {
       const size_t chunk = static_cast<size_t>(c);
-      if (reuse && m_chunkSpan[chunk].quiet(movingBefore)) continue;
+      if (reuse && m_chunkSpan[chunk].quiet(m_movingBlocks)) continue;
       const long begin = c * kChunkPairs, end = std::min(listed, begin + kChunkPairs);
       CandidatePair* dst = m_filtered.data() + begin;
       std::uint64_t* answers = &m_chunkAnswers[chunk * kAnswerWords];
@@ -777,7 +782,6 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   };
   m_directFrom.resize(static_cast<size_t>(chunks));
   m_restingParts.resize(m_rangeKept.size() - 1);
-  const int* restlessBefore = m_restlessBlocksBefore.data();
   parallelCrowdedRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {  // the ranges above
     const size_t first = static_cast<size_t>(firstChunk), end = static_cast<size_t>(endChunk), all = static_cast<size_t>(chunks);
     size_t next = end;  // the first non-empty chunk after the range: where the range's direct pairs end
@@ -809,7 +813,7 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
       // No body restless in the chunk's blocks, and no direct pair merged in: its stretch of the
       // output is pairs of resting bodies only, which the caller reads none of, and it is left as
       // it was (restingPairs' contract): at 10^5 floes that is most of the 1.2 MB copied a step.
-      const bool restingChunk = resting && m_chunkCount[c] > 0 && directEnd == m_directFrom[c] && m_chunkSpan[c].quiet(restlessBefore);
+      const bool restingChunk = resting && m_chunkCount[c] > 0 && directEnd == m_directFrom[c] && m_chunkSpan[c].quiet(m_restlessBlocks);
       if (!restingChunk) std::merge(from, from + m_chunkCount[c], direct0, direct1, out.begin() + static_cast<std::ptrdiff_t>(at), before);
       if (restingChunk) {
         const long begin = static_cast<long>(at), stop = begin + m_chunkCount[c];
