@@ -149,20 +149,19 @@ bool NeighbourList::followRenamed(const World& world) {
   const int n = world.size();
   const long oldCount = static_cast<long>(m_id0.size());
   const std::int64_t* id = world.id.data();
-  std::int64_t largest = -1;
-  for (int i = 0; i < n; ++i) largest = std::max(largest, id[i]);
-  for (const std::int64_t old : m_id0) largest = std::max(largest, old);
-  if (largest >= 4 * static_cast<std::int64_t>(n + oldCount) + 1024) return false;
-  // Each id's new slot. Over ranges of bodies: a repeated id makes two ranges write one entry, and
-  // the check after finds the entry naming the other body (the stores are atomic, so the race is
-  // only over which one).
-  m_slotOfId.resize(static_cast<size_t>(largest) + 1);
+  // Each id's new slot, in a table up to the world's next id (an id of the world past it, set by
+  // hand, makes the list build afresh; an old id past it is of a body that went). Over ranges of
+  // bodies: a repeated id makes two ranges write one entry, and the check after finds the entry
+  // naming the other body (the stores are atomic, so the race is only over which one).
+  const std::int64_t ids = world.nextId;
+  if (ids >= 4 * static_cast<std::int64_t>(n + oldCount) + 1024) return false;
+  m_slotOfId.resize(static_cast<size_t>(std::max<std::int64_t>(ids, 0)));
   parallelRanges(static_cast<long>(m_slotOfId.size()), kBodyGrain,
                  [&](int, long begin, long end) { std::fill(m_slotOfId.begin() + begin, m_slotOfId.begin() + end, -1); });
   std::atomic<bool> unfollowable{false};
   parallelRanges(n, kBodyGrain, [&](int, long begin, long end) {
     for (long i = begin; i < end; ++i) {
-      if (id[i] < 0) {
+      if (id[i] < 0 || id[i] >= ids) {
         unfollowable.store(true, std::memory_order_relaxed);
         return;
       }
@@ -180,7 +179,7 @@ bool NeighbourList::followRenamed(const World& world) {
   parallelRanges(oldCount, kBodyGrain, [&](int, long begin, long end) {
     for (long j = begin; j < end; ++j) {
       const std::int64_t old = m_id0[static_cast<size_t>(j)];
-      const int i = old < 0 ? -1 : m_slotOfId[static_cast<size_t>(old)];
+      const int i = old < 0 || old >= ids ? -1 : m_slotOfId[static_cast<size_t>(old)];
       m_newSlot[static_cast<size_t>(j)] = i;
       if (i >= 0) m_isNew[static_cast<size_t>(i)] = 0;
     }
@@ -204,13 +203,20 @@ bool NeighbourList::followRenamed(const World& world) {
   for (const int v : m_directList)
     if (const int i = m_newSlot[static_cast<size_t>(v)]; i >= 0) m_directList[keptDirect++] = i;
   m_directList.resize(keptDirect);
-  for (int i = 0; i < n; ++i) {
-    const size_t k = static_cast<size_t>(i);
-    if (!m_isNew[k]) continue;
-    m_x0Next[k] = world.x[k], m_y0Next[k] = world.y[k], m_angle0Next[k] = world.angle[k], m_id0Next[k] = world.id[k];
-    m_directNext[k] = m_maskedNext[k] = 1;
-    m_directList.push_back(i);
-  }
+  // The new bodies, each range's into a part of its own, joined in slot order: a break's few.
+  m_newlyDirect.resize(static_cast<size_t>(parallelTasks(n, kBodyGrain)));
+  parallelRanges(n, kBodyGrain, [&](int t, long begin, long end) {
+    std::vector<int>& part = m_newlyDirect[static_cast<size_t>(t)];
+    part.clear();
+    for (long i = begin; i < end; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      if (!m_isNew[k]) continue;
+      m_x0Next[k] = world.x[k], m_y0Next[k] = world.y[k], m_angle0Next[k] = world.angle[k], m_id0Next[k] = world.id[k];
+      m_directNext[k] = m_maskedNext[k] = 1;
+      part.push_back(static_cast<int>(i));
+    }
+  });
+  for (const std::vector<int>& part : m_newlyDirect) m_directList.insert(m_directList.end(), part.begin(), part.end());
   m_x0.swap(m_x0Next), m_y0.swap(m_y0Next), m_angle0.swap(m_angle0Next), m_id0.swap(m_id0Next);
   m_direct.swap(m_directNext), m_masked.swap(m_maskedNext);
   m_maskedBodies = static_cast<int>(std::count(m_masked.begin(), m_masked.end(), 1));

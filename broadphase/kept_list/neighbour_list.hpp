@@ -215,7 +215,7 @@ class NeighbourList {
   // and the bodies that moved more than half the skin since their reference.
   std::vector<char> m_direct;
   std::vector<int> m_directList;
-  std::vector<std::vector<int>> m_newlyDirect;  // update()'s, range by range
+  std::vector<std::vector<int>> m_newlyDirect;  // update()'s and followRenamed()'s new direct bodies, range by range
   std::vector<CandidatePair> m_directPairs;
   // The references binned in cells, for the direct pass and relisting (reference_grid.hpp).
   ReferenceGrid m_grid;
