@@ -419,16 +419,6 @@ void NeighbourList::begin(int parts) {
   for (std::vector<ListedPair>& part : m_raw) part.clear();
 }
 
-// A counting sort by a (O(bodies + pairs)), then each row sorted by b: most rows hold a handful of
-// pairs, and an insertion sort beats std::sort's log factor on them; a long row (a wall's: its
-// bounding circle covers the field, so at 10^5 floes it lists every floe, in sweep order) takes
-// std::sort, which an insertion sort would make quadratic (it was a third of a 10^5-floe step).
-// Equal pairs are equal records (add() leaves reach2 0), so a row's sort by b gives the same row
-// whatever order its pairs were scattered in, and whichever sort runs.
-// That is what lets the parts count and scatter in parallel into one shared count per row, with
-// integer atomics: the counts are exact, and the order in which parts claim places in a row is
-// undone by the row's sort. (Counts kept part by part made the pass over the rows cost bodies x
-// parts, strided through memory: with 64 parts on 16 threads it was 6 % of a 10^5-floe run.)
 // A long row (a wall's: its bounding circle covers much of the field, 22,000 to 45,000 floes of
 // 10^5) sorted by b in O(bodies): each pair's place noted by its b in a bitmap of the slots, the
 // row read back in slot order. After a re-sort every wall's row is out of order, and std::sort of
@@ -461,6 +451,17 @@ bool NeighbourList::placeLongRowBySlot(int begin, int end, size_t bodyCount) {
   return !repeated;
 }
 
+// A counting sort by a (O(bodies + pairs)), then each row sorted by b: most rows hold a handful of
+// pairs, and an insertion sort beats std::sort's log factor on them; a long row (a wall's: its
+// bounding circle covers the field, so at 10^5 floes it lists every floe, in sweep order) takes
+// std::sort, which an insertion sort would make quadratic (it was a third of a 10^5-floe step),
+// or, longer than a thirty-second of the bodies, placeLongRowBySlot.
+// Equal pairs are equal records (add() leaves reach2 0), so a row's sort by b gives the same row
+// whatever order its pairs were scattered in, and whichever sort runs.
+// That is what lets the parts count and scatter in parallel into one shared count per row, with
+// integer atomics: the counts are exact, and the order in which parts claim places in a row is
+// undone by the row's sort. (Counts kept part by part made the pass over the rows cost bodies x
+// parts, strided through memory: with 64 parts on 16 threads it was 6 % of a 10^5-floe run.)
 void NeighbourList::sortRaw(int bodyCount) {
   const int parts = static_cast<int>(m_raw.size());
   const size_t n = static_cast<size_t>(bodyCount);
