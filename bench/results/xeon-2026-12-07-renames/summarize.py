@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Issue "CPU speed": the tables of docs/performance.md 3.20 from a record of
-../xeon-2026-12-07-poses/run.sh. Usage: summarize.py RECORD_DIR (holding run-1/ and run-2/)."""
+../xeon-2026-12-07-poses/run.sh, serial.sh or final.sh. Usage: summarize.py RECORD_DIR (holding
+run-1/ and run-2/)."""
 import re
 import statistics as st
 import sys
@@ -13,18 +14,17 @@ kinds = re.compile(r'steps by kind: (\d+) plain at ([\d.]+) ms.*?(\d+) breaking 
 for run in ('run-1', 'run-2'):
     print(f'{run}: 10^5 floes, ms a step (plain / breaking or re-sorting / right after)')
     times = {}
-    build = threads = None
+    lines = []
     for line in open(f'{record}/{run}/scaling.txt'):
         m = row.match(line)
         if m:
-            build, threads = m.group(1), int(m.group(2))
-            times[(build, threads)] = float(m.group(3))
-            print(f'\n  {build} {threads:2} threads: {float(m.group(3)):.4f}', end='')
+            times[(m.group(1), int(m.group(2)))] = float(m.group(3))
+            lines.append(f'  {m.group(1)} {int(m.group(2)):2} threads: {float(m.group(3)):.4f}')
             continue
         k = kinds.search(line)
-        if k:
-            print(f'  ({float(k.group(2)):.4f} / {float(k.group(4)):.2f} / {float(k.group(6)):.2f})', end='')
-    print()
+        if k and lines:
+            lines[-1] += f'  ({float(k.group(2)):.4f} / {float(k.group(4)):.2f} / {float(k.group(6)):.2f})'
+    print('\n'.join(lines))
     for b in sorted({b for b, _ in times}):
         one = times.get((b, 1))
         if one:
