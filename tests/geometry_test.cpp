@@ -11,6 +11,7 @@
 
 #include "geometry/clip.hpp"
 #include "geometry/contact.hpp"
+#include "geometry/packed_host.hpp"
 #include "geometry/polygon.hpp"
 #include "geometry/sat.hpp"
 #include "geometry/split.hpp"
@@ -618,4 +619,52 @@ TEST(Geometry, ClipToleranceFromTheBoxesGivesTheSameOverlap) {
     clipped += k >= 3;
   }
   EXPECT_GT(clipped, 4000);  // plenty of real overlaps among the pairs
+}
+
+// geometry/packed_host.hpp's packed forms against the scalar ones, bit for bit: world vertices and
+// their box for random shapes, poses far from the origin, zero and negative-zero coordinates and
+// angles from 0 to many turns; boxes that overlap, touch along an edge or a corner (where > and >=
+// differ), are apart, or hold a NaN or an infinite bound.
+TEST(Geometry, PackedFormsGiveTheScalarFormsBits) {
+  std::mt19937 rng(20261208);
+  std::uniform_real_distribution<Real> unit(0, 1);
+  auto bits = [](Real v) { return std::bit_cast<std::uint64_t>(static_cast<double>(v)); };
+  for (int trial = 0; trial < 20000; ++trial) {
+    Poly local = randomConvex(rng, Vec2{0, 0}, 0.2 + 20 * unit(rng));
+    if (trial % 7 == 0) local[0] = Vec2{-Real(0), Real(0)};
+    Vec2 position = trial % 3 == 0 ? Vec2{-Real(0), Real(0)} : Vec2{5000 * (unit(rng) - 0.5), 5000 * (unit(rng) - 0.5)};
+    Real angle = trial % 5 == 0 ? Real(0) : trial % 5 == 1 ? -Real(0) : 40 * (unit(rng) - 0.5);
+    if (trial % 11 == 0) {  // world vertices at -0 and +0 in one shape: the box keeps the zero the scalar test keeps
+      position = Vec2{-Real(0), -Real(0)}, angle = 0;
+      local = trial % 2 ? Poly{{-Real(0), 1}, {Real(0), 2}, {-1, Real(0)}, {-Real(0), -Real(0)}}  // the largest x a zero
+                        : Poly{{Real(0), 1}, {-Real(0), 2}, {1, -Real(0)}, {Real(0), Real(0)}};   // the smallest x a zero
+    }
+    const int n = static_cast<int>(local.size());
+    Vec2 scalar[kMaxVertices]{}, packed[kMaxVertices]{};
+    toWorld(local.data(), n, position, angle, scalar);
+    const Box expected = boundingBox(scalar, n);
+    const Box box = toWorldWithBox(local.data(), n, position, angle, packed);
+    for (int i = 0; i < n; ++i) {
+      ASSERT_EQ(bits(packed[i].x), bits(scalar[i].x)) << "trial " << trial << " vertex " << i;
+      ASSERT_EQ(bits(packed[i].y), bits(scalar[i].y)) << "trial " << trial << " vertex " << i;
+    }
+    ASSERT_EQ(bits(box.x0), bits(expected.x0)) << "trial " << trial;
+    ASSERT_EQ(bits(box.y0), bits(expected.y0)) << "trial " << trial;
+    ASSERT_EQ(bits(box.x1), bits(expected.x1)) << "trial " << trial;
+    ASSERT_EQ(bits(box.y1), bits(expected.y1)) << "trial " << trial;
+  }
+  // Bounds drawn from a few values, so that equal bounds (boxes touching) and zeros of both signs
+  // come up often.
+  const Real values[] = {-2, -1, -Real(0), Real(0), 1, 2, 0.5, std::nan(""), INFINITY, -INFINITY};
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(std::size(values)) - 1);
+  int meeting = 0, apart = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    const Box a{values[pick(rng)], values[pick(rng)], values[pick(rng)], values[pick(rng)]};
+    const Box b{values[pick(rng)], values[pick(rng)], values[pick(rng)], values[pick(rng)]};
+    const bool expected = boxesOverlap(a, b);
+    ASSERT_EQ(boxesMeet(a, b), expected) << "trial " << trial;
+    (expected ? meeting : apart) += 1;
+  }
+  EXPECT_GT(meeting, 20000);
+  EXPECT_GT(apart, 20000);
 }

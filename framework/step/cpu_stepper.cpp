@@ -7,16 +7,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <cstddef>
 #include <optional>
 #include <cmath>
 #include <map>
 #include <string_view>
 
 #include <fmt/format.h>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "framework/api/errors.hpp"
 #include "framework/field/ice_file.hpp"
@@ -28,6 +24,7 @@
 #include "framework/world/vessel.hpp"
 #include "framework/step/phases.hpp"
 #include "geometry/contact.hpp"
+#include "geometry/packed_host.hpp"
 
 namespace gem {
 
@@ -427,8 +424,8 @@ inline bool CpuStepper::refreshPose(int i, bool inContact, bool movedBefore) {
   m_active[static_cast<size_t>(i)] = moved || inContact;
   if (!changed) return moved;
   m_vertexPose[static_cast<size_t>(i)] = pose;
-  Vec2* v = worldVerticesOf(i);
-  m_boxes[static_cast<size_t>(i)] = boundingBox(v, m_world.worldVertices(i, v));
+  m_boxes[static_cast<size_t>(i)] =
+      toWorldWithBox(m_world.local(i), m_world.vertexCount[i], m_world.position(i), m_world.angle[i], worldVerticesOf(i));
   return true;
 }
 
@@ -531,21 +528,6 @@ void CpuStepper::followBodiesToNewSlots() {
   });
   m_stillnessKnown = true;
   m_slotsRenamed = true;
-}
-
-// Whether two boxes overlap: boxesOverlap's test (a NaN bound counts as overlapping), without its
-// short-circuits, as two packed comparisons of corners: {x0, y0} of one against {x1, y1} of the
-// other, and back. Scalar, the four comparisons and their flags were a quarter of the candidate
-// loop's instructions (the 824-floe field's 1,450 candidates of a moving body a step).
-static inline int boxesMeet(const Box& a, const Box& b) {
-#if defined(__SSE2__) && !defined(GEM_REAL_FLOAT)
-  static_assert(offsetof(Box, y0) == sizeof(Real) && offsetof(Box, y1) == 3 * sizeof(Real), "corners {x0, y0} and {x1, y1}");
-  const __m128d apart = _mm_or_pd(_mm_cmpgt_pd(_mm_loadu_pd(&a.x0), _mm_loadu_pd(&b.x1)),  // lanes x, y: all ones where apart
-                                  _mm_cmpgt_pd(_mm_loadu_pd(&b.x0), _mm_loadu_pd(&a.x1)));
-  return _mm_movemask_pd(apart) == 0;
-#else
-  return !(a.x0 > b.x1) & !(b.x0 > a.x1) & !(a.y0 > b.y1) & !(b.y0 > a.y1);
-#endif
 }
 
 void CpuStepper::narrowphase() {
