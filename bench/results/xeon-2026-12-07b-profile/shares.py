@@ -38,7 +38,7 @@ counts = [offsets(r) for r in runs]
 table = []
 for a, n, name in syms:
     shares = [100 * sum(v for k, v in c.items() if a <= k < a + n) / t for c, t, _ in counts]
-    if max(shares) > 0.8:
+    if max(shares) > float(__import__("os").environ.get("SHARE_MIN", "0.8")):
         table.append((shares, name[:100]))
 table.sort(reverse=True)
 print(' '.join('%7s' % ('run%d' % i) for i in range(len(runs))), ' function (% of all samples)')
