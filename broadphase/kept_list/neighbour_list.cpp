@@ -631,8 +631,9 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
   const long flagBlocks = m_movingBlocks.blocks;
   const bool fewMoved = flagBlocks > 0 && 8L * m_movingBlocks.count() < flagBlocks;
   // Finer ranges than most passes: the chunks to judge crowd around the vessel.
-  m_rangeKept.resize(static_cast<size_t>(parallelCrowdedTasks(chunks, kPairGrain / kChunkPairs)) + 1);
-  parallelCrowdedRanges(chunks, kPairGrain / kChunkPairs, [&](int t, long firstChunk, long endChunk) {
+  const int chunkTasks = parallelCrowdedTasks(chunks, kPairGrain / kChunkPairs);
+  m_rangeKept.resize(static_cast<size_t>(chunkTasks) + 1);
+  auto judgeChunks = [&](int t, long firstChunk, long endChunk) {
     for (long c = firstChunk; c < endChunk; ++c) {
       const size_t chunk = static_cast<size_t>(c);
       if (reuse && m_chunkSpan[chunk].quiet(m_movingBlocks)) continue;
@@ -703,48 +704,66 @@ void NeighbourList::filterByCircles(const World& world, std::vector<CandidatePai
     size_t kept = 0;  // the range's pairs, reused chunks' included: the join places the ranges with them
     for (long c = firstChunk; c < endChunk; ++c) kept += static_cast<size_t>(m_chunkCount[static_cast<size_t>(c)]);
     m_rangeKept[static_cast<size_t>(t) + 1] = kept;
-  });
-  m_chunksKnown = true;
+  };
 
   // Direct bodies (the vessel, and floes that moved more than half the skin since the build) are
   // tested against the bodies near them, instead of a rebuild of the whole list every few steps
   // while the vessel shoves floes at its own speed: the bodies that are not direct through the grid
   // of references (as relisting), the direct ones in turn. The pairs are sorted afterwards, so the
   // order of the tests does not matter.
-  m_directPairs.clear();
   const Real* radius = world.radius.data();
-  for (const int v : m_directList) {
-    const Real xv = x[v], yv = y[v], rv = radius[v];
-    const bool wall = world.kind[v] == BodyKind::Wall;
-    auto test = [&](int j) {
-      const Real dx = xv - x[j], dy = yv - y[j], reach = rv + radius[j];
-      if (!(dx * dx + dy * dy <= reach * reach)) return;
-      if (j == v || (direct[j] && j < v)) return;  // a pair of two direct bodies is found once
-      if (wall && world.kind[j] == BodyKind::Wall) return;
-      m_directPairs.push_back(j < v ? CandidatePair{j, v} : CandidatePair{v, j});
-    };
-    m_grid.near(xv, yv, searchReach(xv, yv, rv, 0), [&](int j) {
-      if (!direct[j]) test(j);
-    });
-    for (const int j : m_directList) test(j);
-  }
+  auto directPass = [&] {
+    m_directPairs.clear();
+    for (const int v : m_directList) {
+      const Real xv = x[v], yv = y[v], rv = radius[v];
+      const bool wall = world.kind[v] == BodyKind::Wall;
+      auto test = [&](int j) {
+        const Real dx = xv - x[j], dy = yv - y[j], reach = rv + radius[j];
+        if (!(dx * dx + dy * dy <= reach * reach)) return;
+        if (j == v || (direct[j] && j < v)) return;  // a pair of two direct bodies is found once
+        if (wall && world.kind[j] == BodyKind::Wall) return;
+        m_directPairs.push_back(j < v ? CandidatePair{j, v} : CandidatePair{v, j});
+      };
+      m_grid.near(xv, yv, searchReach(xv, yv, rv, 0), [&](int j) {
+        if (!direct[j]) test(j);
+      });
+      for (const int j : m_directList) test(j);
+    }
+  };
+  // The side list's pairs whose circles overlap now, but those of a direct body (the direct pass
+  // has them): over ranges of the side list, each range's survivors into a part of its own.
+  const long side = static_cast<long>(m_sidePairs.size());
+  const int sideTasks = side > 0 ? parallelTasks(side, kSidePairGrain) : 0;
+  m_sideParts.resize(static_cast<size_t>(sideTasks));
+  auto filterSide = [&](int t, long begin, long end) {
+    std::vector<CandidatePair>& part = m_sideParts[static_cast<size_t>(t)];
+    part.clear();
+    for (long k = begin; k < end; ++k) {
+      const ListedPair& p = m_sidePairs[static_cast<size_t>(k)];
+      const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
+      if (dx * dx + dy * dy <= p.reach2 && !(direct[p.a] | direct[p.b])) part.push_back({p.a, p.b});
+    }
+  };
+  // The three read only this step's positions and the lists, each writes its own buffers: one round
+  // of the pool does them all, the chunks' ranges, the side list's and the direct pass as tasks of
+  // it. Apart, the side list's filter and the direct pass ran on the calling thread while the
+  // others waited (a side list under four grains is one range): at 10^5 floes, after a few
+  // thousand steps, a tenth of a two-thread step.
+  parallelEach(chunkTasks + sideTasks + 1, [&](int task) {
+    if (task < chunkTasks) {
+      judgeChunks(task, chunks * task / chunkTasks, chunks * (task + 1) / chunkTasks);
+    } else if (const int t = task - chunkTasks; t < sideTasks) {
+      filterSide(t, side * t / sideTasks, side * (t + 1) / sideTasks);
+    } else {
+      directPass();
+    }
+  });
+  m_chunksKnown = true;
   auto before = [](CandidatePair p, CandidatePair q) { return p.a < q.a || (p.a == q.a && p.b < q.b); };
   std::sort(m_directPairs.begin(), m_directPairs.end(), before);
-  // The side list's pairs whose circles overlap now, but those of a direct body (the direct pass
-  // has them), merged in: a side pair has no direct body, a direct pair has one, so none is both.
-  // Over ranges of the side list, each range's survivors into a part of its own, appended in order.
-  if (!m_sidePairs.empty()) {
-    const long side = static_cast<long>(m_sidePairs.size());
-    m_sideParts.resize(static_cast<size_t>(parallelTasks(side, kPairGrain)));
-    parallelRanges(side, kPairGrain, [&](int t, long begin, long end) {
-      std::vector<CandidatePair>& part = m_sideParts[static_cast<size_t>(t)];
-      part.clear();
-      for (long k = begin; k < end; ++k) {
-        const ListedPair& p = m_sidePairs[static_cast<size_t>(k)];
-        const Real dx = x[p.a] - x[p.b], dy = y[p.a] - y[p.b];
-        if (dx * dx + dy * dy <= p.reach2 && !(direct[p.a] | direct[p.b])) part.push_back({p.a, p.b});
-      }
-    });
+  // The side list's survivors, in list order, merged in: a side pair has no direct body, a direct
+  // pair has one, so none is both.
+  if (sideTasks > 0) {
     const size_t directCount = m_directPairs.size();
     for (const std::vector<CandidatePair>& part : m_sideParts) m_directPairs.insert(m_directPairs.end(), part.begin(), part.end());
     std::inplace_merge(m_directPairs.begin(), m_directPairs.begin() + static_cast<std::ptrdiff_t>(directCount), m_directPairs.end(),

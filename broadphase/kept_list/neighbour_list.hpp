@@ -87,6 +87,9 @@ class NeighbourList {
   // Items a parallel range takes at least (framework/api/parallel.hpp): pairs of a stream (a few
   // nanoseconds each), bodies of an O(1) pass.
   static constexpr int kPairGrain = 4096, kBodyGrain = 1024;
+  // The side list's pairs name relisted floes all over the field: each reads two bodies' x and y
+  // from far apart, several times a stream pair's cost.
+  static constexpr int kSidePairGrain = 1024;
   // The filter's chunks of listed pairs, and the blocks of slots that say whether a chunk's bodies
   // are all still (filterByCircles). Both divide the grains above.
   static constexpr int kChunkPairs = 256, kFlagBlock = 64;
