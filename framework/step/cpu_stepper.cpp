@@ -870,8 +870,9 @@ void CpuStepper::step() {
     }
   });
   m_slots.assign(contacts, PairSlot{{0, 0}});
-  // The pair events, event by event, each over contiguous ranges of contacts (a contact's slot is
-  // its own; an event's apply is a function of its contact, as on the device). Each range pushes
+  // The pair events over contiguous ranges of contacts, each range running them all in their
+  // order (a contact's slot is its own; an event's apply is a function of its contact, as on the
+  // device, so a contact meets the events in the order one pass event by event gives). Each range pushes
   // its records into buffers of its own, with the contact numbered within the range; they are
   // joined below event by event, range by range, the numbers shifted to the step's: the very rows,
   // in the very order, of one pass over all contacts. Each stream has room for one row per contact
@@ -886,6 +887,9 @@ void CpuStepper::step() {
   m_pairRecordRoom.resize(std::max(m_pairRecordRoom.size(), cells), 0);
   std::vector<int> counts(cells);
   std::vector<int> ends;  // per pair event, range and stream: the rows pushed by then
+  std::vector<EventInstance*> pairEvents;
+  for (auto& e : m_events)
+    if (e.phase == EventPhase::Pair) pairEvents.push_back(e.instance.get());
   for (;;) {
     std::vector<RecordSink> sinks(static_cast<size_t>(ranges));
     for (int t = 0; t < ranges; ++t)
@@ -897,14 +901,11 @@ void CpuStepper::step() {
         counts[c] = 0;
         sinks[static_cast<size_t>(t)].streams[s] = RecordBuffer{m_pairRecordRows[c].data(), m_streams.info(s).stride, room, &counts[c]};
       }
-    ends.clear();
-    int event = 0;
-    for (auto& e : m_events) {
-      if (e.phase != EventPhase::Pair) continue;
-      const size_t first = ends.size();
-      ends.resize(first + cells);
-      auto range = [&](int t) {
-        const int begin = rangeStart(t);
+    // One round of the pool for all the events: a round an event cost a hand-off each.
+    ends.assign(pairEvents.size() * cells, 0);
+    auto range = [&](int t) {
+      const int begin = rangeStart(t);
+      for (size_t event = 0; event < pairEvents.size(); ++event) {
         const PairPhaseData pairData{m_pairBodies.data(),
                                      m_contactA.data() + begin,
                                      m_contactB.data() + begin,
@@ -913,19 +914,18 @@ void CpuStepper::step() {
                                      rangeStart(t + 1) - begin,
                                      ctx,
                                      sinks[static_cast<size_t>(t)],
-                                     event};
-        e.instance->runPairs(pairData);
+                                     static_cast<int>(event)};
+        pairEvents[event]->runPairs(pairData);
         for (int s = 0; s < streams; ++s) {
           const size_t c = static_cast<size_t>(t) * static_cast<size_t>(streams) + static_cast<size_t>(s);
-          ends[first + c] = counts[c];
+          ends[event * cells + c] = counts[c];
         }
-      };
-      if (ranges > 1)
-        m_pool->run(ranges, range);
-      else
-        range(0);
-      ++event;
-    }
+      }
+    };
+    if (ranges > 1)
+      m_pool->run(ranges, range);
+    else
+      range(0);
     bool overflow = false;
     for (size_t c = 0; c < cells; ++c)
       if (counts[c] > m_pairRecordRoom[c]) m_pairRecordRoom[c] = counts[c], overflow = true;
