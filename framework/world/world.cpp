@@ -279,27 +279,38 @@ std::vector<int> World::curveOrder(const TaskRunner& forEachTask) const {
   for (const Bounds& b : part)
     all.x0 = std::min(all.x0, b.x0), all.x1 = std::max(all.x1, b.x1), all.y0 = std::min(all.y0, b.y0), all.y1 = std::max(all.y1, b.y1);
   const Real scale = curveScale(all.x0, all.y0, all.x1, all.y1);
-  std::vector<std::uint32_t> key(static_cast<size_t>(n));
+  // Each slot's key and the slot in one word, the key above: sorted, the words are in key order,
+  // ties in slot order, and a pass reads the words in order (read by slot, the keys were a random
+  // read of the whole array in every pass after the first).
+  // Kept by the calling thread from one re-sort to the next: fresh, their pages were faulted in at
+  // every call, and two threads faulting at once wait on each other in the kernel. (Named through
+  // references: a task on another thread that named the thread_local would get that thread's.)
+  thread_local std::vector<std::uint64_t> keptWords, keptSorted;
+  std::vector<std::uint64_t>& word = keptWords;
+  std::vector<std::uint64_t>& sorted = keptSorted;
+  word.resize(static_cast<size_t>(n)), sorted.resize(static_cast<size_t>(n));
   overRanges([&](int r) {
     const auto [begin, end] = rangeOf(r);
-    for (int i = begin; i < end; ++i) key[static_cast<size_t>(i)] = curveKey(x[i], y[i], all.x0, all.y0, scale);
+    for (int i = begin; i < end; ++i)
+      word[static_cast<size_t>(i)] = std::uint64_t{curveKey(x[i], y[i], all.x0, all.y0, scale)} << 32 | static_cast<std::uint32_t>(i);
   });
-  // A stable sort by key of the slots in slot order, so ties stay in slot order: three passes of a
-  // counting sort on 11 bits each (a least-significant-digit radix sort; at 10^5 bodies a tenth of
-  // std::sort's time). A pass counts each range's digits, places each range's share of a digit
-  // after the earlier digits' and the earlier ranges' share of its own, and each range then moves
-  // its slots in order: the same places as one pass over all the slots.
-  constexpr int kDigitBits = 11, kDigits = 1 << kDigitBits;
-  std::vector<int> from(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) from[static_cast<size_t>(i)] = i;
+  // A stable sort by key of the slots in slot order, so ties stay in slot order: four passes of a
+  // counting sort on 8 bits each of the key (a least-significant-digit radix sort; at 10^5 bodies
+  // a tenth of std::sort's time). A pass counts each range's digits, places each range's share of a
+  // digit after the earlier digits' and the earlier ranges' share of its own (on the calling
+  // thread, reading every range's counts digit by digit), and each range then moves its words in
+  // order: the same places as one pass over all the slots. Three passes of 11 bits made that
+  // placing 2,048 digits by 16 ranges, counts the other threads had just written: 0.65 ms a re-sort
+  // on two AMD threads, more than the rest of the sort (docs/performance.md 3.22).
+  constexpr int kDigitBits = 8, kDigits = 1 << kDigitBits;
   std::vector<std::array<int, kDigits>> start(static_cast<size_t>(ranges));
-  for (const int shift : {0, kDigitBits, 2 * kDigitBits}) {
-    auto digitOf = [&](int i) { return static_cast<int>((key[static_cast<size_t>(i)] >> shift) & (kDigits - 1)); };
+  for (const int shift : {32, 32 + kDigitBits, 32 + 2 * kDigitBits, 32 + 3 * kDigitBits}) {
+    auto digitOf = [&](std::uint64_t w) { return static_cast<size_t>((w >> shift) & (kDigits - 1)); };
     overRanges([&](int r) {
       std::array<int, kDigits>& count = start[static_cast<size_t>(r)];
       count.fill(0);
       const auto [begin, end] = rangeOf(r);
-      for (int k = begin; k < end; ++k) ++count[static_cast<size_t>(digitOf(from[static_cast<size_t>(k)]))];
+      for (int k = begin; k < end; ++k) ++count[digitOf(word[static_cast<size_t>(k)])];
     });
     int placed = 0;
     for (int d = 0; d < kDigits; ++d)
@@ -312,13 +323,17 @@ std::vector<int> World::curveOrder(const TaskRunner& forEachTask) const {
       std::array<int, kDigits>& at = start[static_cast<size_t>(r)];
       const auto [begin, end] = rangeOf(r);
       for (int k = begin; k < end; ++k) {
-        const int i = from[static_cast<size_t>(k)];
-        order[static_cast<size_t>(at[static_cast<size_t>(digitOf(i))]++)] = i;
+        const std::uint64_t w = word[static_cast<size_t>(k)];
+        sorted[static_cast<size_t>(at[digitOf(w)]++)] = w;
       }
     });
-    from.swap(order);
+    word.swap(sorted);
   }
-  return from;
+  overRanges([&](int r) {
+    const auto [begin, end] = rangeOf(r);
+    for (int k = begin; k < end; ++k) order[static_cast<size_t>(k)] = static_cast<int>(word[static_cast<size_t>(k)] & 0xffffffffu);
+  });
+  return order;
 }
 
 double World::floeMass() const {
