@@ -376,14 +376,14 @@ void CpuStepper::reorderAlongCurve() {
   followBodiesToNewSlots();
 }
 
-int CpuStepper::rangesFor(int n) const {
+int CpuStepper::rangesFor(int n, int from, int grain) const {
   // Small fields stay on one thread: waking the pool costs more than their work (on 2 cores the
   // 456-hexagon field took 0.116 ms a step on 2 threads against 0.079 ms on one).
-  return m_pool && n >= kParallelBodies ? std::max(1, std::min(n / kGrain, kTasksPerThread * m_pool->size())) : 1;
+  return m_pool && n >= from ? std::max(1, std::min(n / grain, kTasksPerThread * m_pool->size())) : 1;
 }
 
-void CpuStepper::forEachPart(int n, const std::function<void(int, int, int)>& range) {
-  const int tasks = rangesFor(n);
+void CpuStepper::forEachPart(int n, const std::function<void(int, int, int)>& range, int from, int grain) {
+  const int tasks = rangesFor(n, from, grain);
   if (tasks <= 1) {
     range(0, 0, n);
     return;
@@ -393,8 +393,9 @@ void CpuStepper::forEachPart(int n, const std::function<void(int, int, int)>& ra
   });
 }
 
-void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range) {
-  forEachPart(n, [&](int, int begin, int end) { range(begin, end); });
+void CpuStepper::forEachRange(int n, const std::function<void(int, int)>& range, int from, int grain) {
+  forEachPart(
+      n, [&](int, int begin, int end) { range(begin, end); }, from, grain);
 }
 
 // Whether block b's bodies all hold kStill in m_stillness: one flag a block, kept with the flags
@@ -863,12 +864,16 @@ void CpuStepper::step() {
   // in five in a pack.
   const int contacts = static_cast<int>(m_contacts.size());
   m_pairBodies.resize(n);
-  forEachRange(static_cast<int>(m_byBody.bodies.size()), [&](int begin, int end) {
-    for (int q = begin; q < end; ++q) {
-      const int i = m_byBody.bodies[static_cast<size_t>(q)];
-      m_pairBodies[i] = pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof), worldVerticesOf(i), m_world.vertexCount[i]);
-    }
-  });
+  forEachRange(
+      static_cast<int>(m_byBody.bodies.size()),
+      [&](int begin, int end) {
+        for (int q = begin; q < end; ++q) {
+          const int i = m_byBody.bodies[static_cast<size_t>(q)];
+          m_pairBodies[i] =
+              pairBodyOf(m_world, i, degreesOfFreedom(m_world.kind[i], vesselDof), worldVerticesOf(i), m_world.vertexCount[i]);
+        }
+      },
+      kParallelPairViews, kPairViewGrain);
   m_slots.assign(contacts, PairSlot{{0, 0}});
   // The pair events over contiguous ranges of contacts, each range running them all in their
   // order (a contact's slot is its own; an event's apply is a function of its contact, as on the

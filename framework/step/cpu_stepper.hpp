@@ -89,6 +89,10 @@ class CpuStepper final : public Stepper {
   // Bodies or pairs a task takes at least: a small field wakes few threads (on 16 cores, waking all
   // of them for the 456-hexagon field made its step 1.3x slower than one thread's).
   static constexpr int kGrain = 512;
+  // The pair views (one body's view a few dozen nanoseconds): from this many bodies in contact on,
+  // over ranges of kPairViewGrain. Under kParallelBodies they were made on the calling thread: at
+  // 10^5 floes after a few thousand steps, 1,000 bodies and 14 us of a two-thread step.
+  static constexpr int kParallelPairViews = 512, kPairViewGrain = 128;
   // Contacts and separated pairs from which the narrowphase's parts are joined on the pool.
   static constexpr size_t kParallelJoin = 32768;
   Vec2 vesselIceForce() const override { return m_vesselIceForce; }  // N, world frame, from the step's impulses
@@ -268,12 +272,13 @@ class CpuStepper final : public Stepper {
   std::vector<long> m_survivorsBefore;              // the box survivors of the parts before each part, and all of them last
   std::vector<std::pair<size_t, size_t>> m_joinAt;  // each part's first contact and separated pair in the join
   void joinParts(int tasks);
-  // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads.
-  void forEachRange(int n, const std::function<void(int, int)>& range);
+  // range(begin, end) over contiguous ranges that cover [0, n), on the pool's threads: from `from`
+  // items on, `grain` items a range at least.
+  void forEachRange(int n, const std::function<void(int, int)>& range, int from = kParallelBodies, int grain = kGrain);
   // The same with each range's index, 0 .. rangesFor(n) - 1 in the order of the ranges, for ranges
   // that fill a part of their own to be joined in order.
-  void forEachPart(int n, const std::function<void(int, int, int)>& range);
-  int rangesFor(int n) const;
+  void forEachPart(int n, const std::function<void(int, int, int)>& range, int from = kParallelBodies, int grain = kGrain);
+  int rangesFor(int n, int from = kParallelBodies, int grain = kGrain) const;
   // The body updates' blocks: slots [b kBlock, (b + 1) kBlock), each updated whole (its views made
   // once and kept in the cache) or left out whole. By block: whether every body holds kStill
   // (m_blockStill, kept with m_stillness), whether one has a contact this step, and this step's
