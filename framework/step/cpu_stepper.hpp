@@ -89,7 +89,7 @@ class CpuStepper final : public Stepper {
   // Bodies or pairs a task takes at least: a small field wakes few threads (on 16 cores, waking all
   // of them for the 456-hexagon field made its step 1.3x slower than one thread's).
   static constexpr int kGrain = 512;
-  // The pair views (one body's view a few dozen nanoseconds): from this many bodies in contact on,
+  // The pair views (about 15 nanoseconds a body's view): from this many bodies in contact on,
   // over ranges of kPairViewGrain. Under kParallelBodies they were made on the calling thread: at
   // 10^5 floes after a few thousand steps, 1,000 bodies and 14 us of a two-thread step.
   static constexpr int kParallelPairViews = 512, kPairViewGrain = 128;
