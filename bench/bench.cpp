@@ -5,6 +5,9 @@
 #include <cstdlib>
 #include <chrono>
 #include <ctime>
+#include <exception>
+#include <latch>
+#include <numeric>
 #include <thread>
 #include <tuple>
 #include <cmath>
@@ -409,8 +412,56 @@ void sweepTable(const TableRun& run, const std::string& name) {
   table.finish();
 }
 
+// `fields` copies of the case, each stepped on one thread (no pool) by a thread of its own, all
+// at once: the copies' mean time a step. They share nothing but the machine (its caches above the
+// core, its memory, its clock under load), so `fields` times one field's time over that mean is
+// the work the machine does on that many cores when nothing is shared: what threads stepping one
+// field could gain at most on this machine (docs/performance.md 3.23). Each copy is timed as
+// timeRow times one; a copy that ends first leaves the others a little less disturbed, so the
+// mean is a little kinder than a machine busy throughout.
+Row independentFieldsRow(CaseScenarios& scenarios, const CaseKey& c, const std::string& broadphase, long steps, int fields) {
+  Scenario s = scenarios.get(c);
+  s.backend = "cpu";
+  s.threads = 1;
+  s.broadphase = broadphase;
+  s.steps = std::max<long>(s.steps, 2 * steps + 1000);
+  const bool large = c.floes >= 50000;
+  const auto begun = Clock::now();
+  if (large) std::fprintf(stderr, "gem bench: %s, cpu, %s, %d independent fields...\n", c.name.c_str(), broadphase.c_str(), fields);
+  std::vector<std::unique_ptr<Stepper>> sims;
+  for (int k = 0; k < fields; ++k) sims.push_back(makeStepper(s));
+  Row r;
+  r.caseName = c.name, r.backend = "cpu", r.broadphase = broadphase, r.param = fmt::format("{} fields", fields);
+  r.bodies = sims.front()->hostWorld().size();  // before the steps, as timeRow's (breaks add bodies)
+  r.floes = sims.front()->hostWorld().count(BodyKind::Floe);
+  std::vector<double> seconds(static_cast<size_t>(fields));
+  std::vector<std::exception_ptr> errors(static_cast<size_t>(fields));
+  std::latch start(fields);  // every field made before any is stepped
+  std::vector<std::thread> threads;
+  for (int k = 0; k < fields; ++k)
+    threads.emplace_back([&, k] {
+      start.arrive_and_wait();
+      try {
+        Stepper& sim = *sims[static_cast<size_t>(k)];
+        seconds[static_cast<size_t>(k)] = timePerStep(sim, s, steps, sim.hostWorld().size());
+      } catch (...) {
+        errors[static_cast<size_t>(k)] = std::current_exception();
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+  r.dt = s.dt;
+  r.seconds = std::accumulate(seconds.begin(), seconds.end(), 0.0) / fields;
+  r.device = cpuName() + fmt::format(" ({} independent fields, a thread each)", fields);
+  if (large) std::fprintf(stderr, "gem bench: ... done in %.1f s\n", secondsSince(begun));
+  return r;
+}
+
 // --table cpu: the CPU backend on one field over 1, 2, 4, 8 and every core's threads
-// (simulation.threads), the thesis fields and 10^4, 10^5 floes; each row's speed-up over one thread.
+// (simulation.threads), the thesis fields and 10^4, 10^5 floes; each row's speed-up over one
+// thread, and after it as many independent one-thread fields stepped at once (the row's threads
+// column says "N fields"): the speed-up the machine itself allows at that thread count.
 void cpuTable(const TableRun& run) {
   const BenchOptions& o = run.options;
   const auto cases = casesOf(o, {"456", "824", "10000", "100000"});
@@ -434,7 +485,11 @@ void cpuTable(const TableRun& run) {
         const Row r = timeRow(run.scenarios, c, "cpu", broadphase, o.steps, std::to_string(t));
         table.add(r);
         if (t == 1) one = r.seconds;
-        if (t > 1) std::printf("  %d threads: %.2fx one thread\n", t, one / r.seconds);
+        if (t == 1) continue;
+        const Row fields = independentFieldsRow(run.scenarios, c, broadphase, o.steps, t);
+        table.add(fields);
+        std::printf("  %d threads: %.2fx one thread; %d independent fields: %.2fx one field's work (the most %d threads could gain here)\n",
+                    t, one / r.seconds, t, t * one / fields.seconds, t);
       }
     }
   g_cpuThreads = asked;

@@ -3,6 +3,8 @@
 // are timed on a GPU machine (scripts/stage-gpu.sh runs gem bench --table all).
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include "test_support.hpp"
 
 using namespace gem;
@@ -61,4 +63,31 @@ TEST(GemBench, BadTablesAndOptionsAreBadInput) {
     EXPECT_EQ(test::runGem("bench --table resident", log), 2);
     EXPECT_NE(test::readFile(log).find("it times the CUDA drivers"), std::string::npos) << test::readFile(log);
   }
+}
+
+// --table cpu: a row a thread count, and after each one above 1 a row of as many independent
+// one-thread fields (the machine's ceiling for that thread count), with the line that compares
+// them. On a one-core machine the table has the one-thread row only, which is checked too.
+TEST(GemBench, CpuTableTimesThreadsAndAsManyIndependentFields) {
+  TempDir dir;
+  const auto log = dir.path() / "log.txt", csv = dir.path() / "cpu.csv";
+  ASSERT_EQ(test::runGem("bench --table cpu --cases 456 --steps 10 --csv " + csv.string(), log), 0) << test::readFile(log);
+  const std::string rows = test::readFile(csv);
+  EXPECT_EQ(rows.rfind("case,backend,broadphase,threads,bodies,floes,ms_per_step", 0), 0u) << rows;
+  EXPECT_NE(rows.find("\"456 hexagons (46 %)\",cpu,variable_radius,1,"), std::string::npos) << rows;
+  const std::string text = test::readFile(log);
+  if (std::thread::hardware_concurrency() < 2) {
+    EXPECT_EQ(countLines(rows), 2) << rows;
+    return;
+  }
+  EXPECT_NE(rows.find("\"456 hexagons (46 %)\",cpu,variable_radius,2,"), std::string::npos) << rows;
+  EXPECT_NE(rows.find("\"456 hexagons (46 %)\",cpu,variable_radius,2 fields,459,456,"), std::string::npos) << rows;
+  EXPECT_NE(rows.find("(2 independent fields, a thread each)"), std::string::npos) << rows;
+  // One row of threads and one of fields for every thread count above 1, after the one-thread row.
+  const int counts = countLines(rows) - 2;
+  EXPECT_GE(counts, 2) << rows;
+  EXPECT_EQ(counts % 2, 0) << rows;
+  EXPECT_NE(text.find("2 threads: "), std::string::npos) << text;
+  EXPECT_NE(text.find("x one thread; 2 independent fields: "), std::string::npos) << text;
+  EXPECT_NE(text.find("x one field's work (the most 2 threads could gain here)"), std::string::npos) << text;
 }
