@@ -233,15 +233,23 @@ std::string cpuDeviceName() {
   return cpuName() + (g_cpuThreads == 1 ? std::string(" (one core)") : fmt::format(" ({} threads)", g_cpuThreads));
 }
 
-Row timeRow(CaseScenarios& scenarios, const CaseKey& c, const std::string& backend, const std::string& broadphase, long steps,
-            const std::string& param = "", std::optional<int> blockSize = {}, std::optional<int> copyBackEvery = {}) {
+// The case's scenario as a row times it: on `backend` with `broadphase` and `threads`, long enough
+// that no batch is cut at the scenario's end inside the timing.
+Scenario rowScenario(CaseScenarios& scenarios, const CaseKey& c, const std::string& backend, const std::string& broadphase, long steps,
+                     int threads) {
   Scenario s = scenarios.get(c);
   s.backend = backend;
-  s.threads = g_cpuThreads;
+  s.threads = threads;
   s.broadphase = broadphase;
+  s.steps = std::max<long>(s.steps, 2 * steps + 1000);
+  return s;
+}
+
+Row timeRow(CaseScenarios& scenarios, const CaseKey& c, const std::string& backend, const std::string& broadphase, long steps,
+            const std::string& param = "", std::optional<int> blockSize = {}, std::optional<int> copyBackEvery = {}) {
+  Scenario s = rowScenario(scenarios, c, backend, broadphase, steps, g_cpuThreads);
   if (blockSize) s.cudaBlockSize = *blockSize;
   if (copyBackEvery) s.copyBackEvery = *copyBackEvery;
-  s.steps = std::max<long>(s.steps, 2 * steps + 1000);  // no batch cut at the scenario's end inside the timing
   const bool large = c.floes >= 50000;
   const auto start = Clock::now();
   if (large)
@@ -420,11 +428,7 @@ void sweepTable(const TableRun& run, const std::string& name) {
 // timeRow times one; a copy that ends first leaves the others a little less disturbed, so the
 // mean is a little kinder than a machine busy throughout.
 Row independentFieldsRow(CaseScenarios& scenarios, const CaseKey& c, const std::string& broadphase, long steps, int fields) {
-  Scenario s = scenarios.get(c);
-  s.backend = "cpu";
-  s.threads = 1;
-  s.broadphase = broadphase;
-  s.steps = std::max<long>(s.steps, 2 * steps + 1000);
+  const Scenario s = rowScenario(scenarios, c, "cpu", broadphase, steps, 1);
   const bool large = c.floes >= 50000;
   const auto begun = Clock::now();
   if (large) std::fprintf(stderr, "gem bench: %s, cpu, %s, %d independent fields...\n", c.name.c_str(), broadphase.c_str(), fields);
